@@ -1,0 +1,17 @@
+"""Numba options, set in one place for every kernel.
+
+``cache=True`` keeps compiled kernels on disk (cold start once per install); ``fastmath`` stays
+off so that results do not depend on the instruction set or reassociation; ``nogil`` lets the
+threading layer run kernels side by side.
+"""
+
+import numba
+
+JIT_OPTIONS = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+
+jit = numba.njit(**JIT_OPTIONS)
+
+
+def parallel_jit(function):
+    """Compile *function* with ``parallel=True`` (its outer loop is a ``numba.prange`` over trials)."""
+    return numba.njit(parallel=True, **JIT_OPTIONS)(function)

@@ -1,0 +1,191 @@
+"""The data reduction of JJF 2003-2022, exactly as the specification writes it.
+
+Pure functions over NumPy arrays, vectorised over leading (trial) dimensions. They see only what
+a laboratory sees: the mean output of each recorded segment (eq. (3)) and the *nominal* schedule,
+never the truth. Output channels are ordered ``gx, gy, gz, ax, ay, az`` (gyro in rad/s,
+accelerometer in m/s²).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from plansim.model.parameters import pack
+from plansim.schedule.segments import Schedule, axis_vector
+
+GYRO = slice(0, 3)
+ACCEL = slice(3, 6)
+
+#: JJF 2003 eq. (6)/(9): the 4×6 design matrix (rows a_X, a_Y, a_Z in g, then the constant)
+DESIGN_MATRIX_A = np.array([[1, -1, 0, 0, 0, 0],
+                            [0, 0, 1, -1, 0, 0],
+                            [0, 0, 0, 0, 1, -1],
+                            [1, 1, 1, 1, 1, 1]], dtype=float)
+
+
+def segment_mean(samples: np.ndarray) -> np.ndarray:
+    """JJF 2003 eq. (3): ``U_k = (1/N) Σ U_ki`` over the last axis (the samples of one point)."""
+    return np.mean(samples, axis=-1)
+
+
+def line_fit(rates: np.ndarray, outputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """JJF 2003 eq. (4)–(5): least-squares ``U = K X + b``, ``[K b]ᵀ = (HᵀH)⁻¹ HᵀU``, ``H = [X 1]``.
+
+    Parameters
+    ----------
+    rates : (n,) array
+        Nominal input rates X of the rate points.
+    outputs : (..., n) array
+        Mean outputs U at those points.
+
+    Returns
+    -------
+    K, b : arrays of shape (...)
+        Slope (scale factor) and intercept (fitted bias).
+    """
+    rates = np.asarray(rates, dtype=float)
+    H = np.column_stack([rates, np.ones_like(rates)])
+    if np.linalg.matrix_rank(H) < 2:
+        raise ValueError(f"rate points {rates.tolist()}: at least 2 distinct rates are needed for eq. (5)")
+    pseudo_inverse = np.linalg.solve(H.T @ H, H.T)  # (2, n)
+    coefficients = np.asarray(outputs, dtype=float) @ pseudo_inverse.T
+    return coefficients[..., 0], coefficients[..., 1]
+
+
+def multi_position_fit(group_means: np.ndarray, design: np.ndarray) -> np.ndarray:
+    """JJF 2003 eq. (7)/(10): ``Ḡ = U Aᵀ (A Aᵀ)⁻¹``.
+
+    Parameters
+    ----------
+    group_means : (..., 3, m) array
+        Mean output of three sensors in each of the m groups (``U_g`` or ``U_a``).
+    design : (4, m) array
+        Matrix A: rows a_X, a_Y, a_Z (in g) and the constant 1.
+
+    Returns
+    -------
+    (..., 3, 4) array
+        ``[G | B]`` (gyro, eq. (8)) or ``[Ka | Ba]`` (accelerometer, eq. (11)), per g.
+    """
+    design = np.asarray(design, dtype=float)
+    right = design.T @ np.linalg.inv(design @ design.T)  # (m, 4)
+    return np.asarray(group_means, dtype=float) @ right
+
+
+def rate_sensitivity(at_rest: np.ndarray, rotating: np.ndarray, rate: float, sign: str = "model") -> np.ndarray:
+    """JJF 2003 eq. (12)–(13): accelerometer angular-rate sensitivity from U7 (at rest) and U8 (rotating).
+
+    ``sign = "as_printed"`` returns ``(U7 − U8)/ω²`` as eq. (12) prints it; ``"model"`` (default)
+    returns ``(U8 − U7)/ω²``, the estimator consistent with eq. (2), where the rotating reading is
+    ``U8 = U7 + p·ω²`` (digest §1.4: the printed sign returns −p).
+    """
+    if sign not in ("model", "as_printed"):
+        raise ValueError(f"reduction.omega_squared_sign = {sign!r}; allowed: 'model', 'as_printed'")
+    difference = np.asarray(rotating) - np.asarray(at_rest)
+    if sign == "as_printed":
+        difference = -difference
+    return difference / rate**2
+
+
+# ----------------------------------------------------------------------------- the design of a schedule
+
+
+def multi_position_design(schedule: Schedule) -> tuple[list[int], list[list[int]], np.ndarray]:
+    """Groups of the multi-position test: (group numbers, segment indices per group, matrix A).
+
+    Column *j* of A is ``[a_X, a_Y, a_Z, 1]`` with the nominal specific force of group *j* in g
+    (the up-pointing body axis); for the 12- and 6-position tests it is eq. (6)'s matrix.
+    """
+    idx = schedule.select("multi_position")
+    groups = sorted({schedule.segments[k].group for k in idx})
+    members = [[k for k in idx if schedule.segments[k].group == g] for g in groups]
+    columns = []
+    for g, ks in zip(groups, members):
+        ups = {schedule.segments[k].up for k in ks}
+        if len(ups) != 1:
+            raise ValueError(f"schedule: multi-position group {g} mixes up-axes {sorted(ups)}; "
+                             "the positions averaged into one group must share the axis that points up")
+        columns.append(np.append(axis_vector(ups.pop()), 1.0))
+    design = np.array(columns).T if columns else np.zeros((4, 0))
+    return groups, members, design
+
+
+def check_design(schedule: Schedule) -> None:
+    """Raise ``ValueError`` if the schedule cannot give every JJF 2003 parameter."""
+    groups, _, design = multi_position_design(schedule)
+    if design.shape[1] == 0 or np.linalg.matrix_rank(design) < 4:
+        raise ValueError(
+            f"schedule: the multi-position groups {groups} give a rank-{np.linalg.matrix_rank(design) if design.size else 0} "
+            "design matrix A; eq. (7) needs rank 4 (each axis up and down, e.g. the 6 or 12 positions of Appendix C)")
+    for axis in range(3):
+        rates = {schedule.segments[k].rate for k in schedule.select("rate") if schedule.segments[k].group == axis}
+        if len(rates) < 2:
+            raise ValueError(f"schedule: the rate test about {'xyz'[axis]} has {len(rates)} distinct rate point(s) "
+                             f"{sorted(rates)}; eq. (5) needs at least 2 (the specification asks for 7 to 11)")
+        for k in schedule.select("rate"):
+            s = schedule.segments[k]
+            if s.group == axis and s.rate_axis != f"+{'xyz'[axis]}":
+                raise ValueError(f"segment {s.label!r}: a rate-test segment of group {axis} must turn about "
+                                 f"'+{'xyz'[axis]}', not {s.rate_axis!r}")
+    for axis in range(3):
+        segs = [schedule.segments[k] for k in schedule.select("omega_squared") if schedule.segments[k].group == axis]
+        rest = [s for s in segs if not s.is_rotating]
+        turning = [s for s in segs if s.is_rotating]
+        if not rest or not turning or len({s.rate for s in turning}) != 1:
+            raise ValueError(f"schedule: the omega-squared test about {'xyz'[axis]} needs at least one segment at "
+                             "rest (U7) and rotating segments at one rate (U8) (JJF 2003 §7.2.5)")
+        if any(s.rate_axis != f"+{'xyz'[axis]}" or s.up != f"+{'xyz'[axis]}" for s in segs):
+            raise ValueError(f"schedule: the omega-squared test of group {axis} must have +{'xyz'[axis]} up and "
+                             "turn about it (JJF 2003 §7.2.5 a))")
+
+
+# ----------------------------------------------------------------------------- the whole reduction
+
+
+def reduce(means: np.ndarray, schedule: Schedule, reference_gravity: float,
+           omega_squared_sign: str = "model") -> np.ndarray:
+    """Every JJF 2003 parameter from the segment means.
+
+    Parameters
+    ----------
+    means : (..., S, 6) array
+        Mean output of every segment, channels gx, gy, gz (rad/s), ax, ay, az (m/s²).
+    schedule : Schedule
+        The nominal schedule (what the lab commanded).
+    reference_gravity : float
+        The value of "1 g" the lab uses in matrix A, m/s².
+    omega_squared_sign : {"model", "as_printed"}
+        See :func:`rate_sensitivity`.
+
+    Returns
+    -------
+    (..., 39) array
+        Estimates in SI, ordered as :data:`plansim.model.parameters.PARAMETER_NAMES`.
+    """
+    means = np.asarray(means, dtype=float)
+    lead = means.shape[:-2]
+    Kg = np.zeros(lead + (3, 3))
+    for axis in range(3):
+        ks = [k for k in schedule.select("rate") if schedule.segments[k].group == axis]
+        rates = np.array([schedule.segments[k].rate for k in ks])
+        slope, _ = line_fit(rates, np.moveaxis(means[..., ks, GYRO], -2, -1))
+        Kg[..., :, axis] = slope  # §7.2.3: column = rate about this table axis
+
+    _, members, design = multi_position_design(schedule)
+    group_means = np.stack([means[..., ks, :].mean(axis=-2) for ks in members], axis=-1)  # (..., 6, m)
+    gyro = multi_position_fit(group_means[..., GYRO, :], design)
+    accel = multi_position_fit(group_means[..., ACCEL, :], design)
+    G, Bg = gyro[..., :3] / reference_gravity, gyro[..., 3]
+    Ka, Ba = accel[..., :3] / reference_gravity, accel[..., 3]
+
+    P = np.zeros(lead + (3, 3))
+    for axis in range(3):
+        segs = [k for k in schedule.select("omega_squared") if schedule.segments[k].group == axis]
+        rest = [k for k in segs if not schedule.segments[k].is_rotating]
+        turning = [k for k in segs if schedule.segments[k].is_rotating]
+        rate = schedule.segments[turning[0]].rate
+        u7 = means[..., rest, ACCEL].mean(axis=-2)
+        u8 = means[..., turning, ACCEL].mean(axis=-2)
+        P[..., :, axis] = rate_sensitivity(u7, u8, rate, omega_squared_sign)
+    P[..., [0, 1, 2], [0, 1, 2]] = 0.0
+    return pack(Kg, Bg, G, Ka, Ba, P)

@@ -1,0 +1,1 @@
+"""The world being simulated: calibration parameters, sensor effects, noise, turntable, laboratory."""

@@ -1,0 +1,503 @@
+"""Scenarios: the whole simulated world and procedure, read from and written to TOML.
+
+A scenario file has the sections ``[monte_carlo]``, ``[environment]``, ``[mimu]`` (with
+``[mimu.truth]``, ``[mimu.truth_spread]``, ``[mimu.noise]``, ``[mimu.effects]``),
+``[acquisition]``, ``[turntable]``, ``[schedule]`` and ``[reduction]``; docs/scenario-file.md
+explains every field. Quantities are strings ``"<number> <unit>"``; parsing is strict: an unknown
+key, a wrong unit, a NaN, a non-positive dwell, fewer than two distinct rate points or a
+rank-deficient position set raise ``ValueError``/``TypeError`` naming the field and what is allowed.
+Inside, everything is SI.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from plansim.model.environment import earth_rate_enu, normal_gravity
+from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, PARAMETERS
+from plansim.schedule import Schedule, Segment, jjf2003
+from plansim.units import STANDARD_GRAVITY, parse_matrix, parse_quantity, parse_vector
+
+# ----------------------------------------------------------------------------- configuration objects
+
+
+@dataclass(frozen=True)
+class ErrorDistribution:
+    """A table or fixture error: a ± limit is uniform, a stated uncertainty is normal (GUM 4.3.7, 4.3.3)."""
+
+    kind: str  # "uniform" | "normal"
+    scale: float  # half-width (uniform) or standard deviation (normal), SI
+
+    @property
+    def standard_uncertainty(self) -> float:
+        return self.scale / math.sqrt(3.0) if self.kind == "uniform" else self.scale
+
+    @property
+    def code(self) -> int:
+        return 0 if self.kind == "uniform" else 1
+
+
+@dataclass(frozen=True)
+class Environment:
+    latitude: float = math.radians(39.9)  # rad
+    height: float = 50.0  # m
+    earth_rate: bool = True
+
+    @property
+    def gravity(self) -> float:
+        """Local normal gravity, m/s²."""
+        return normal_gravity(self.latitude, self.height)
+
+    @property
+    def earth_rate_vector(self) -> np.ndarray:
+        """Earth rate in ENU, rad/s (zero when switched off)."""
+        return earth_rate_enu(self.latitude) if self.earth_rate else np.zeros(3)
+
+
+@dataclass(frozen=True)
+class Noise:
+    """IEEE Std 952 Allan-variance coefficients per axis (SI), and optional Gauss–Markov drift."""
+
+    gyro_angle_random_walk: np.ndarray  # N, rad/√s
+    gyro_bias_instability: np.ndarray  # B, rad/s
+    gyro_rate_random_walk: np.ndarray  # K, rad/s/√s
+    accel_velocity_random_walk: np.ndarray  # m/s/√s
+    accel_bias_instability: np.ndarray  # m/s²
+    accel_acceleration_random_walk: np.ndarray  # m/s²/√s
+    bias_instability_correlation_time: float  # s
+    gyro_markov_sigma: np.ndarray  # rad/s
+    accel_markov_sigma: np.ndarray  # m/s²
+    markov_correlation_time: float  # s
+
+
+@dataclass(frozen=True)
+class Effects:
+    """Effects beyond eq. (1)/(2); all zero (off) unless a scenario sets them."""
+
+    gyro_nonlinearity_quadratic: np.ndarray  # 1/(rad/s)
+    gyro_nonlinearity_cubic: np.ndarray  # 1/(rad/s)²
+    gyro_asymmetry: np.ndarray  # (K+ − K−)/K
+    gyro_g2_sensitivity: np.ndarray  # 3×3, rad/s per (m/s²)²
+    accel_second_order: np.ndarray  # K2, 1/(m/s²)
+    gyro_bias_temperature_coefficient: np.ndarray  # rad/s/°C
+    gyro_scale_temperature_coefficient: np.ndarray  # 1/°C
+    accel_bias_temperature_coefficient: np.ndarray  # m/s²/°C
+    accel_scale_temperature_coefficient: np.ndarray  # 1/°C
+    reference_temperature: float  # °C
+    accel_lever_arm: np.ndarray  # 3×3, row i = position of accelerometer i from the table axis, m
+    gyro_output_range: float  # rad/s; inf = no saturation
+    accel_output_range: float  # m/s²
+
+
+@dataclass(frozen=True)
+class Acquisition:
+    """Data acquisition (JJF 2003 Appendix A eq. (A.3)): N bits over ±full scale, δ = 1/2^N."""
+
+    bits: int  # 0 = no quantisation
+    gyro_full_scale: float  # rad/s
+    accel_full_scale: float  # m/s²
+
+    @property
+    def gyro_step(self) -> float:
+        """Quantisation step 2·FS/2^N (so the half-step is δ·FS), rad/s; 0 when off."""
+        return 2.0 * self.gyro_full_scale / 2**self.bits if self.bits else 0.0
+
+    @property
+    def accel_step(self) -> float:
+        return 2.0 * self.accel_full_scale / 2**self.bits if self.bits else 0.0
+
+
+@dataclass(frozen=True)
+class Turntable:
+    """Turntable and fixture errors (JJF 2003 Table 1, §6.2). Angles in rad, rate errors relative."""
+
+    position_accuracy: ErrorDistribution  # per position
+    position_repeatability: ErrorDistribution  # per position
+    axis_perpendicularity: ErrorDistribution  # per calibration, per rate-test axis
+    platform_tilt: ErrorDistribution  # per calibration
+    fixture_perpendicularity: ErrorDistribution  # per calibration
+    rate_error_systematic: ErrorDistribution  # per calibration
+    rate_error_per_point: ErrorDistribution  # per rate point
+    rate_smoothness: float  # relative standard deviation of the rate, per sample
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """Choices a lab makes when it reduces the data with the specification's formulas."""
+
+    reference_gravity: float  # m/s²: the value of "1 g" in the matrix A of eq. (6)-(11)
+    reference_gravity_label: str  # "local", "standard" or the stated value
+    omega_squared_sign: str  # "model": p = (U8 − U7)/ω², consistent with eq. (2); "as_printed": eq. (12)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    description: str
+    trials: int
+    seed: int
+    environment: Environment
+    mimu_description: str
+    truth_nominal: np.ndarray  # (39,) SI
+    truth_spread: np.ndarray  # (39,) SI standard deviations
+    noise: Noise
+    effects: Effects
+    acquisition: Acquisition
+    turntable: Turntable
+    schedule: Schedule
+    reduction: Reduction
+    document: dict = field(repr=False, default_factory=dict)  # the parsed TOML, for provenance and saving
+
+
+# ----------------------------------------------------------------------------- parsing helpers
+
+_ZERO3 = ["0 1"] * 3
+
+
+class _Section:
+    """Reads one TOML table, remembering which keys were used so that unknown keys are errors."""
+
+    def __init__(self, document: dict, path: str):
+        self.path = path
+        node = document
+        for part in path.split("."):
+            node = node.get(part, {}) if isinstance(node, dict) else {}
+        if not isinstance(node, dict):
+            raise TypeError(f"[{path}] must be a table, got {type(node).__name__}")
+        self.data = node
+        self.used: set[str] = set()
+
+    def where(self, key: str) -> str:
+        return f"{self.path}.{key}"
+
+    def get(self, key, default=None):
+        self.used.add(key)
+        return self.data.get(key, default)
+
+    def quantity(self, key, kind, default):
+        return parse_quantity(self.get(key, default), kind, self.where(key))
+
+    def vector(self, key, kind, default="0"):
+        raw = self.get(key, None)
+        if raw is None:
+            return np.zeros(3) if default == "0" else parse_vector(default, kind, self.where(key))
+        return parse_vector(raw, kind, self.where(key))
+
+    def matrix(self, key, kind):
+        raw = self.get(key, None)
+        return np.zeros((3, 3)) if raw is None else parse_matrix(raw, kind, self.where(key))
+
+    def boolean(self, key, default):
+        value = self.get(key, default)
+        if not isinstance(value, bool):
+            raise TypeError(f"{self.where(key)} = {value!r}: expected true or false")
+        return value
+
+    def integer(self, key, default, minimum=None):
+        value = self.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise TypeError(f"{self.where(key)} = {value!r}: expected a whole number")
+        if minimum is not None and value < minimum:
+            raise ValueError(f"{self.where(key)} = {value!r}: must be >= {minimum}")
+        return value
+
+    def string(self, key, default, allowed=None):
+        value = self.get(key, default)
+        if not isinstance(value, str):
+            raise TypeError(f"{self.where(key)} = {value!r}: expected a string")
+        if allowed is not None and value not in allowed:
+            raise ValueError(f"{self.where(key)} = {value!r}; allowed: {', '.join(map(repr, allowed))}")
+        return value
+
+    def error(self, key, kind):
+        raw = self.get(key, None)
+        where = self.where(key)
+        if raw is None:
+            return ErrorDistribution("uniform", 0.0)
+        if isinstance(raw, dict):
+            keys = set(raw)
+            if keys == {"limit"}:
+                return ErrorDistribution("uniform", _nonneg(parse_quantity(raw["limit"], kind, where + ".limit"), where))
+            if keys == {"standard_uncertainty"}:
+                return ErrorDistribution("normal", _nonneg(parse_quantity(raw["standard_uncertainty"], kind, where), where))
+            if keys == {"expanded_uncertainty", "k"}:
+                k = raw["k"]
+                if isinstance(k, bool) or not isinstance(k, (int, float)) or not k > 0:
+                    raise ValueError(f"{where}.k = {k!r}: the coverage factor must be a number > 0")
+                u = parse_quantity(raw["expanded_uncertainty"], kind, where + ".expanded_uncertainty")
+                return ErrorDistribution("normal", _nonneg(u / k, where))
+            raise ValueError(f"{where} = {raw!r}: give {{limit = ...}} (uniform ± limit), "
+                             "{standard_uncertainty = ...} or {expanded_uncertainty = ..., k = ...} (normal)")
+        return ErrorDistribution("uniform", _nonneg(parse_quantity(raw, kind, where), where))
+
+    def check_unknown(self, subtables=()):
+        unknown = set(self.data) - self.used - set(subtables)
+        if unknown:
+            raise ValueError(f"[{self.path}] has unknown key(s) {', '.join(sorted(map(repr, unknown)))}; "
+                             f"allowed: {', '.join(sorted(self.used | set(subtables)))}")
+
+
+def _nonneg(value: float, where: str) -> float:
+    if value < 0:
+        raise ValueError(f"{where} = {value!r}: an error limit or uncertainty must be >= 0")
+    return value
+
+
+_TOP_LEVEL = {"name", "description", "monte_carlo", "environment", "mimu", "acquisition", "turntable",
+              "schedule", "reduction"}
+
+
+def _parse_truth(section: _Section, default_zero: bool) -> np.ndarray:
+    out = np.zeros(N_PARAMETERS)
+    for k, p in enumerate(PARAMETERS):
+        raw = section.get(p.name)
+        if raw is None:
+            if not default_zero and p.group in ("Kg", "Ka") and p.row == p.col:
+                out[k] = 1.0
+            continue
+        out[k] = parse_quantity(raw, p.kind, section.where(p.name))
+    unknown = set(section.data) - set(PARAMETER_NAMES)
+    if unknown:
+        raise ValueError(f"[{section.path}] has unknown parameter(s) {', '.join(sorted(map(repr, unknown)))}; "
+                         f"parameters are named by the JJF 2003 symbols: {', '.join(PARAMETER_NAMES)}")
+    return out
+
+
+def _parse_schedule(document: dict) -> Schedule:
+    s = _Section(document, "schedule")
+    procedure = s.string("procedure", "jjf2003", allowed=("jjf2003", "custom"))
+    if procedure == "custom":
+        raw_segments = s.get("segments")
+        if not isinstance(raw_segments, list) or not raw_segments:
+            raise ValueError("schedule.segments: a custom schedule needs a non-empty list of [[schedule.segments]]")
+        segments = []
+        for i, raw in enumerate(raw_segments):
+            seg = _Section({"seg": raw}, "seg")
+            seg.path = f"schedule.segments[{i}]"
+            segments.append(Segment(
+                label=seg.string("label", f"segment {i}"),
+                test=seg.string("test", "multi_position"),
+                group=seg.integer("group", 0),
+                up=seg.string("up", "+z"),
+                heading=seg.quantity("heading", "angle", "0 deg"),
+                rate=seg.quantity("rate", "angular_rate", "0 deg/s"),
+                rate_axis=seg.string("rate_axis", "+z"),
+                dwell=seg.quantity("dwell", "time", "30 s"),
+                settle=seg.quantity("settle", "time", "10 s"),
+                sample_rate=seg.quantity("sample_rate", "frequency", "100 Hz"),
+                temperature=seg.quantity("temperature", "temperature", "20 degC"),
+            ))
+            seg.check_unknown()
+        s.check_unknown()
+        schedule = Schedule(tuple(segments), procedure="custom")
+    else:
+        rate_points = s.get("rate_points", ["-100 deg/s", "-50 deg/s", "-20 deg/s", "-5 deg/s", "0 deg/s",
+                                            "5 deg/s", "20 deg/s", "50 deg/s", "100 deg/s"])
+        if not isinstance(rate_points, list):
+            raise TypeError(f"schedule.rate_points = {rate_points!r}: expected a list of rates")
+        rates = [parse_quantity(r, "angular_rate", f"schedule.rate_points[{i}]") for i, r in enumerate(rate_points)]
+        schedule = jjf2003(
+            rate_points=rates,
+            omega_squared_rate=s.quantity("omega_squared_rate", "angular_rate", "100 deg/s"),
+            positions=s.integer("positions", 12),
+            dwell=s.quantity("dwell", "time", "30 s"),
+            settle=s.quantity("settle", "time", "10 s"),
+            sample_rate=s.quantity("sample_rate", "frequency", "100 Hz"),
+            temperature_start=s.quantity("temperature_start", "temperature", "20 degC"),
+            temperature_end=s.quantity("temperature_end", "temperature", "20 degC"),
+        )
+        s.check_unknown()
+    from plansim.estimate.jjf2003 import check_design  # the estimators say what they need
+
+    check_design(schedule)
+    return schedule
+
+
+def parse_scenario(document: dict, name: str | None = None) -> Scenario:
+    """Build a :class:`Scenario` from a parsed TOML document, validating every field."""
+    if not isinstance(document, dict):
+        raise TypeError(f"scenario: expected a TOML table, got {type(document).__name__}")
+    unknown = set(document) - _TOP_LEVEL
+    if unknown:
+        raise ValueError(f"scenario has unknown section(s) or key(s) {', '.join(sorted(map(repr, unknown)))}; "
+                         f"allowed: {', '.join(sorted(_TOP_LEVEL))}")
+    mc = _Section(document, "monte_carlo")
+    trials = mc.integer("trials", 2000, minimum=1)
+    seed = mc.integer("seed", 1, minimum=0)
+    mc.check_unknown()
+
+    env = _Section(document, "environment")
+    latitude = env.quantity("latitude", "angle", "39.9 deg")
+    if abs(latitude) > math.pi / 2:
+        raise ValueError(f"environment.latitude = {env.data.get('latitude')!r}: must lie within ±90 deg")
+    environment = Environment(latitude=latitude, height=env.quantity("height", "length", "50 m"),
+                              earth_rate=env.boolean("earth_rate", True))
+    env.check_unknown()
+
+    mimu = _Section(document, "mimu")
+    mimu_description = mimu.string("description", "")
+    gyro_range = mimu.quantity("gyro_range", "angular_rate", "0 deg/s") or math.inf
+    accel_range = mimu.quantity("accel_range", "acceleration", "0 g") or math.inf
+    mimu.check_unknown(subtables=("truth", "truth_spread", "noise", "effects"))
+    truth_nominal = _parse_truth(_Section(document, "mimu.truth"), default_zero=False)
+    truth_spread = _parse_truth(_Section(document, "mimu.truth_spread"), default_zero=True)
+    if np.any(truth_spread < 0):
+        bad = PARAMETER_NAMES[int(np.argmax(truth_spread < 0))]
+        raise ValueError(f"mimu.truth_spread.{bad}: a standard deviation must be >= 0")
+
+    n = _Section(document, "mimu.noise")
+    noise = Noise(
+        gyro_angle_random_walk=n.vector("gyro_angle_random_walk", "angle_random_walk"),
+        gyro_bias_instability=n.vector("gyro_bias_instability", "angular_rate"),
+        gyro_rate_random_walk=n.vector("gyro_rate_random_walk", "rate_random_walk"),
+        accel_velocity_random_walk=n.vector("accel_velocity_random_walk", "velocity_random_walk"),
+        accel_bias_instability=n.vector("accel_bias_instability", "acceleration"),
+        accel_acceleration_random_walk=n.vector("accel_acceleration_random_walk", "acceleration_random_walk"),
+        bias_instability_correlation_time=n.quantity("bias_instability_correlation_time", "time", "100 s"),
+        gyro_markov_sigma=n.vector("gyro_markov_sigma", "angular_rate"),
+        accel_markov_sigma=n.vector("accel_markov_sigma", "acceleration"),
+        markov_correlation_time=n.quantity("markov_correlation_time", "time", "300 s"),
+    )
+    n.check_unknown()
+    for key in ("bias_instability_correlation_time", "markov_correlation_time"):
+        if not getattr(noise, key) > 0:
+            raise ValueError(f"mimu.noise.{key}: must be > 0 s")
+    for key, value in vars(noise).items():
+        if isinstance(value, np.ndarray) and np.any(value < 0):
+            raise ValueError(f"mimu.noise.{key}: noise coefficients must be >= 0")
+
+    e = _Section(document, "mimu.effects")
+    effects = Effects(
+        gyro_nonlinearity_quadratic=e.vector("gyro_nonlinearity_quadratic", "per_rate"),
+        gyro_nonlinearity_cubic=e.vector("gyro_nonlinearity_cubic", "per_rate_squared"),
+        gyro_asymmetry=e.vector("gyro_asymmetry", "dimensionless"),
+        gyro_g2_sensitivity=e.matrix("gyro_g2_sensitivity", "rate_per_acceleration_squared"),
+        accel_second_order=e.vector("accel_second_order", "per_acceleration"),
+        gyro_bias_temperature_coefficient=e.vector("gyro_bias_temperature_coefficient", "angular_rate_per_temperature"),
+        gyro_scale_temperature_coefficient=e.vector("gyro_scale_temperature_coefficient", "per_temperature"),
+        accel_bias_temperature_coefficient=e.vector("accel_bias_temperature_coefficient", "acceleration_per_temperature"),
+        accel_scale_temperature_coefficient=e.vector("accel_scale_temperature_coefficient", "per_temperature"),
+        reference_temperature=e.quantity("reference_temperature", "temperature", "20 degC"),
+        accel_lever_arm=e.matrix("accel_lever_arm", "length"),
+        gyro_output_range=gyro_range,
+        accel_output_range=accel_range,
+    )
+    e.check_unknown()
+
+    a = _Section(document, "acquisition")
+    bits = a.integer("bits", 0, minimum=0)
+    if bits > 52:
+        raise ValueError(f"acquisition.bits = {bits}: must be 0 (no quantisation) to 52")
+    acquisition = Acquisition(bits=bits,
+                              gyro_full_scale=a.quantity("gyro_full_scale", "angular_rate", "125 deg/s"),
+                              accel_full_scale=a.quantity("accel_full_scale", "acceleration", "8 g"))
+    a.check_unknown()
+    if bits and not (acquisition.gyro_full_scale > 0 and acquisition.accel_full_scale > 0):
+        raise ValueError("acquisition: gyro_full_scale and accel_full_scale must be > 0 when bits > 0")
+
+    t = _Section(document, "turntable")
+    turntable = Turntable(
+        position_accuracy=t.error("position_accuracy", "angle"),
+        position_repeatability=t.error("position_repeatability", "angle"),
+        axis_perpendicularity=t.error("axis_perpendicularity", "angle"),
+        platform_tilt=t.error("platform_tilt", "angle"),
+        fixture_perpendicularity=t.error("fixture_perpendicularity", "angle"),
+        rate_error_systematic=t.error("rate_error_systematic", "dimensionless"),
+        rate_error_per_point=t.error("rate_error_per_point", "dimensionless"),
+        rate_smoothness=_nonneg(t.quantity("rate_smoothness", "dimensionless", 0), "turntable.rate_smoothness"),
+    )
+    t.check_unknown()
+
+    schedule = _parse_schedule(document)
+
+    r = _Section(document, "reduction")
+    raw_g = r.get("reference_gravity", "local")
+    if raw_g == "local":
+        g_ref, g_label = environment.gravity, "local"
+    elif raw_g == "standard":
+        g_ref, g_label = STANDARD_GRAVITY, "standard"
+    else:
+        try:
+            g_ref = parse_quantity(raw_g, "acceleration", "reduction.reference_gravity")
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"{exc}; or use 'local' or 'standard'") from None
+        g_label = str(raw_g)
+        if not g_ref > 0:
+            raise ValueError(f"reduction.reference_gravity = {raw_g!r}: must be > 0")
+    reduction = Reduction(reference_gravity=g_ref, reference_gravity_label=g_label,
+                          omega_squared_sign=r.string("omega_squared_sign", "model", allowed=("model", "as_printed")))
+    r.check_unknown()
+
+    scenario_name = document.get("name", name or "unnamed")
+    description = document.get("description", "")
+    for key, value in (("name", scenario_name), ("description", description)):
+        if not isinstance(value, str):
+            raise TypeError(f"{key} = {value!r}: expected a string")
+    return Scenario(name=scenario_name, description=description, trials=trials, seed=seed,
+                    environment=environment, mimu_description=mimu_description,
+                    truth_nominal=truth_nominal, truth_spread=truth_spread, noise=noise, effects=effects,
+                    acquisition=acquisition, turntable=turntable, schedule=schedule, reduction=reduction,
+                    document=copy.deepcopy(document))
+
+
+# ----------------------------------------------------------------------------- files
+
+
+def builtin_scenarios() -> dict[str, Path]:
+    """Name -> path of the scenarios shipped in ``scenarios/``."""
+    root = resources.files("plansim.scenarios")
+    return {Path(p.name).stem: Path(str(p)) for p in sorted(root.iterdir(), key=lambda p: p.name)
+            if p.name.endswith(".toml")}
+
+
+def load_scenario(name_or_path: str | os.PathLike = "jjf2003") -> Scenario:
+    """Load a built-in scenario by name, or a TOML file by path."""
+    text_name = str(name_or_path)
+    builtin = builtin_scenarios()
+    if text_name in builtin:
+        path = builtin[text_name]
+    else:
+        path = Path(text_name)
+        if not path.is_file():
+            raise ValueError(f"scenario {text_name!r}: no such file and no built-in scenario of that name; "
+                             f"built-in: {', '.join(builtin)}")
+    try:
+        with open(path, "rb") as fh:
+            document = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
+    return parse_scenario(document, name=path.stem)
+
+
+def schedule_to_document(schedule: Schedule) -> dict:
+    """The ``[schedule]`` table of a custom schedule listing every segment (user units)."""
+    segments = []
+    for s in schedule.segments:
+        segments.append({
+            "label": s.label, "test": s.test, "group": int(s.group), "up": s.up,
+            "heading": f"{math.degrees(s.heading):.12g} deg", "rate": f"{math.degrees(s.rate):.12g} deg/s",
+            "rate_axis": s.rate_axis, "dwell": f"{s.dwell:.12g} s", "settle": f"{s.settle:.12g} s",
+            "sample_rate": f"{s.sample_rate:.12g} Hz", "temperature": f"{s.temperature:.12g} degC",
+        })
+    return {"procedure": "custom", "segments": segments}
+
+
+def save_scenario(scenario: Scenario, path: str | os.PathLike, expand_schedule: bool = True) -> None:
+    """Write *scenario* as TOML (atomically). With *expand_schedule* the schedule is written segment by segment."""
+    import tomli_w
+
+    from plansim.report.files import atomic_write_bytes
+
+    document = copy.deepcopy(scenario.document)
+    document["name"] = scenario.name
+    if expand_schedule:
+        document["schedule"] = schedule_to_document(scenario.schedule)
+    atomic_write_bytes(path, tomli_w.dumps(document).encode())

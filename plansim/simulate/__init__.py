@@ -1,0 +1,1 @@
+"""Simulation: numba kernels (plain SI arrays) and the engine that feeds them from a scenario."""
