@@ -76,6 +76,7 @@ class Noise:
     gyro_markov_sigma: np.ndarray  # rad/s
     accel_markov_sigma: np.ndarray  # m/s²
     markov_correlation_time: float  # s
+    drift_update_interval: float  # s: drift states are advanced (exactly) this often and held between
 
 
 @dataclass(frozen=True)
@@ -365,9 +366,10 @@ def parse_scenario(document: dict, name: str | None = None) -> Scenario:
         gyro_markov_sigma=n.vector("gyro_markov_sigma", "angular_rate"),
         accel_markov_sigma=n.vector("accel_markov_sigma", "acceleration"),
         markov_correlation_time=n.quantity("markov_correlation_time", "time", "300 s"),
+        drift_update_interval=n.quantity("drift_update_interval", "time", "0.1 s"),
     )
     n.check_unknown()
-    for key in ("bias_instability_correlation_time", "markov_correlation_time"):
+    for key in ("bias_instability_correlation_time", "markov_correlation_time", "drift_update_interval"):
         if not getattr(noise, key) > 0:
             raise ValueError(f"mimu.noise.{key}: must be > 0 s")
     for key, value in vars(noise).items():

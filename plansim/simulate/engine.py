@@ -84,6 +84,7 @@ def kernel_arguments(scenario: Scenario) -> dict[str, object]:
         rrw=np.concatenate([n.gyro_rate_random_walk, n.accel_acceleration_random_walk]),
         markov_sigma=np.concatenate([n.gyro_markov_sigma, n.accel_markov_sigma]),
         markov_tau=float(n.markov_correlation_time),
+        drift_interval=float(n.drift_update_interval),
         step_gyro=float(a.gyro_step), step_accel=float(a.accel_step),
         fs_gyro=float(a.gyro_full_scale), fs_accel=float(a.accel_full_scale),
         error_kind=np.array([d.code for d in errors], dtype=np.int64),

@@ -102,13 +102,53 @@ def _gauss_markov_step(x, phi, sigma, state, zig_x, zig_ratio):
     return phi * x + sigma * math.sqrt(1.0 - phi * phi) * normal(state, zig_x, zig_ratio)
 
 
+
+@jit
+def _advance_drift(interval, bi_state, mk_state, rw_state, bi_sigma, bi_tau, markov_sigma, markov_tau, rrw,
+                   state, zig_x, zig_ratio):
+    """Exact update of the drift processes over *interval* seconds (Gauss–Markov and random walk)."""
+    if interval <= 0.0:
+        return
+    phi_bi = math.exp(-interval / bi_tau)
+    phi_mk = math.exp(-interval / markov_tau)
+    sq = math.sqrt(interval)
+    for c in range(6):
+        if bi_sigma[c] > 0.0:
+            bi_state[c] = _gauss_markov_step(bi_state[c], phi_bi, bi_sigma[c], state, zig_x, zig_ratio)
+        if markov_sigma[c] > 0.0:
+            mk_state[c] = _gauss_markov_step(mk_state[c], phi_mk, markov_sigma[c], state, zig_x, zig_ratio)
+        if rrw[c] > 0.0:
+            rw_state[c] += rrw[c] * sq * normal(state, zig_x, zig_ratio)
+
+
+@jit
+def _sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, n2, n3, asym, S2, k2,
+                    gyro_btc, gyro_stc, accel_btc, accel_stc, fi, y):
+    """Noise-free outputs (6) for gyro input *w* and specific force *fc* at the IMU centre."""
+    for i in range(3):  # gyros, eq. (1) + effects
+        val = Bg[i] + gyro_btc[i] * dT
+        for j in range(3):
+            val += Kg[i, j] * w[j] + G[i, j] * fc[j] + S2[i, j] * fc[j] * fc[j]
+        wi = w[i]
+        val += Kg[i, i] * gyro_stc[i] * dT * wi + n2[i] * wi * wi + n3[i] * wi * wi * wi
+        val += 0.5 * asym[i] * Kg[i, i] * abs(wi)
+        y[i] = val
+    for i in range(3):  # accelerometers, eq. (2) + effects; accelerometer i sits at its lever arm
+        for j in range(3):
+            fi[j] = fc[j] + perp[i, j]
+        val = Ba[i] + accel_btc[i] * dT
+        for j in range(3):
+            val += Ka[i, j] * fi[j] + P[i, j] * w[j] * w[j]
+        val += Ka[i, i] * accel_stc[i] * dT * fi[i] + k2[i] * fi[i] * fi[i]
+        y[3 + i] = val
+
 @jit
 def simulate_trial(trial, key, zig_x, zig_ratio,
                    seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                    truth_nominal, truth_spread,
                    n2, n3, asym, S2, k2, gyro_btc, gyro_stc, accel_btc, accel_stc, t_ref, lever,
                    gyro_range, accel_range,
-                   white_density, bi_sigma, bi_tau, rrw, markov_sigma, markov_tau,
+                   white_density, bi_sigma, bi_tau, rrw, markov_sigma, markov_tau, drift_interval,
                    step_gyro, step_accel, fs_gyro, fs_accel,
                    error_kind, error_scale, smoothness,
                    gravity, earth_enu,
@@ -235,40 +275,42 @@ def simulate_trial(trial, key, zig_x, zig_ratio,
                 perp[i, j] = -rate_act * rate_act * (lever[i, j] - ru * u[j])
 
         # drift over the settling time before recording
-        gap = seg_gap[s]
-        if gap > 0.0:
-            for c in range(6):
-                if bi_sigma[c] > 0.0:
-                    bi_state[c] = _gauss_markov_step(bi_state[c], math.exp(-gap / bi_tau), bi_sigma[c],
-                                                     noise_state, zig_x, zig_ratio)
-                if markov_sigma[c] > 0.0:
-                    mk_state[c] = _gauss_markov_step(mk_state[c], math.exp(-gap / markov_tau), markov_sigma[c],
-                                                     noise_state, zig_x, zig_ratio)
-                if rrw[c] > 0.0:
-                    rw_state[c] += rrw[c] * math.sqrt(gap) * normal(noise_state, zig_x, zig_ratio)
+        _advance_drift(seg_gap[s], bi_state, mk_state, rw_state, bi_sigma, bi_tau, markov_sigma, markov_tau,
+                       rrw, noise_state, zig_x, zig_ratio)
 
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
-        phi_bi = math.exp(-dt / bi_tau)
-        phi_mk = math.exp(-dt / markov_tau)
-        sq_dt = math.sqrt(dt)
+        white_sigma = np.empty(6)
+        for c in range(6):
+            white_sigma[c] = white_density[c] / math.sqrt(dt)
+        # drift processes are advanced every `hold` samples (exactly, over hold·dt) and held between
+        hold = max(1, int(math.floor(drift_interval / dt + 0.5)))
         for c in range(6):
             acc[c] = 0.0
         n = seg_n[s]
+        if not rotating:
+            # at rest the deterministic part of every sample is the same: compute it once
+            for i in range(3):
+                fc[i] = g_b0[i]
+                w[i] = om_b0[i]
+            _sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, n2, n3, asym, S2, k2,
+                            gyro_btc, gyro_stc, accel_btc, accel_stc, fi, y)
+        # sin/cos of θ_k by recurrence (one rotation by ω·dt per sample)
+        ct = math.cos(phase)
+        st = math.sin(phase)
+        cd = math.cos(rate_act * dt)
+        sd = math.sin(rate_act * dt)
+        ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
+        uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
+        cg0 = u[1] * g_b0[2] - u[2] * g_b0[1]
+        cg1 = u[2] * g_b0[0] - u[0] * g_b0[2]
+        cg2 = u[0] * g_b0[1] - u[1] * g_b0[0]
+        co0 = u[1] * om_b0[2] - u[2] * om_b0[1]
+        co1 = u[2] * om_b0[0] - u[0] * om_b0[2]
+        co2 = u[0] * om_b0[1] - u[1] * om_b0[0]
         for k in range(n):
             if rotating:
-                theta = phase + rate_act * (k * dt)
-                ct = math.cos(theta)
-                st = math.sin(theta)
                 # Rodrigues with angle −θ: v cosθ − (u×v) sinθ + u (u·v)(1 − cosθ)
-                ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
-                uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
-                cg0 = u[1] * g_b0[2] - u[2] * g_b0[1]
-                cg1 = u[2] * g_b0[0] - u[0] * g_b0[2]
-                cg2 = u[0] * g_b0[1] - u[1] * g_b0[0]
-                co0 = u[1] * om_b0[2] - u[2] * om_b0[1]
-                co1 = u[2] * om_b0[0] - u[0] * om_b0[2]
-                co2 = u[0] * om_b0[1] - u[1] * om_b0[0]
                 fc[0] = g_b0[0] * ct - cg0 * st + u[0] * ug * (1.0 - ct)
                 fc[1] = g_b0[1] * ct - cg1 * st + u[1] * ug * (1.0 - ct)
                 fc[2] = g_b0[2] * ct - cg2 * st + u[2] * ug * (1.0 - ct)
@@ -278,33 +320,15 @@ def simulate_trial(trial, key, zig_x, zig_ratio,
                 w[0] = rate_k * u[0] + om_b0[0] * ct - co0 * st + u[0] * uo * (1.0 - ct)
                 w[1] = rate_k * u[1] + om_b0[1] * ct - co1 * st + u[1] * uo * (1.0 - ct)
                 w[2] = rate_k * u[2] + om_b0[2] * ct - co2 * st + u[2] * uo * (1.0 - ct)
-            else:
-                for i in range(3):
-                    fc[i] = g_b0[i]
-                    w[i] = om_b0[i]
-            # gyros, eq. (1) + effects
-            for i in range(3):
-                val = Bg[i] + gyro_btc[i] * dT
-                for j in range(3):
-                    val += Kg[i, j] * w[j] + G[i, j] * fc[j] + S2[i, j] * fc[j] * fc[j]
-                wi = w[i]
-                val += Kg[i, i] * gyro_stc[i] * dT * wi + n2[i] * wi * wi + n3[i] * wi * wi * wi
-                val += 0.5 * asym[i] * Kg[i, i] * abs(wi)
-                y[i] = val
-            # accelerometers, eq. (2) + effects
-            for i in range(3):
-                for j in range(3):
-                    fi[j] = fc[j] + perp[i, j]
-                val = Ba[i] + accel_btc[i] * dT
-                for j in range(3):
-                    val += Ka[i, j] * fi[j] + P[i, j] * w[j] * w[j]
-                val += Ka[i, i] * accel_stc[i] * dT * fi[i] + k2[i] * fi[i] * fi[i]
-                y[3 + i] = val
-            # noise and drift
+                _sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, n2, n3, asym, S2, k2,
+                                gyro_btc, gyro_stc, accel_btc, accel_stc, fi, y)
+                c_next = ct * cd - st * sd
+                st = st * cd + ct * sd
+                ct = c_next
             for c in range(6):
                 val = y[c] + bi_state[c] + mk_state[c] + rw_state[c]
-                if white_density[c] > 0.0:
-                    val += white_density[c] / sq_dt * normal(noise_state, zig_x, zig_ratio)
+                if white_sigma[c] > 0.0:
+                    val += white_sigma[c] * normal(noise_state, zig_x, zig_ratio)
                 if c < 3:
                     val = _quantise(val, gyro_range, step_gyro, fs_gyro)
                 else:
@@ -312,13 +336,13 @@ def simulate_trial(trial, key, zig_x, zig_ratio,
                 acc[c] += val
                 if record:
                     samples_out[offset + k, c] = val
-                # advance the drift processes to the next sample
-                if bi_sigma[c] > 0.0:
-                    bi_state[c] = _gauss_markov_step(bi_state[c], phi_bi, bi_sigma[c], noise_state, zig_x, zig_ratio)
-                if markov_sigma[c] > 0.0:
-                    mk_state[c] = _gauss_markov_step(mk_state[c], phi_mk, markov_sigma[c], noise_state, zig_x, zig_ratio)
-                if rrw[c] > 0.0:
-                    rw_state[c] += rrw[c] * sq_dt * normal(noise_state, zig_x, zig_ratio)
+            if (k + 1) % hold == 0 and k + 1 < n:
+                _advance_drift(hold * dt, bi_state, mk_state, rw_state, bi_sigma, bi_tau, markov_sigma,
+                               markov_tau, rrw, noise_state, zig_x, zig_ratio)
+        # to the end of the recording: the last (partial) hold interval
+        tail = n % hold
+        _advance_drift((tail if tail else hold) * dt, bi_state, mk_state, rw_state, bi_sigma, bi_tau,
+                       markov_sigma, markov_tau, rrw, noise_state, zig_x, zig_ratio)
         for c in range(6):
             means_out[s, c] = acc[c] / n
         offset += n
@@ -330,7 +354,7 @@ def simulate_chunk(first_trial, key, zig_x, zig_ratio,
                    truth_nominal, truth_spread,
                    n2, n3, asym, S2, k2, gyro_btc, gyro_stc, accel_btc, accel_stc, t_ref, lever,
                    gyro_range, accel_range,
-                   white_density, bi_sigma, bi_tau, rrw, markov_sigma, markov_tau,
+                   white_density, bi_sigma, bi_tau, rrw, markov_sigma, markov_tau, drift_interval,
                    step_gyro, step_accel, fs_gyro, fs_accel,
                    error_kind, error_scale, smoothness,
                    gravity, earth_enu,
@@ -343,7 +367,7 @@ def simulate_chunk(first_trial, key, zig_x, zig_ratio,
                        truth_nominal, truth_spread,
                        n2, n3, asym, S2, k2, gyro_btc, gyro_stc, accel_btc, accel_stc, t_ref, lever,
                        gyro_range, accel_range,
-                       white_density, bi_sigma, bi_tau, rrw, markov_sigma, markov_tau,
+                       white_density, bi_sigma, bi_tau, rrw, markov_sigma, markov_tau, drift_interval,
                        step_gyro, step_accel, fs_gyro, fs_accel,
                        error_kind, error_scale, smoothness,
                        gravity, earth_enu,

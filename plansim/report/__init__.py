@@ -1,0 +1,1 @@
+"""Reports: text tables, JSON, figures, and atomic output files."""

@@ -1,0 +1,45 @@
+"""Readable text tables of a Monte Carlo run: parameters, and Appendix A claimed vs achieved."""
+
+from __future__ import annotations
+
+import xarray as xr
+
+from plansim.model.parameters import parameter
+from plansim.runner import parameter_summary
+
+
+def _g(x: float, digits: int = 4) -> str:
+    return f"{x:.{digits}g}"
+
+
+def header(results: xr.Dataset, elapsed: float | None = None) -> str:
+    a = results.attrs
+    when = f" in {elapsed:.1f} s" if elapsed is not None else ""
+    return (f"plansim {a['plansim_version']} — scenario {a['scenario']!r}: {a['trials']} trials, seed {a['seed']}, "
+            f"{a['simulation_path']} path{when}\n{a['scenario_description']}\n"
+            f"Reduction uses 1 g = {a['reference_gravity_m_s2']:.7f} m/s² ({a['reference_gravity_choice']}); "
+            f"local gravity {a['local_gravity_m_s2']:.7f} m/s² at latitude {a['latitude_deg']:.4g}°")
+
+
+def parameter_table(results: xr.Dataset) -> str:
+    """Per parameter: mean truth, mean error (estimator bias) and standard deviation of the error."""
+    lines = ["Parameters — error = estimate − truth over the trials (display units)",
+             f"{'name':6s} {'unit':>14s} {'truth (mean)':>14s} {'mean error':>12s} {'std error':>12s}"]
+    for row in parameter_summary(results):
+        spec = parameter(row["name"])
+        f = spec.display_factor
+        lines.append(f"{row['name']:6s} {spec.display_unit:>14s} {_g(row['truth'] / f, 8):>14s} "
+                     f"{_g(row['mean_error'] / f, 3):>12s} {_g(row['std_error'] / f, 3):>12s}")
+    return "\n".join(lines)
+
+
+def appendix_a_table(comparisons) -> str:
+    """Claimed (Appendix A as printed) against achieved (Monte Carlo), in each budget's reading."""
+    lines = ["Appendix A of JJF 2003-2022 (k = 2) — claimed vs achieved, in the reading named per item",
+             f"{'item':4s} {'quantity':28s} {'claimed u_c':>11s} {'claimed U':>10s} {'MC u':>10s} {'MC U95':>10s} "
+             f"{'MC bias':>10s} {'coverage':>8s}  verdict"]
+    for c in comparisons:
+        lines.append(f"{c.item:4s} {c.quantity[:28]:28s} {c.budget_uc:>11.3g} {c.budget_U:>10.3g} {c.mc_u:>10.3g} "
+                     f"{c.mc_U95:>10.3g} {c.mc_bias:>10.3g} {c.coverage:>8.1%}  {c.verdict}")
+    lines.append("readings: " + "; ".join(f"{c.item} {c.reading_unit}" for c in comparisons))
+    return "\n".join(lines)

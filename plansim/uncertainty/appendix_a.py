@@ -1,0 +1,818 @@
+"""JJF 2003-2022 Appendix A: the five published uncertainty budgets, as data, and a check against Monte Carlo.
+
+Appendix A ("MIMU 测量不确定度评定示例") evaluates five example budgets, all with coverage
+factor k = 2:
+
+- A.1 gyro scale factor K, eq. (A.1)-(A.2): Kgxx, Kgyy, Kgzz;
+- A.2 gyro bias B, the mean of the 6 position groups, eq. (A.4)-(A.5): Bgx, Bgy, Bgz;
+- A.3 gyro bias acceleration sensitivity, ``gxx = (U1 − U2)/2``, eq. (A.6)-(A.8): the nine g**
+  (gxx is the example, "the others similar", A.3.1);
+- A.4 gyro cross-coupling, eq. (A.9), propagated as A.1: the six off-diagonal Kg**;
+- A.5 accelerometer angular-rate sensitivity, ``p_yx = (U7 − U8)/ω²``, eq. (A.10)-(A.12): the six
+  p** (p_yx is the example, "the others similar", A.5.1).
+
+Each budget combines three components by ``u_c = sqrt(u1² + u2² + u3²)`` (A.1.3, A.2.3, …):
+
+- ``u1`` turntable: ``U = 2e-4, k = 2`` -> ``1.0e-4`` (A.1.2.1);
+- ``u2`` acquisition: quantisation ``δ = 1/2^N`` (eq. (A.3)), ``N = 12``, uniform ->
+  ``u2 = δ/√3 = 1.41e-4`` (A.1.2.2);
+- ``u3`` repeatability: ``1.22e-4`` given directly (A.1.2.3, A.4.2.3); for A.2 six inputs of
+  ``3.41e-5`` **added linearly** to ``2.046e-4`` (A.2.2.3); for A.3 and A.5 two inputs of
+  ``2.51e-3`` added linearly to ``5.02e-3`` (A.3.2.3, A.5.2.3).
+
+:data:`APPENDIX_A` stores every component's inputs (value per reading, number of readings, the
+combination rule as printed, and the measurement model's sensitivity coefficient) together with the
+printed ``u_c`` and ``U`` exactly as printed, so that the printed arithmetic can be checked
+(:meth:`AppendixABudget.recomputed_combined_standard_uncertainty`) and a GUM evaluation can
+recombine the same inputs (:attr:`UncertaintyComponent.gum_standard_uncertainty`).
+
+Slips in the printed arithmetic (see ``tests/test_appendix_a.py``):
+
+- A.3 and A.5: ``2 × 5.02e-3 = 1.00e-2``, printed ``1.1e-2``;
+- A.1 and A.4: ``2 × 2.12e-4 = 4.23e-4``, printed ``4.3e-4`` (both are the arithmetic value
+  rounded *up* to two significant digits, GUM 7.2.6; A.2's ``5.36e-4`` is rounded to nearest);
+- A.2, A.3, A.5: the repeatability of the individual readings is added linearly, although the
+  model is a mean (sensitivity 1/6, eq. (A.4)), a half-difference (1/2, eq. (A.6)) or a
+  difference (1, eq. (A.10)); the GUM law of propagation for independent readings (GUM 5.1.2)
+  gives ``√6·3.41e-5/6 = 1.39e-5``, ``√2·2.51e-3/2 = 1.77e-3`` and ``√2·2.51e-3 = 3.55e-3``.
+
+Reading of the units (our documented choice)
+--------------------------------------------
+Appendix A never states units: ``u1`` is a relative rate error (Table 1), ``u2`` a fraction of the
+acquisition full-scale range (eq. (A.3)) and ``u3`` is in unstated output units, and they are added
+without sensitivity coefficients. To compare the budgets with simulated errors plansim *reads*
+each budget in the unit that makes its three components commensurable with the model:
+
+``A.1`` — ``"relative"``
+    The relative error of the scale factor, ``(K̂ − K)/K`` (dimensionless). ``u1`` is the relative
+    rate error of the table and ``u2`` the quantisation relative to full scale, which the maximum
+    rate point (required by §7.2.1 a)) approaches.
+``A.4`` — ``"absolute"``
+    The absolute error of the dimensionless cross-coupling coefficient, ``K̂gxy − Kgxy``
+    (A.4.1: "the same model as the scale factor"; a relative error of a coefficient near zero is
+    meaningless).
+``A.2`` — ``"gyro_full_scale"``
+    A fraction of the gyro full scale: ``U_abs = U × FS_g`` in rad/s
+    (``scenario.acquisition.gyro_full_scale``).
+``A.3`` — ``"gyro_full_scale_per_reference_gravity"``
+    A fraction of the gyro full scale per g: ``U_abs = U × FS_g / g_ref`` in rad/s per m/s², since
+    eq. (A.6) divides outputs (fractions of FS_g) by the 2 g span of the matrix A of eq. (6), and
+    ``g_ref`` is the value of 1 g the laboratory uses there (``scenario.reduction.reference_gravity``).
+``A.5`` — ``"accel_full_scale_per_rate_squared"``
+    A fraction of the accelerometer full scale per squared test rate:
+    ``U_abs = U × FS_a / ω²`` in m/s² per (rad/s)², since eq. (A.10) divides outputs (fractions of
+    FS_a) by ω²; ω is the rate of the rotating ("U8") ``omega_squared`` segment of the schedule
+    about the parameter's input axis (column *j* of P is measured with axis *j* up, §7.2.5).
+
+:func:`reading_unit_in_si` gives the SI size of one reading unit, :func:`errors_in_reading_units`
+converts errors, and :func:`compare_with_appendix_a` compares Monte Carlo errors with each budget.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, parameter
+
+__all__ = [
+    "ACQUISITION_BITS",
+    "APPENDIX_A",
+    "COMBINATION_RULES",
+    "READING_KINDS",
+    "TABLE_COVERAGE_FACTOR",
+    "TABLE_EXPANDED_UNCERTAINTY",
+    "AppendixABudget",
+    "ItemComparison",
+    "ParameterComparison",
+    "UncertaintyComponent",
+    "acquisition_quantisation_uncertainty",
+    "NOMINAL_COVERAGE",
+    "appendix_a_budget",
+    "appendix_a_verdict",
+    "coverage_tolerance",
+    "compare_with_appendix_a",
+    "errors_in_reading_units",
+    "expanded_uncertainty_in_si",
+    "omega_squared_test_rate",
+    "reading_unit_description",
+    "reading_unit_in_si",
+]
+
+#: A.1.2.1: expanded uncertainty of the position and rate table, and its coverage factor.
+TABLE_EXPANDED_UNCERTAINTY = 2e-4
+TABLE_COVERAGE_FACTOR = 2.0
+#: A.1.2.2: effective number of bits N of the acquisition system in eq. (A.3).
+ACQUISITION_BITS = 12
+
+#: How Appendix A combines the readings of one component, as printed.
+#: ``"single"``: one value; ``"linear_sum"``: ``u = Σ u(U_i) = count × value`` (A.2.2.3, A.3.2.3, A.5.2.3).
+COMBINATION_RULES = ("single", "linear_sum")
+
+#: The unit readings of the budgets (see the module docstring).
+READING_KINDS = (
+    "relative",
+    "absolute",
+    "gyro_full_scale",
+    "gyro_full_scale_per_reference_gravity",
+    "accel_full_scale_per_rate_squared",
+)
+
+#: Display unit of each reading, for reports.
+_READING_UNIT_SYMBOL = {
+    "relative": "1 (relative error, error / true value)",
+    "absolute": "1 (absolute error of the dimensionless coefficient)",
+    "gyro_full_scale": "FS_g (gyro full scale)",
+    "gyro_full_scale_per_reference_gravity": "FS_g/g_ref (gyro full scale per reference g)",
+    "accel_full_scale_per_rate_squared": "FS_a/ω² (accelerometer full scale per squared test rate)",
+}
+
+
+def acquisition_quantisation_uncertainty(bits: int = ACQUISITION_BITS) -> float:
+    """Standard uncertainty of the acquisition quantisation, JJF 2003 eq. (A.3) and A.1.2.2.
+
+    Parameters
+    ----------
+    bits : int
+        Effective number of bits N of the acquisition system (A.1.2.2 takes N = 12).
+
+    Returns
+    -------
+    float
+        ``u2 = δ/√3`` with ``δ = 1/2^N`` (type B, uniform distribution), a fraction of full scale;
+        ``1.4095e-4`` for N = 12, printed as ``1.41e-4``.
+    """
+    if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)):
+        raise TypeError(f"bits = {bits!r}: expected a whole number of bits")
+    if bits < 1:
+        raise ValueError(f"bits = {bits!r}: the acquisition system needs at least 1 effective bit")
+    return (1.0 / 2.0 ** int(bits)) / math.sqrt(3.0)
+
+
+# ----------------------------------------------------------------------------- the budgets as data
+
+
+@dataclass(frozen=True)
+class UncertaintyComponent:
+    """One uncertainty component of an Appendix A budget, with its inputs as printed.
+
+    Attributes
+    ----------
+    symbol : str
+        ``"u1"``, ``"u2"`` or ``"u3"``.
+    source : str
+        What the component comes from (turntable, acquisition system, repeatability).
+    clause : str
+        The Appendix A clause that evaluates it, e.g. ``"A.2.2.3"``.
+    value_per_reading : float
+        The standard uncertainty of one input reading, as printed (e.g. ``u(U_gx1) = 3.41e-5``),
+        in the budget's reading unit.
+    count : int
+        Number of input readings the component combines (1, 2 or 6).
+    combination_as_printed : str
+        How the text combines the readings, one of :data:`COMBINATION_RULES`.
+    printed_value : float
+        The component's value exactly as printed (``1.0e-4``, ``1.41e-4``, ``2.046e-4``, …).
+    sensitivity_coefficient : float
+        Magnitude of the sensitivity coefficient of each reading in the budget's measurement
+        model, in the reading unit: 1/6 for the mean of eq. (A.4), 1/2 for the half-difference of
+        eq. (A.6), 1 for the difference of eq. (A.10) read in FS_a/ω², and 1 where the text gives the
+        component directly (u1, u2, and u3 of A.1/A.4). The printed budgets do not apply it.
+    derivation : str
+        How the text obtains the value.
+    """
+
+    symbol: str
+    source: str
+    clause: str
+    value_per_reading: float
+    count: int
+    combination_as_printed: str
+    printed_value: float
+    sensitivity_coefficient: float = 1.0
+    derivation: str = ""
+
+    def __post_init__(self):
+        where = f"component {self.symbol!r} ({self.clause})"
+        if self.combination_as_printed not in COMBINATION_RULES:
+            raise ValueError(f"{where}: combination_as_printed = {self.combination_as_printed!r}; "
+                             f"allowed: {', '.join(map(repr, COMBINATION_RULES))}")
+        if isinstance(self.count, bool) or not isinstance(self.count, int):
+            raise TypeError(f"{where}: count = {self.count!r}; expected a whole number of readings")
+        if self.count < 1:
+            raise ValueError(f"{where}: count = {self.count!r}; it must be >= 1")
+        if self.combination_as_printed == "single" and self.count != 1:
+            raise ValueError(f"{where}: count = {self.count!r} with combination 'single'; "
+                             "a single value has count 1 (use 'linear_sum' for several readings)")
+        for name in ("value_per_reading", "printed_value", "sensitivity_coefficient"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise TypeError(f"{where}: {name} = {value!r}; expected a number")
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{where}: {name} = {value!r}; it must be finite and >= 0")
+
+    @property
+    def combined_as_printed(self) -> float:
+        """The component recomputed with the printed rule: ``value`` or ``count × value`` (linear sum)."""
+        if self.combination_as_printed == "linear_sum":
+            return self.count * self.value_per_reading
+        return self.value_per_reading
+
+    @property
+    def gum_standard_uncertainty(self) -> float:
+        """The component by the GUM law of propagation for independent readings (GUM 5.1.2, eq. (10)).
+
+        ``c · sqrt(count) · value_per_reading``: ``√6·3.41e-5/6 = 1.39e-5`` for A.2,
+        ``√2·2.51e-3/2 = 1.77e-3`` for A.3, ``√2·2.51e-3 = 3.55e-3`` for A.5 (read in FS_a/ω²).
+        """
+        return self.sensitivity_coefficient * math.sqrt(self.count) * self.value_per_reading
+
+
+@dataclass(frozen=True)
+class AppendixABudget:
+    """One Appendix A uncertainty budget (JJF 2003-2022, A.1 … A.5), as printed.
+
+    Attributes
+    ----------
+    item : str
+        ``"A.1"`` … ``"A.5"``.
+    quantity : str
+        The quantity evaluated.
+    measurement_model : str
+        The model and the equations the clause cites.
+    parameters : tuple of str
+        The JJF 2003 parameters (names of :data:`plansim.model.parameters.PARAMETER_NAMES`) the
+        budget applies to; the text treats one as an example and says the others are similar.
+    components : tuple of UncertaintyComponent
+        ``u1``, ``u2``, ``u3``.
+    printed_combined_standard_uncertainty : float
+        ``u_c`` exactly as printed (A.x.3).
+    printed_expanded_uncertainty : float
+        ``U`` exactly as printed (A.x.4).
+    coverage_factor : float
+        ``k`` (2 in every budget).
+    reading_kind : str
+        The unit reading plansim uses (one of :data:`READING_KINDS`; module docstring).
+    reading : str
+        The reading in words.
+    """
+
+    item: str
+    quantity: str
+    measurement_model: str
+    parameters: tuple[str, ...]
+    components: tuple[UncertaintyComponent, ...]
+    printed_combined_standard_uncertainty: float
+    printed_expanded_uncertainty: float
+    coverage_factor: float
+    reading_kind: str
+    reading: str
+
+    def __post_init__(self):
+        where = f"budget {self.item!r}"
+        if not self.parameters:
+            raise ValueError(f"{where}: parameters is empty; name at least one JJF 2003 parameter")
+        for name in self.parameters:
+            if name not in PARAMETER_INDEX:
+                raise ValueError(f"{where}: unknown parameter {name!r}; known: {', '.join(PARAMETER_NAMES)}")
+        if len(set(self.parameters)) != len(self.parameters):
+            raise ValueError(f"{where}: parameters {self.parameters!r} lists a parameter twice")
+        if not self.components or not all(isinstance(c, UncertaintyComponent) for c in self.components):
+            raise TypeError(f"{where}: components must be a non-empty tuple of UncertaintyComponent")
+        if self.reading_kind not in READING_KINDS:
+            raise ValueError(f"{where}: reading_kind = {self.reading_kind!r}; "
+                             f"allowed: {', '.join(map(repr, READING_KINDS))}")
+        for name in ("printed_combined_standard_uncertainty", "printed_expanded_uncertainty", "coverage_factor"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise TypeError(f"{where}: {name} = {value!r}; expected a number")
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{where}: {name} = {value!r}; it must be finite and > 0")
+
+    def component(self, symbol: str) -> UncertaintyComponent:
+        """The component named *symbol* (``"u1"``, ``"u2"`` or ``"u3"``)."""
+        for c in self.components:
+            if c.symbol == symbol:
+                return c
+        raise ValueError(f"budget {self.item!r} has no component {symbol!r}; "
+                         f"it has {', '.join(repr(c.symbol) for c in self.components)}")
+
+    def recomputed_combined_standard_uncertainty(self) -> float:
+        """``u_c = sqrt(u1² + u2² + u3²)`` from the printed components (A.1.3 … A.5.3).
+
+        Each component is recombined from its inputs with the printed rule
+        (:attr:`UncertaintyComponent.combined_as_printed`), so this is the text's own arithmetic.
+        """
+        return math.sqrt(sum(c.combined_as_printed ** 2 for c in self.components))
+
+    def recomputed_expanded_uncertainty(self) -> float:
+        """``U = k · u_c`` with :meth:`recomputed_combined_standard_uncertainty` (A.1.4 … A.5.4), unrounded."""
+        return self.coverage_factor * self.recomputed_combined_standard_uncertainty()
+
+
+def _table_component(clause: str) -> UncertaintyComponent:
+    return UncertaintyComponent(
+        symbol="u1", source="position and rate table", clause=clause,
+        value_per_reading=TABLE_EXPANDED_UNCERTAINTY / TABLE_COVERAGE_FACTOR, count=1,
+        combination_as_printed="single", printed_value=1.0e-4,
+        derivation="table U = 2e-4 with k = 2, u1 = U/k (type B)",
+    )
+
+
+def _acquisition_component(clause: str) -> UncertaintyComponent:
+    return UncertaintyComponent(
+        symbol="u2", source="data acquisition system (quantisation)", clause=clause,
+        value_per_reading=1.41e-4, count=1, combination_as_printed="single", printed_value=1.41e-4,
+        derivation="eq. (A.3) δ = 1/2^N, N = 12, uniform: u2 = δ/√3 (type B)",
+    )
+
+
+#: The five budgets of JJF 2003-2022 Appendix A, as printed.
+APPENDIX_A: tuple[AppendixABudget, ...] = (
+    AppendixABudget(
+        item="A.1",
+        quantity="gyro scale factor K",
+        measurement_model="U = K X + b + ε, eq. (A.1) (from §7.2.1.2 eq. (4)); u_c²(K) by eq. (A.2)",
+        parameters=("Kgxx", "Kgyy", "Kgzz"),
+        components=(
+            _table_component("A.1.2.1"),
+            _acquisition_component("A.1.2.2"),
+            UncertaintyComponent(
+                symbol="u3", source="measurement repeatability", clause="A.1.2.3",
+                value_per_reading=1.22e-4, count=1, combination_as_printed="single", printed_value=1.22e-4,
+                derivation="from a large amount of experimental data on one MIMU type (type A)",
+            ),
+        ),
+        printed_combined_standard_uncertainty=2.12e-4,
+        printed_expanded_uncertainty=4.3e-4,
+        coverage_factor=2.0,
+        reading_kind="relative",
+        reading="relative error of the scale factor, (estimate − truth)/truth (dimensionless)",
+    ),
+    AppendixABudget(
+        item="A.2",
+        quantity="gyro bias B (mean of the 6 position groups)",
+        measurement_model="B = (U_gx1 + … + U_gx6)/6, eq. (A.4) (from §7.2.2.2 eq. (7)); u_c²(B) by eq. (A.5)",
+        parameters=("Bgx", "Bgy", "Bgz"),
+        components=(
+            _table_component("A.2.2.1"),
+            _acquisition_component("A.2.2.2"),
+            UncertaintyComponent(
+                symbol="u3", source="repeatability of the 6 group outputs U_gx1 … U_gx6", clause="A.2.2.3",
+                value_per_reading=3.41e-5, count=6, combination_as_printed="linear_sum", printed_value=2.046e-4,
+                sensitivity_coefficient=1.0 / 6.0,
+                derivation="u(U_gx1) = … = u(U_gx6) = 3.41e-5 (type A); printed u3 = Σ u(U_gxi) = 2.046e-4",
+            ),
+        ),
+        printed_combined_standard_uncertainty=2.68e-4,
+        printed_expanded_uncertainty=5.36e-4,
+        coverage_factor=2.0,
+        reading_kind="gyro_full_scale",
+        reading="gyro bias error as a fraction of the gyro full scale (U_abs = U × FS_g, rad/s)",
+    ),
+    AppendixABudget(
+        item="A.3",
+        quantity="gyro bias acceleration sensitivity g (gxx as the example, the others similar)",
+        measurement_model="gxx = (U_gx1 − U_gx2)/2, eq. (A.6)-(A.7) (from §7.2.2.2 eq. (7)); u_c² by eq. (A.8)",
+        parameters=("gxx", "gxy", "gxz", "gyx", "gyy", "gyz", "gzx", "gzy", "gzz"),
+        components=(
+            _table_component("A.3.2.1"),
+            _acquisition_component("A.3.2.2"),
+            UncertaintyComponent(
+                symbol="u3", source="repeatability of the outputs U_gx1, U_gx2", clause="A.3.2.3",
+                value_per_reading=2.51e-3, count=2, combination_as_printed="linear_sum", printed_value=5.02e-3,
+                sensitivity_coefficient=0.5,
+                derivation="u(U_gx1) = u(U_gx2) = 2.51e-3 (type A); printed u3 = u(U_gx1) + u(U_gx2) = 5.02e-3",
+            ),
+        ),
+        printed_combined_standard_uncertainty=5.02e-3,
+        printed_expanded_uncertainty=1.1e-2,
+        coverage_factor=2.0,
+        reading_kind="gyro_full_scale_per_reference_gravity",
+        reading="g-sensitivity error as a fraction of the gyro full scale per g "
+                "(U_abs = U × FS_g / g_ref, rad/s per m/s²)",
+    ),
+    AppendixABudget(
+        item="A.4",
+        quantity="gyro cross-coupling coefficient (Kgxy as the example, the others similar)",
+        measurement_model="off-diagonal elements of Kg, eq. (A.9) (from §7.2.3.2); propagation as A.1, eq. (A.2)",
+        parameters=("Kgxy", "Kgxz", "Kgyx", "Kgyz", "Kgzx", "Kgzy"),
+        components=(
+            _table_component("A.4.2.1"),
+            _acquisition_component("A.4.2.2"),
+            UncertaintyComponent(
+                symbol="u3", source="measurement repeatability", clause="A.4.2.3",
+                value_per_reading=1.22e-4, count=1, combination_as_printed="single", printed_value=1.22e-4,
+                derivation="from a large amount of experimental data on one MIMU type (type A)",
+            ),
+        ),
+        printed_combined_standard_uncertainty=2.12e-4,
+        printed_expanded_uncertainty=4.3e-4,
+        coverage_factor=2.0,
+        reading_kind="absolute",
+        reading="absolute error of the dimensionless cross-coupling coefficient, estimate − truth",
+    ),
+    AppendixABudget(
+        item="A.5",
+        quantity="accelerometer angular-rate sensitivity p (p_yx as the example, the others similar)",
+        measurement_model="p_yx = (U_ay7 − U_ay8)/ω², eq. (A.10)-(A.11) (from §7.2.5.2 eq. (12)-(13)); "
+                          "u_c² by eq. (A.12)",
+        parameters=("pxy", "pxz", "pyx", "pyz", "pzx", "pzy"),
+        components=(
+            _table_component("A.5.2.1"),
+            _acquisition_component("A.5.2.2"),
+            UncertaintyComponent(
+                symbol="u3", source="repeatability of the outputs U_ay7, U_ay8", clause="A.5.2.3",
+                value_per_reading=2.51e-3, count=2, combination_as_printed="linear_sum", printed_value=5.02e-3,
+                sensitivity_coefficient=1.0,
+                derivation="u(U_ay7) = u(U_ay8) = 2.51e-3 (type A); printed u3 = u(U_ay7) + u(U_ay8) = 5.02e-3",
+            ),
+        ),
+        printed_combined_standard_uncertainty=5.02e-3,
+        printed_expanded_uncertainty=1.1e-2,
+        coverage_factor=2.0,
+        reading_kind="accel_full_scale_per_rate_squared",
+        reading="rate-sensitivity error as a fraction of the accelerometer full scale per squared test rate "
+                "(U_abs = U × FS_a / ω², (m/s²)/(rad/s)²)",
+    ),
+)
+
+
+def appendix_a_budget(item: str) -> AppendixABudget:
+    """The Appendix A budget numbered *item* (``"A.1"`` … ``"A.5"``)."""
+    for budget in APPENDIX_A:
+        if budget.item == item:
+            return budget
+    raise ValueError(f"Appendix A item {item!r} does not exist; items: "
+                     f"{', '.join(repr(b.item) for b in APPENDIX_A)}")
+
+
+# ----------------------------------------------------------------------------- readings of the units
+
+
+def omega_squared_test_rate(scenario, input_axis: int) -> float:
+    """The table rate ω of the §7.2.5 test about body axis *input_axis*, rad/s.
+
+    Parameters
+    ----------
+    scenario : plansim.scenario.Scenario
+        Its schedule's ``omega_squared`` segments of group *input_axis* are searched.
+    input_axis : int
+        0, 1, 2 for x, y, z: the column *j* of P (p_ij is measured with axis *j* up, JJF 2003 §7.2.5).
+
+    Returns
+    -------
+    float
+        ``|rate|`` of the rotating (U8) segments, which must share one rate.
+    """
+    if input_axis not in (0, 1, 2):
+        raise ValueError(f"input_axis = {input_axis!r}; allowed: 0, 1, 2 (x, y, z)")
+    schedule = scenario.schedule
+    rates = {abs(s.rate) for s in schedule.segments
+             if s.test == "omega_squared" and s.group == input_axis and s.rate != 0.0}
+    if len(rates) != 1:
+        raise ValueError(f"scenario {scenario.name!r}: schedule has rotating omega_squared rates "
+                         f"{sorted(rates)} rad/s about {'xyz'[input_axis]}; the A.5 reading U × FS_a/ω² "
+                         "needs exactly one test rate (JJF 2003 §7.2.5)")
+    return rates.pop()
+
+
+def _positive(value: float, where: str, why: str) -> float:
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{where} = {value!r}: must be finite and > 0 {why}")
+    return float(value)
+
+
+def _budget_for(budget: AppendixABudget, parameter_name: str) -> int:
+    if not isinstance(budget, AppendixABudget):
+        raise TypeError(f"budget = {budget!r}: expected an AppendixABudget (e.g. an element of APPENDIX_A)")
+    if parameter_name not in budget.parameters:
+        raise ValueError(f"parameter {parameter_name!r} is not covered by budget {budget.item}; "
+                         f"it covers {', '.join(budget.parameters)}")
+    return PARAMETER_INDEX[parameter_name]
+
+
+def reading_unit_in_si(budget: AppendixABudget, parameter_name: str, scenario, truth=None):
+    """The SI size of one unit of the budget's reading, for one parameter.
+
+    Parameters
+    ----------
+    budget : AppendixABudget
+        The budget (its ``reading_kind`` selects the reading, module docstring).
+    parameter_name : str
+        One of ``budget.parameters``.
+    scenario : plansim.scenario.Scenario
+        Supplies ``acquisition.gyro_full_scale`` (A.2, A.3), ``reduction.reference_gravity`` (A.3),
+        ``acquisition.accel_full_scale`` and the ω² test rate (A.5).
+    truth : float or array, optional
+        True value(s) of the parameter, needed only by the relative reading (A.1); default the
+        scenario's nominal truth.
+
+    Returns
+    -------
+    float or ndarray
+        ``|truth|`` (A.1), 1 (A.4), ``FS_g`` rad/s (A.2), ``FS_g/g_ref`` rad/s per m/s² (A.3) or
+        ``FS_a/ω²`` (m/s²)/(rad/s)² (A.5): an error of ``e`` reading units is ``e × this`` in SI.
+    """
+    index = _budget_for(budget, parameter_name)
+    kind = budget.reading_kind
+    if kind == "absolute":
+        return 1.0
+    if kind == "relative":
+        value = scenario.truth_nominal[index] if truth is None else truth
+        magnitude = np.abs(np.asarray(value, dtype=float))
+        if not np.all(np.isfinite(magnitude) & (magnitude > 0)):
+            raise ValueError(f"truth of {parameter_name} = {value!r}: the relative reading of {budget.item} "
+                             "divides by the true value, which must be finite and non-zero")
+        return float(magnitude) if magnitude.ndim == 0 else magnitude
+    if kind == "gyro_full_scale":
+        return _positive(scenario.acquisition.gyro_full_scale, "acquisition.gyro_full_scale",
+                         f"to read {budget.item} as a fraction of the gyro full scale")
+    if kind == "gyro_full_scale_per_reference_gravity":
+        fs = _positive(scenario.acquisition.gyro_full_scale, "acquisition.gyro_full_scale",
+                       f"to read {budget.item} as a fraction of the gyro full scale per g")
+        g = _positive(scenario.reduction.reference_gravity, "reduction.reference_gravity",
+                      f"to read {budget.item} per g")
+        return fs / g
+    # accel_full_scale_per_rate_squared
+    fs = _positive(scenario.acquisition.accel_full_scale, "acquisition.accel_full_scale",
+                   f"to read {budget.item} as a fraction of the accelerometer full scale per ω²")
+    omega = omega_squared_test_rate(scenario, parameter(parameter_name).col)
+    return fs / omega**2
+
+
+def errors_in_reading_units(budget: AppendixABudget, parameter_name: str, error, scenario, truth=None) -> np.ndarray:
+    """Convert SI errors ``estimate − truth`` of one parameter into the budget's reading units.
+
+    Parameters
+    ----------
+    budget, parameter_name, scenario, truth
+        As in :func:`reading_unit_in_si` (*truth* broadcasts against *error* for A.1).
+    error : array_like
+        Errors in SI (:mod:`plansim.model.parameters` units).
+
+    Returns
+    -------
+    ndarray
+        ``error / reading_unit_in_si(...)``: relative error (A.1), absolute error (A.4), fraction of
+        ``FS_g`` (A.2), of ``FS_g/g_ref`` (A.3), of ``FS_a/ω²`` (A.5).
+    """
+    error = np.asarray(error, dtype=float)
+    return error / reading_unit_in_si(budget, parameter_name, scenario, truth)
+
+
+def expanded_uncertainty_in_si(budget: AppendixABudget, parameter_name: str, scenario, truth=None):
+    """The printed ``U`` of *budget* expressed in SI for one parameter: ``U × reading_unit_in_si``.
+
+    For A.1 (relative) the result scales with the true scale factor (default: the scenario's nominal truth).
+    """
+    return budget.printed_expanded_uncertainty * reading_unit_in_si(budget, parameter_name, scenario, truth)
+
+
+def reading_unit_description(budget: AppendixABudget, scenario) -> str:
+    """The unit of the budget's reading in words, with its SI size in *scenario* where it has one."""
+    if not isinstance(budget, AppendixABudget):
+        raise TypeError(f"budget = {budget!r}: expected an AppendixABudget")
+    symbol = _READING_UNIT_SYMBOL[budget.reading_kind]
+    kind = budget.reading_kind
+    if kind in ("relative", "absolute"):
+        return symbol
+    sizes = {reading_unit_in_si(budget, name, scenario) for name in budget.parameters}
+    si = {"gyro_full_scale": "rad/s", "gyro_full_scale_per_reference_gravity": "rad/s per m/s^2",
+          "accel_full_scale_per_rate_squared": "(m/s^2)/(rad/s)^2"}[kind]
+    if len(sizes) == 1:
+        return f"{symbol} = {sizes.pop():.6g} {si}"
+    listing = ", ".join(f"{name}: {reading_unit_in_si(budget, name, scenario):.6g}" for name in budget.parameters)
+    return f"{symbol}, in {si} per parameter ({listing})"
+
+
+# ----------------------------------------------------------------------------- comparison with Monte Carlo
+
+#: Nominal coverage probability of an expanded uncertainty with k = 2 (GUM 6.2, 6.3.3: ≈ 95 %).
+NOMINAL_COVERAGE = 0.95
+
+
+def _statistics(errors: np.ndarray, expanded: float) -> tuple[float, float, float, float]:
+    magnitude = np.abs(errors)
+    return (float(np.mean(errors)), float(np.std(errors, ddof=1)),
+            float(np.quantile(magnitude, NOMINAL_COVERAGE)), float(np.mean(magnitude <= expanded)))
+
+
+@dataclass(frozen=True)
+class ParameterComparison:
+    """Monte Carlo errors of one parameter in the reading units of its Appendix A budget.
+
+    Attributes
+    ----------
+    name : str
+        Parameter symbol.
+    mean : float
+        Mean error (bias).
+    std : float
+        Standard deviation of the errors (ddof = 1).
+    U95 : float
+        95th percentile of ``|error|``.
+    coverage : float
+        Fraction of ``|error| ≤`` the printed ``U``.
+    reading_unit_in_si : float
+        SI size of one reading unit for this parameter (for A.1 the mean ``|truth|``).
+    budget_U_si : float
+        The printed ``U`` in SI (``U × reading_unit_in_si``).
+    """
+
+    name: str
+    mean: float
+    std: float
+    U95: float
+    coverage: float
+    reading_unit_in_si: float
+    budget_U_si: float
+
+    def as_dict(self) -> dict:
+        return {"name": self.name, "mean": self.mean, "std": self.std, "U95": self.U95,
+                "coverage": self.coverage, "reading_unit_in_si": self.reading_unit_in_si,
+                "budget_U_si": self.budget_U_si}
+
+
+@dataclass(frozen=True)
+class ItemComparison:
+    """One Appendix A budget compared with the pooled Monte Carlo errors of its parameters.
+
+    All error statistics are in the budget's reading units (module docstring).
+
+    Attributes
+    ----------
+    item, quantity, reading : str
+        From the budget.
+    reading_unit : str
+        The reading's unit, with its SI size in the scenario (:func:`reading_unit_description`).
+    parameters : tuple of str
+        The pooled parameters.
+    n : int
+        Number of pooled errors (trials × parameters).
+    budget_uc, budget_U : float
+        ``u_c`` and ``U`` as printed.
+    coverage_factor : float
+        ``k`` of the budget.
+    arithmetic_uc, arithmetic_U : float
+        ``u_c`` and ``U = k·u_c`` recomputed from the printed components.
+    mc_bias : float
+        Mean error.
+    mc_u : float
+        Standard deviation of the errors (ddof = 1), the Monte Carlo standard uncertainty.
+    mc_U95 : float
+        95th percentile of ``|error|``: half-width of the interval about the truth holding 95 % of errors.
+    coverage : float
+        Fraction of errors with ``|error| ≤ budget_U``.
+    ratio : float
+        ``mc_u / budget_uc``.
+    tolerance : float
+        ``3·sqrt(0.95·0.05/n)``, three binomial standard deviations of the coverage at 95 %.
+    overstatement_factor : float
+        ``budget_U / mc_U95`` (``inf`` when every error is zero).
+    verdict : str
+        ``"supported"``; ``"under-stated"`` if ``coverage < 0.95 − tolerance``; ``"over-stated ×F"``
+        if ``coverage ≥ 0.95 + tolerance`` and ``F = overstatement_factor > 2``.
+    per_parameter : tuple of ParameterComparison
+        The same statistics for each parameter alone.
+    """
+
+    item: str
+    quantity: str
+    reading: str
+    reading_unit: str
+    parameters: tuple[str, ...]
+    n: int
+    budget_uc: float
+    budget_U: float
+    coverage_factor: float
+    arithmetic_uc: float
+    arithmetic_U: float
+    mc_bias: float
+    mc_u: float
+    mc_U95: float
+    coverage: float
+    ratio: float
+    tolerance: float
+    overstatement_factor: float
+    verdict: str
+    per_parameter: tuple[ParameterComparison, ...] = field(default_factory=tuple)
+
+    def as_dict(self) -> dict:
+        """Plain-Python dictionary for JSON (keys ``item``, ``budget_uc``, ``budget_U``, ``mc_u``,
+        ``mc_U95``, ``coverage`` and the other attributes; ``per_parameter`` as a list of dicts)."""
+        return {
+            "item": self.item, "quantity": self.quantity, "reading": self.reading,
+            "reading_unit": self.reading_unit, "parameters": list(self.parameters), "n": self.n,
+            "budget_uc": self.budget_uc, "budget_U": self.budget_U, "coverage_factor": self.coverage_factor,
+            "arithmetic_uc": self.arithmetic_uc, "arithmetic_U": self.arithmetic_U,
+            "mc_bias": self.mc_bias, "mc_u": self.mc_u, "mc_U95": self.mc_U95, "coverage": self.coverage,
+            "ratio": self.ratio, "tolerance": self.tolerance,
+            "overstatement_factor": self.overstatement_factor, "verdict": self.verdict,
+            "per_parameter": [p.as_dict() for p in self.per_parameter],
+        }
+
+
+def coverage_tolerance(n: int) -> float:
+    """``3·sqrt(0.95·0.05/n)``: three binomial standard deviations of an observed 95 % coverage from *n* errors."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"n = {n!r}: the number of errors must be a whole number >= 1")
+    return 3.0 * math.sqrt(NOMINAL_COVERAGE * (1.0 - NOMINAL_COVERAGE) / n)
+
+
+def appendix_a_verdict(coverage: float, n: int, budget_expanded: float, mc_U95: float) -> tuple[str, float]:
+    """Verdict on a printed ``U`` from the Monte Carlo coverage of *n* errors.
+
+    Returns
+    -------
+    verdict : str
+        ``"under-stated"`` if ``coverage < 0.95 − tol``; ``"over-stated ×F"`` if
+        ``coverage ≥ 0.95 + tol`` and ``F = budget_expanded / mc_U95 > 2``; else ``"supported"``;
+        ``tol`` = :func:`coverage_tolerance` (n).
+    F : float
+        ``budget_expanded / mc_U95`` (``inf`` if ``mc_U95 == 0``).
+    """
+    tolerance = coverage_tolerance(n)
+    factor = budget_expanded / mc_U95 if mc_U95 > 0 else math.inf
+    if coverage < NOMINAL_COVERAGE - tolerance:
+        return "under-stated", factor
+    if coverage >= NOMINAL_COVERAGE + tolerance and factor > 2.0:
+        return f"over-stated ×{factor:.3g}", factor
+    return "supported", factor
+
+
+def _check_parameter_array(name: str, value) -> np.ndarray:
+    array = np.asarray(value, dtype=float)
+    if array.ndim != 2 or array.shape[1] != N_PARAMETERS:
+        raise ValueError(f"{name}: shape {array.shape}; expected (trials, {N_PARAMETERS}) ordered as "
+                         "plansim.model.parameters.PARAMETER_NAMES")
+    if array.shape[0] < 2:
+        raise ValueError(f"{name}: {array.shape[0]} trial(s); a standard deviation needs at least 2")
+    return array
+
+
+def compare_with_appendix_a(truth, estimate, scenario, budgets: Iterable[AppendixABudget] = APPENDIX_A
+                            ) -> list[ItemComparison]:
+    """Compare Monte Carlo calibration errors with the Appendix A budgets of JJF 2003-2022.
+
+    For each budget the errors ``estimate − truth`` of its parameters are converted into the
+    budget's reading units (:func:`errors_in_reading_units`), pooled, and summarised.
+
+    Parameters
+    ----------
+    truth, estimate : (trials, 39) array_like
+        True and estimated parameters, SI, ordered as :data:`plansim.model.parameters.PARAMETER_NAMES`.
+    scenario : plansim.scenario.Scenario
+        Supplies full scales, reference gravity and the ω² test rate for the readings.
+    budgets : iterable of AppendixABudget
+        Default: all of :data:`APPENDIX_A`.
+
+    Returns
+    -------
+    list of ItemComparison
+        One per budget, in the order given.
+    """
+    truth = _check_parameter_array("truth", truth)
+    estimate = _check_parameter_array("estimate", estimate)
+    if truth.shape != estimate.shape:
+        raise ValueError(f"estimate: shape {estimate.shape} differs from truth's {truth.shape}")
+    budgets = tuple(budgets)
+    for budget in budgets:
+        if not isinstance(budget, AppendixABudget):
+            raise TypeError(f"budgets: element {budget!r} is not an AppendixABudget")
+    results: list[ItemComparison] = []
+    for budget in budgets:
+        expanded = budget.printed_expanded_uncertainty
+        pooled, per_parameter = [], []
+        for name in budget.parameters:
+            k = PARAMETER_INDEX[name]
+            if not (np.all(np.isfinite(truth[:, k])) and np.all(np.isfinite(estimate[:, k]))):
+                bad = int(np.argmax(~(np.isfinite(truth[:, k]) & np.isfinite(estimate[:, k]))))
+                raise ValueError(f"parameter {name}: trial {bad} has truth {truth[bad, k]!r} and estimate "
+                                 f"{estimate[bad, k]!r}; every value must be finite")
+            errors = errors_in_reading_units(budget, name, estimate[:, k] - truth[:, k], scenario, truth[:, k])
+            pooled.append(errors)
+            mean, std, u95, coverage = _statistics(errors, expanded)
+            unit = float(np.mean(reading_unit_in_si(budget, name, scenario, truth[:, k])))
+            per_parameter.append(ParameterComparison(name=name, mean=mean, std=std, U95=u95, coverage=coverage,
+                                                     reading_unit_in_si=unit, budget_U_si=expanded * unit))
+        errors = np.concatenate(pooled)
+        n = int(errors.size)
+        mean, std, u95, coverage = _statistics(errors, expanded)
+        verdict, factor = appendix_a_verdict(coverage, n, expanded, u95)
+        results.append(ItemComparison(
+            item=budget.item, quantity=budget.quantity, reading=budget.reading,
+            reading_unit=reading_unit_description(budget, scenario), parameters=tuple(budget.parameters), n=n,
+            budget_uc=budget.printed_combined_standard_uncertainty, budget_U=expanded,
+            coverage_factor=budget.coverage_factor,
+            arithmetic_uc=budget.recomputed_combined_standard_uncertainty(),
+            arithmetic_U=budget.recomputed_expanded_uncertainty(),
+            mc_bias=mean, mc_u=std, mc_U95=u95, coverage=coverage,
+            ratio=std / budget.printed_combined_standard_uncertainty,
+            tolerance=coverage_tolerance(n), overstatement_factor=factor, verdict=verdict,
+            per_parameter=tuple(per_parameter),
+        ))
+    return results
