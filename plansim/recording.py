@@ -39,8 +39,8 @@ from plansim.report.files import atomic_write
 from plansim.schedule.segments import Schedule, Segment
 from plansim.units import DEG
 
-# The same order as plansim.simulate.engine.CHANNELS; kept here so that reading a recording does not
-# import the numba kernels.
+# The same order as plansim.simulate.engine.CHANNELS (a test checks it); defined here so that the file
+# format does not depend on the simulation engine.
 CHANNELS = ("gx", "gy", "gz", "ax", "ay", "az")
 CHANNEL_UNITS = {"gx": "rad/s", "gy": "rad/s", "gz": "rad/s", "ax": "m/s^2", "ay": "m/s^2", "az": "m/s^2"}
 CHANNEL_LONG_NAMES = {
@@ -295,7 +295,7 @@ def simulate_and_record(scenario, seed: int, trial: int = 0) -> Recording:
         and ``units``. The true parameters of the simulated unit are not kept; call
         :func:`plansim.simulate.engine.simulate_recording` for them.
     """
-    # imported here: the engine pulls in the numba kernels, which reading a recording does not need
+    # imported here: the file format stays independent of the engine and its numba kernels
     from plansim.scenario import Scenario
     from plansim.simulate.engine import simulate_recording
 

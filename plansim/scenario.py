@@ -281,6 +281,9 @@ def _parse_schedule(document: dict) -> Schedule:
             raise ValueError("schedule.segments: a custom schedule needs a non-empty list of [[schedule.segments]]")
         segments = []
         for i, raw in enumerate(raw_segments):
+            if not isinstance(raw, dict):
+                raise TypeError(f"schedule.segments[{i}] = {raw!r}: each segment must be a table "
+                                "([[schedule.segments]] with label, test, group, up, ...)")
             seg = _Section({"seg": raw}, "seg")
             seg.path = f"schedule.segments[{i}]"
             segments.append(Segment(
@@ -313,7 +316,8 @@ def _parse_schedule(document: dict) -> Schedule:
             settle=s.quantity("settle", "time", "10 s"),
             sample_rate=s.quantity("sample_rate", "frequency", "100 Hz"),
             temperature_start=s.quantity("temperature_start", "temperature", "20 degC"),
-            temperature_end=s.quantity("temperature_end", "temperature", "20 degC"),
+            temperature_end=(None if s.get("temperature_end") is None
+                             else s.quantity("temperature_end", "temperature", None)),
         )
         s.check_unknown()
     from plansim.estimate.jjf2003 import check_design  # the estimators say what they need
@@ -345,8 +349,9 @@ def parse_scenario(document: dict, name: str | None = None) -> Scenario:
 
     mimu = _Section(document, "mimu")
     mimu_description = mimu.string("description", "")
-    gyro_range = mimu.quantity("gyro_range", "angular_rate", "0 deg/s") or math.inf
-    accel_range = mimu.quantity("accel_range", "acceleration", "0 g") or math.inf
+    # output ranges (saturation): 0 or absent = no saturation
+    gyro_range = _nonneg(mimu.quantity("gyro_range", "angular_rate", "0 deg/s"), "mimu.gyro_range") or math.inf
+    accel_range = _nonneg(mimu.quantity("accel_range", "acceleration", "0 g"), "mimu.accel_range") or math.inf
     mimu.check_unknown(subtables=("truth", "truth_spread", "noise", "effects"))
     truth_nominal = _parse_truth(_Section(document, "mimu.truth"), default_zero=False)
     truth_spread = _parse_truth(_Section(document, "mimu.truth_spread"), default_zero=True)
@@ -485,9 +490,10 @@ def schedule_to_document(schedule: Schedule) -> dict:
     for s in schedule.segments:
         segments.append({
             "label": s.label, "test": s.test, "group": int(s.group), "up": s.up,
-            "heading": f"{math.degrees(s.heading):.12g} deg", "rate": f"{math.degrees(s.rate):.12g} deg/s",
-            "rate_axis": s.rate_axis, "dwell": f"{s.dwell:.12g} s", "settle": f"{s.settle:.12g} s",
-            "sample_rate": f"{s.sample_rate:.12g} Hz", "temperature": f"{s.temperature:.12g} degC",
+            # SI units and repr: the round trip is exact
+            "heading": f"{s.heading!r} rad", "rate": f"{s.rate!r} rad/s",
+            "rate_axis": s.rate_axis, "dwell": f"{s.dwell!r} s", "settle": f"{s.settle!r} s",
+            "sample_rate": f"{s.sample_rate!r} Hz", "temperature": f"{s.temperature!r} degC",
         })
     return {"procedure": "custom", "segments": segments}
 

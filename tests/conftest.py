@@ -1,4 +1,4 @@
-"""Shared fixtures: the ``ideal`` scenario as a fresh TOML document and as a truth vector."""
+"""Shared fixture: the ``ideal`` scenario (scenarios/ideal.toml) as a fresh TOML document."""
 
 from __future__ import annotations
 

@@ -312,7 +312,7 @@ ROUND_TRIP_CASES = {
     "rate points on a 12-digit degree grid": _set("schedule.rate_points", ["-123.456789 deg/s", "0 deg/s", "0.5 deg/s"]),
 }
 
-# Numbers that need more than 12 significant digits in the units save_scenario writes (deg, deg/s, degC)
+# Numbers that need more than 12 significant digits: save_scenario writes repr() in SI, so they round-trip
 NOT_TWELVE_DIGIT_CASES = {
     "temperature ramp": _set("schedule.temperature_end", "23.7 degC"),
     "rate points in rad/s and deg/h": _set("schedule.rate_points", ["-0.1 rad/s", "7 deg/h", "0.1 rad/s"]),
@@ -324,48 +324,26 @@ def test_save_then_load_round_trip(ideal_document, tmp_path, modify):
     _assert_round_trip(modify(ideal_document) if modify else ideal_document, tmp_path, rtol=1e-12)
 
 
-# save_scenario writes each segment number with "%.12g": 12 significant digits, i.e. a relative
-# rounding error of at most half a unit in the 12th digit, 0.5·10⁻¹¹.
-TWELVE_DIGIT_ROUNDING = 0.5e-11
-
-
-@pytest.mark.parametrize("modify", list(NOT_TWELVE_DIGIT_CASES.values()), ids=list(NOT_TWELVE_DIGIT_CASES))
-def test_round_trip_within_twelve_digit_rounding(ideal_document, tmp_path, modify):
-    _assert_round_trip(modify(ideal_document), tmp_path, rtol=TWELVE_DIGIT_ROUNDING)
-
-
-@pytest.mark.xfail(strict=True, reason="bug: plansim/scenario.py schedule_to_document formats segment numbers with "
-                   "'%.12g' (12 significant digits), so a ramped temperature such as 20.215833333333332 degC is "
-                   "saved as 20.2158333333 and reloads with a relative error 1.6e-12 > 1e-12; repr()/'%.17g' "
-                   "would round-trip exactly (likewise 0.1 rad/s -> 5.72957795131 deg/s)")
 @pytest.mark.parametrize("modify", list(NOT_TWELVE_DIGIT_CASES.values()), ids=list(NOT_TWELVE_DIGIT_CASES))
 def test_round_trip_to_1e_12(ideal_document, tmp_path, modify):
     _assert_round_trip(modify(ideal_document), tmp_path, rtol=1e-12)
 
 
-# ----------------------------------------------------------------------------- bugs found (xfail, strict)
+# ----------------------------------------------------------------------------- regressions (bugs found in review)
 
 
-@pytest.mark.xfail(strict=True, reason="bug: plansim/scenario.py _parse_schedule passes temperature_end with a default "
-                   "of '20 degC', so temperature_start alone silently makes a ramp back to 20 degC instead of a "
-                   "constant temperature (jjf2003(temperature_end=None) means constant)")
 def test_temperature_start_alone_gives_a_constant_temperature(ideal_document):
     ideal_document["schedule"]["temperature_start"] = "25 degC"
     schedule = parse_scenario(ideal_document).schedule
     np.testing.assert_allclose([s.temperature for s in schedule.segments], 25.0, rtol=1e-15)
 
 
-@pytest.mark.xfail(strict=True, reason="bug: plansim/scenario.py parse_scenario accepts a negative mimu.gyro_range "
-                   "(`... or math.inf` only replaces 0) and stores a negative output range")
 def test_negative_output_range_is_rejected(ideal_document):
     ideal_document["mimu"]["gyro_range"] = "-5 deg/s"
     with pytest.raises(ValueError, match=r"mimu\.gyro_range"):
         parse_scenario(ideal_document)
 
 
-@pytest.mark.xfail(strict=True, reason="bug: plansim/scenario.py _parse_schedule builds _Section({'seg': raw}, 'seg') "
-                   "and only then renames the path, so a segment that is not a table raises "
-                   "TypeError('[seg] must be a table') without naming schedule.segments[i]")
 def test_segment_that_is_not_a_table_names_its_index(ideal_document):
     segments = custom_segments()
     segments[2] = "rate x 5 deg/s"
