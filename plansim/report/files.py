@@ -17,6 +17,10 @@ def atomic_write(path: str | os.PathLike, writer: Callable[[str], None]) -> None
     os.close(fd)
     try:
         writer(tmp)
+        # mkstemp creates 0600; give the file the permissions an ordinary open() would
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, target)
     except BaseException:
         if os.path.exists(tmp):
