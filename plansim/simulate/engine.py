@@ -13,7 +13,8 @@ from scipy.optimize import minimize_scalar
 from plansim.model.parameters import N_PARAMETERS
 from plansim.scenario import Scenario
 from plansim.schedule.segments import Schedule, axis_vector, body_to_level
-from plansim.simulate import kernels
+from plansim.simulate import sample_path
+from plansim.simulate.physics import EFFECT_ROWS, draw_systematic, draws_length
 from plansim.simulate.random import ZIG_RATIO, ZIG_X, root_key
 
 CHANNELS = ("gx", "gy", "gz", "ax", "ay", "az")
@@ -64,34 +65,33 @@ def schedule_arrays(schedule: Schedule) -> dict[str, np.ndarray]:
 
 
 def kernel_arguments(scenario: Scenario) -> dict[str, object]:
-    """Every model input of :func:`plansim.simulate.kernels.simulate_trial`, in SI."""
+    """Every model input of the kernels, in SI (see :mod:`plansim.simulate.sample_path`)."""
     e, n, a, t = scenario.effects, scenario.noise, scenario.acquisition, scenario.turntable
     errors = (t.position_accuracy, t.position_repeatability, t.axis_perpendicularity, t.platform_tilt,
               t.fixture_perpendicularity, t.rate_error_systematic, t.rate_error_per_point)
+    sensor = np.array([getattr(e, row) for row in EFFECT_ROWS], dtype=float)
+    noise = np.column_stack([
+        np.concatenate([n.gyro_angle_random_walk, n.accel_velocity_random_walk]),
+        bias_instability_sigma(np.concatenate([n.gyro_bias_instability, n.accel_bias_instability])),
+        np.concatenate([n.gyro_rate_random_walk, n.accel_acceleration_random_walk]),
+        np.concatenate([n.gyro_markov_sigma, n.accel_markov_sigma]),
+    ])
     return dict(
-        **schedule_arrays(scenario.schedule),
         truth_nominal=np.asarray(scenario.truth_nominal, float),
         truth_spread=np.asarray(scenario.truth_spread, float),
-        n2=e.gyro_nonlinearity_quadratic, n3=e.gyro_nonlinearity_cubic, asym=e.gyro_asymmetry,
-        S2=e.gyro_g2_sensitivity, k2=e.accel_second_order,
-        gyro_btc=e.gyro_bias_temperature_coefficient, gyro_stc=e.gyro_scale_temperature_coefficient,
-        accel_btc=e.accel_bias_temperature_coefficient, accel_stc=e.accel_scale_temperature_coefficient,
-        t_ref=float(e.reference_temperature), lever=e.accel_lever_arm,
-        gyro_range=float(e.gyro_output_range), accel_range=float(e.accel_output_range),
-        white_density=np.concatenate([n.gyro_angle_random_walk, n.accel_velocity_random_walk]),
-        bi_sigma=bias_instability_sigma(np.concatenate([n.gyro_bias_instability, n.accel_bias_instability])),
-        bi_tau=float(n.bias_instability_correlation_time),
-        rrw=np.concatenate([n.gyro_rate_random_walk, n.accel_acceleration_random_walk]),
-        markov_sigma=np.concatenate([n.gyro_markov_sigma, n.accel_markov_sigma]),
-        markov_tau=float(n.markov_correlation_time),
-        drift_interval=float(n.drift_update_interval),
-        step_gyro=float(a.gyro_step), step_accel=float(a.accel_step),
-        fs_gyro=float(a.gyro_full_scale), fs_accel=float(a.accel_full_scale),
         error_kind=np.array([d.code for d in errors], dtype=np.int64),
         error_scale=np.array([d.scale for d in errors]),
+        **schedule_arrays(scenario.schedule),
+        sensor=sensor, S2=np.asarray(e.gyro_g2_sensitivity, float), lever=np.asarray(e.accel_lever_arm, float),
+        t_ref=float(e.reference_temperature),
+        acquisition=np.array([e.gyro_output_range, e.accel_output_range, a.gyro_step, a.accel_step,
+                              a.gyro_full_scale, a.accel_full_scale], dtype=float),
+        noise=noise,
+        noise_times=np.array([n.bias_instability_correlation_time, n.markov_correlation_time,
+                              n.drift_update_interval], dtype=float),
         smoothness=float(t.rate_smoothness),
         gravity=float(scenario.environment.gravity),
-        earth_enu=scenario.environment.earth_rate_vector,
+        earth_enu=np.asarray(scenario.environment.earth_rate_vector, float),
     )
 
 
@@ -140,8 +140,8 @@ def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_siz
     truth = np.empty((trials, N_PARAMETERS))
     for start in range(0, trials, chunk_size):
         stop = min(trials, start + chunk_size)
-        kernels.simulate_chunk(start, key, ZIG_X, ZIG_RATIO, **args,
-                               means_out=means[start:stop], truth_out=truth[start:stop])
+        sample_path.simulate_chunk(start, key, ZIG_X, ZIG_RATIO, **args,
+                                   means_out=means[start:stop], truth_out=truth[start:stop])
         if progress is not None:
             progress(stop, trials)
     return means, truth
@@ -158,7 +158,10 @@ def simulate_recording(scenario: Scenario, seed: int, trial: int = 0) -> tuple[n
     args = _as_float_arrays(kernel_arguments(scenario))
     samples = np.empty((scenario.schedule.total_samples, 6))
     means = np.empty((len(scenario.schedule), 6))
-    truth = np.empty(N_PARAMETERS)
-    kernels.simulate_trial(int(trial), key, ZIG_X, ZIG_RATIO, **args, means_out=means, truth_out=truth,
-                           samples_out=samples, record=True)
+    draws = np.empty(draws_length(len(scenario.schedule)))
+    draw_systematic(int(trial), key, ZIG_X, ZIG_RATIO, args.pop("truth_nominal"), args.pop("truth_spread"),
+                    args.pop("error_kind"), args.pop("error_scale"), len(scenario.schedule), draws)
+    sample_path.simulate_trial(int(trial), key, ZIG_X, ZIG_RATIO, draws, **args, means_out=means,
+                               samples_out=samples, record=True)
+    truth = draws[:N_PARAMETERS].copy()
     return samples, means, truth

@@ -1,0 +1,237 @@
+"""The physics shared by both simulation paths (numba, plain SI arrays).
+
+A trial is split into its *systematic draws* — the unit's truth and every table/fixture error, in
+one flat vector (layout below) — and what follows deterministically from them: the orientation of
+the MIMU in each segment and the noise-free sensor output at any table angle θ. Noise is added by
+the path (sample by sample, or as exact segment statistics). Keeping the draws explicit lets a
+caller fix any of them (e.g. the GUM sensitivities of :mod:`plansim.uncertainty`).
+
+Draws vector (length ``HEAD + PER_SEGMENT·S``):
+
+====================  ====================================================================
+``[0:39]``            the unit's parameters (order of :data:`plansim.model.parameters.PARAMETER_NAMES`)
+``[39:42]``           fixture misalignment, rotation vector of the MIMU case in the fixture, rad
+``[42:44]``           platform tilt about East and North, rad
+``[44]``              rate error, systematic (relative)
+``[45:51]``           axis perpendicularity: for rate axis x, y, z two components each, rad
+``[51+8s : 59+8s]``   segment s: position accuracy x, repeatability x, accuracy y, repeatability y,
+                      accuracy z, repeatability z (rad), rate error of the point (relative), start
+                      phase θ0 of the table (rad)
+====================  ====================================================================
+
+Physics (docs/model.md): ``C_nb(θ) = Tilt · PosErr · C_nb,nominal · C_fb · R(u_b, θ)``; the gyro
+input is ``w = ω·u_b + R(u_b, −θ) Ω_b0`` and the specific force at the IMU centre
+``f = R(u_b, −θ) g_b0``; accelerometer i at lever arm r_i adds ``−ω²(r_i − (r_i·u)u)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from plansim._jit import jit
+from plansim.simulate.random import draw_error, normal, seed_trial, uniform
+
+N_TRUTH = 39
+HEAD = 51
+PER_SEGMENT = 8
+STREAM_SYSTEMATIC = 0  # truth spread and table/fixture errors
+STREAM_NOISE = 1  # sensor noise, drift and rate smoothness
+
+# rows of the `sensor` effects array (3 columns: x, y, z)
+EFFECT_ROWS = ("gyro_nonlinearity_quadratic", "gyro_nonlinearity_cubic", "gyro_asymmetry", "accel_second_order",
+               "gyro_bias_temperature_coefficient", "gyro_scale_temperature_coefficient",
+               "accel_bias_temperature_coefficient", "accel_scale_temperature_coefficient")
+
+
+def draws_length(n_segments: int) -> int:
+    return HEAD + PER_SEGMENT * n_segments
+
+
+@jit
+def draw_systematic(trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind, error_scale,
+                    n_segments, draws):
+    """Fill *draws* with trial *trial*'s truth and table errors (stream 0 of its random stream).
+
+    ``error_kind``/``error_scale`` (7,): position accuracy, position repeatability, axis
+    perpendicularity, platform tilt, fixture perpendicularity, rate error systematic, rate error
+    per point (kind 0 = uniform ± scale, 1 = normal σ = scale).
+    """
+    state = np.empty(4, np.uint64)
+    seed_trial(key, trial, STREAM_SYSTEMATIC, state)
+    for k in range(N_TRUTH):
+        draws[k] = truth_nominal[k] + truth_spread[k] * normal(state, zig_x, zig_ratio)
+    for k in range(3):
+        draws[39 + k] = draw_error(state, error_kind[4], error_scale[4], zig_x, zig_ratio)
+    draws[42] = draw_error(state, error_kind[3], error_scale[3], zig_x, zig_ratio)
+    draws[43] = draw_error(state, error_kind[3], error_scale[3], zig_x, zig_ratio)
+    draws[44] = draw_error(state, error_kind[5], error_scale[5], zig_x, zig_ratio)
+    for k in range(6):
+        draws[45 + k] = draw_error(state, error_kind[2], error_scale[2], zig_x, zig_ratio)
+    for s in range(n_segments):
+        base = HEAD + PER_SEGMENT * s
+        for axis in range(3):
+            draws[base + 2 * axis] = draw_error(state, error_kind[0], error_scale[0], zig_x, zig_ratio)
+            draws[base + 2 * axis + 1] = draw_error(state, error_kind[1], error_scale[1], zig_x, zig_ratio)
+        draws[base + 6] = draw_error(state, error_kind[6], error_scale[6], zig_x, zig_ratio)
+        draws[base + 7] = 2.0 * math.pi * uniform(state)
+
+
+@jit
+def small_rotation(phi0, phi1, phi2, out):
+    """Exact rotation matrix of the rotation vector φ (Rodrigues), written into *out* (3×3)."""
+    angle = math.sqrt(phi0 * phi0 + phi1 * phi1 + phi2 * phi2)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = 1.0 if i == j else 0.0
+    if angle == 0.0:
+        return
+    kx, ky, kz = phi0 / angle, phi1 / angle, phi2 / angle
+    c, s = math.cos(angle), math.sin(angle)
+    v = 1.0 - c
+    out[0, 0] = c + kx * kx * v
+    out[0, 1] = kx * ky * v - kz * s
+    out[0, 2] = kx * kz * v + ky * s
+    out[1, 0] = ky * kx * v + kz * s
+    out[1, 1] = c + ky * ky * v
+    out[1, 2] = ky * kz * v - kx * s
+    out[2, 0] = kz * kx * v - ky * s
+    out[2, 1] = kz * ky * v + kx * s
+    out[2, 2] = c + kz * kz * v
+
+
+@jit
+def unpack_truth(p, Kg, Bg, G, Ka, Ba, P):
+    """Flat parameter vector (order of plansim.model.parameters) -> matrices."""
+    for i in range(3):
+        for j in range(3):
+            Kg[i, j] = p[3 * i + j]
+            G[i, j] = p[12 + 3 * i + j]
+            Ka[i, j] = p[21 + 3 * i + j]
+            P[i, j] = 0.0
+        Bg[i] = p[9 + i]
+        Ba[i] = p[30 + i]
+    P[0, 1] = p[33]
+    P[0, 2] = p[34]
+    P[1, 0] = p[35]
+    P[1, 2] = p[36]
+    P[2, 0] = p[37]
+    P[2, 1] = p[38]
+
+
+@jit
+def _matmul3(a, b, out):
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                acc += a[i, k] * b[k, j]
+            out[i, j] = acc
+
+
+@jit
+def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity, earth_enu, lever,
+                     g_b0, om_b0, u, perp):
+    """Orientation of segment *s* under the trial's errors.
+
+    Writes the body-frame gravity reaction ``g_b0`` and Earth rate ``om_b0`` at θ = 0, the table
+    axis ``u`` (body frame, unit) and the centripetal term ``perp`` (3×3: row i for accelerometer
+    i); returns ``(rate_act, phase)``: the actual table rate (rad/s) and start angle (rad).
+    """
+    fixture = np.empty((3, 3))
+    tilt = np.empty((3, 3))
+    pos_err = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    c_actual = np.empty((3, 3))
+    small_rotation(draws[39], draws[40], draws[41], fixture)  # C_fb: MIMU case in the fixture
+    small_rotation(draws[42], draws[43], 0.0, tilt)  # platform tilt about East and North
+    base = HEAD + PER_SEGMENT * s
+    small_rotation(draws[base] + draws[base + 1], draws[base + 2] + draws[base + 3],
+                   draws[base + 4] + draws[base + 5], pos_err)
+    nominal = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            nominal[i, j] = seg_C0[s, i, j]
+    _matmul3(pos_err, nominal, tmp)
+    _matmul3(tmp, fixture, c_actual)
+    _matmul3(tilt, c_actual, tmp)  # tmp = C_nb,actual
+    for i in range(3):  # C_bn = C_nbᵀ: g_b0 = C_bn·(0, 0, g), Ω_b0 = C_bn·Ω_ie
+        g_b0[i] = tmp[2, i] * gravity
+        om_b0[i] = tmp[0, i] * earth_enu[0] + tmp[1, i] * earth_enu[1] + tmp[2, i] * earth_enu[2]
+    # table axis: nominal (a coordinate axis of the fixture) tilted by the perpendicularity error,
+    # expressed in the MIMU case frame (C_bf = C_fbᵀ)
+    a = seg_axis_index[s]
+    v = np.empty(3)
+    for i in range(3):
+        v[i] = seg_axis[s, i]
+    ia = 0 if abs(v[0]) > 0.5 else (1 if abs(v[1]) > 0.5 else 2)
+    v[(ia + 1) % 3] += draws[45 + 2 * a]
+    v[(ia + 2) % 3] += draws[46 + 2 * a]
+    norm = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    for i in range(3):
+        u[i] = (fixture[0, i] * v[0] + fixture[1, i] * v[1] + fixture[2, i] * v[2]) / norm
+    rate_act = seg_rate[s] * (1.0 + draws[44] + draws[base + 6])
+    for i in range(3):  # centripetal acceleration of accelerometer i: −ω²(r_i − (r_i·u)u)
+        ru = lever[i, 0] * u[0] + lever[i, 1] * u[1] + lever[i, 2] * u[2]
+        for j in range(3):
+            perp[i, j] = -rate_act * rate_act * (lever[i, j] - ru * u[j])
+    return rate_act, draws[base + 7]
+
+
+@jit
+def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
+    """Gyro input *w* and specific force *fc* at table angle θ with table rate *rate* (Rodrigues, angle −θ)."""
+    ct = math.cos(theta)
+    st = math.sin(theta)
+    ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
+    uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
+    fc[0] = g_b0[0] * ct - (u[1] * g_b0[2] - u[2] * g_b0[1]) * st + u[0] * ug * (1.0 - ct)
+    fc[1] = g_b0[1] * ct - (u[2] * g_b0[0] - u[0] * g_b0[2]) * st + u[1] * ug * (1.0 - ct)
+    fc[2] = g_b0[2] * ct - (u[0] * g_b0[1] - u[1] * g_b0[0]) * st + u[2] * ug * (1.0 - ct)
+    w[0] = rate * u[0] + om_b0[0] * ct - (u[1] * om_b0[2] - u[2] * om_b0[1]) * st + u[0] * uo * (1.0 - ct)
+    w[1] = rate * u[1] + om_b0[1] * ct - (u[2] * om_b0[0] - u[0] * om_b0[2]) * st + u[1] * uo * (1.0 - ct)
+    w[2] = rate * u[2] + om_b0[2] * ct - (u[0] * om_b0[1] - u[1] * om_b0[0]) * st + u[2] * uo * (1.0 - ct)
+
+
+@jit
+def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
+    """Noise-free outputs (6) for gyro input *w* and specific force *fc* at the IMU centre.
+
+    JJF 2003 eq. (1)/(2) plus the effects in ``sensor`` (rows :data:`EFFECT_ROWS`) and ``S2``
+    (g² sensitivity, 3×3); ``dT`` = temperature − reference temperature.
+    """
+    for i in range(3):  # gyros, eq. (1) + effects
+        val = Bg[i] + sensor[4, i] * dT
+        for j in range(3):
+            val += Kg[i, j] * w[j] + G[i, j] * fc[j] + S2[i, j] * fc[j] * fc[j]
+        wi = w[i]
+        val += Kg[i, i] * sensor[5, i] * dT * wi + sensor[0, i] * wi * wi + sensor[1, i] * wi * wi * wi
+        val += 0.5 * sensor[2, i] * Kg[i, i] * abs(wi)
+        y[i] = val
+    for i in range(3):  # accelerometers, eq. (2) + effects; accelerometer i sits at its lever arm
+        f0 = fc[0] + perp[i, 0]
+        f1 = fc[1] + perp[i, 1]
+        f2 = fc[2] + perp[i, 2]
+        fi = f0 if i == 0 else (f1 if i == 1 else f2)
+        val = Ba[i] + sensor[6, i] * dT
+        val += Ka[i, 0] * f0 + Ka[i, 1] * f1 + Ka[i, 2] * f2
+        val += P[i, 0] * w[0] * w[0] + P[i, 1] * w[1] * w[1] + P[i, 2] * w[2] * w[2]
+        val += Ka[i, i] * sensor[7, i] * dT * fi + sensor[3, i] * fi * fi
+        y[3 + i] = val
+
+
+@jit
+def quantise(y, output_range, step, full_scale):
+    """Saturate at ± output range, then quantise to *step* (round half up), clipped at ± full scale."""
+    if y > output_range:
+        y = output_range
+    elif y < -output_range:
+        y = -output_range
+    if step > 0.0:
+        y = step * math.floor(y / step + 0.5)
+        if y > full_scale:
+            y = full_scale
+        elif y < -full_scale:
+            y = -full_scale
+    return y

@@ -1,0 +1,186 @@
+"""Sample-level path: every raw sample generated, quantised and folded into its segment mean.
+
+Numba kernels, parallel over trials; no trial × sample array is ever held (a recording of one
+trial is the exception, on request). Orientation within a rate point follows the table angle
+sample by sample, noise and drift are drawn per sample, saturation and quantisation act on each
+raw sample exactly as a data acquisition would.
+
+Array arguments (SI), built by :func:`plansim.simulate.engine.kernel_arguments`:
+
+- ``seg_*``: the nominal schedule (see engine.schedule_arrays);
+- ``sensor`` (8, 3): effect coefficients, rows :data:`plansim.simulate.physics.EFFECT_ROWS`;
+  ``S2`` (3, 3) g² sensitivity; ``lever`` (3, 3) accelerometer positions; ``t_ref`` (°C);
+- ``acquisition`` (6,): gyro output range, accel output range, gyro step, accel step, gyro full
+  scale, accel full scale;
+- ``noise`` (6, 4) per channel gx…az: white density (N or VRW), bias-instability σ (Gauss–Markov),
+  random-walk coefficient, Gauss–Markov drift σ; ``noise_times`` (3,): bias-instability
+  correlation time, Gauss–Markov correlation time, drift update interval;
+- ``smoothness``: relative σ of the table rate per sample; ``gravity``; ``earth_enu`` (3,).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from plansim._jit import jit, parallel_jit
+from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, quantise,
+                                      segment_geometry, sensor_outputs, unpack_truth)
+from plansim.simulate.random import normal, seed_trial
+
+
+@jit
+def _gauss_markov_step(x, phi, sigma, state, zig_x, zig_ratio):
+    """Exact first-order Gauss–Markov update over a step with φ = exp(−Δt/τ), stationary σ."""
+    return phi * x + sigma * math.sqrt(1.0 - phi * phi) * normal(state, zig_x, zig_ratio)
+
+
+@jit
+def advance_drift(interval, drift, noise, noise_times, state, zig_x, zig_ratio):
+    """Exact update of the drift processes over *interval* s; ``drift`` (3, 6): GM bias instability,
+    GM drift, random walk per channel."""
+    if interval <= 0.0:
+        return
+    phi_bi = math.exp(-interval / noise_times[0])
+    phi_mk = math.exp(-interval / noise_times[1])
+    sq = math.sqrt(interval)
+    for c in range(6):
+        if noise[c, 1] > 0.0:
+            drift[0, c] = _gauss_markov_step(drift[0, c], phi_bi, noise[c, 1], state, zig_x, zig_ratio)
+        if noise[c, 3] > 0.0:
+            drift[1, c] = _gauss_markov_step(drift[1, c], phi_mk, noise[c, 3], state, zig_x, zig_ratio)
+        if noise[c, 2] > 0.0:
+            drift[2, c] += noise[c, 2] * sq * normal(state, zig_x, zig_ratio)
+
+
+@jit
+def initial_drift(noise, state, zig_x, zig_ratio):
+    """Drift states at the start of the test: Gauss–Markov processes stationary, random walks at 0."""
+    drift = np.zeros((3, 6))
+    for c in range(6):
+        if noise[c, 1] > 0.0:
+            drift[0, c] = noise[c, 1] * normal(state, zig_x, zig_ratio)
+        if noise[c, 3] > 0.0:
+            drift[1, c] = noise[c, 3] * normal(state, zig_x, zig_ratio)
+    return drift
+
+
+@jit
+def simulate_trial(trial, key, zig_x, zig_ratio, draws,
+                   seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                   sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
+                   means_out, samples_out, record):
+    """One calibration, sample by sample, from its systematic *draws*; segment means into ``means_out`` (S, 6).
+
+    If *record*, every raw sample is also written to ``samples_out`` (total samples, 6).
+    """
+    state = np.empty(4, np.uint64)
+    seed_trial(key, trial, STREAM_NOISE, state)
+    Kg = np.empty((3, 3))
+    G = np.empty((3, 3))
+    Ka = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Bg = np.empty(3)
+    Ba = np.empty(3)
+    unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
+    drift = initial_drift(noise, state, zig_x, zig_ratio)
+    u = np.empty(3)
+    g_b0 = np.empty(3)
+    om_b0 = np.empty(3)
+    perp = np.empty((3, 3))
+    w = np.empty(3)
+    fc = np.empty(3)
+    y = np.empty(6)
+    acc = np.empty(6)
+    white = np.empty(6)
+    offset = 0
+    for s in range(seg_n.shape[0]):
+        rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                           earth_enu, lever, g_b0, om_b0, u, perp)
+        rotating = seg_rate[s] != 0.0
+        advance_drift(seg_gap[s], drift, noise, noise_times, state, zig_x, zig_ratio)  # settling
+        dt = seg_dt[s]
+        dT = seg_temp[s] - t_ref
+        for c in range(6):
+            white[c] = noise[c, 0] / math.sqrt(dt)
+            acc[c] = 0.0
+        # drift processes are advanced every `hold` samples (exactly, over hold·dt) and held between
+        hold = max(1, int(math.floor(noise_times[2] / dt + 0.5)))
+        n = seg_n[s]
+        if not rotating:  # at rest the deterministic part of every sample is the same
+            for i in range(3):
+                fc[i] = g_b0[i]
+                w[i] = om_b0[i]
+            sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+        # sin/cos of θ_k by recurrence (one rotation by ω·dt per sample)
+        ct = math.cos(phase)
+        st = math.sin(phase)
+        cd = math.cos(rate_act * dt)
+        sd = math.sin(rate_act * dt)
+        ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
+        uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
+        cg0 = u[1] * g_b0[2] - u[2] * g_b0[1]
+        cg1 = u[2] * g_b0[0] - u[0] * g_b0[2]
+        cg2 = u[0] * g_b0[1] - u[1] * g_b0[0]
+        co0 = u[1] * om_b0[2] - u[2] * om_b0[1]
+        co1 = u[2] * om_b0[0] - u[0] * om_b0[2]
+        co2 = u[0] * om_b0[1] - u[1] * om_b0[0]
+        for k in range(n):
+            if rotating:
+                # Rodrigues with angle −θ: v cosθ − (u×v) sinθ + u (u·v)(1 − cosθ)
+                fc[0] = g_b0[0] * ct - cg0 * st + u[0] * ug * (1.0 - ct)
+                fc[1] = g_b0[1] * ct - cg1 * st + u[1] * ug * (1.0 - ct)
+                fc[2] = g_b0[2] * ct - cg2 * st + u[2] * ug * (1.0 - ct)
+                rate_k = rate_act
+                if smoothness > 0.0:
+                    rate_k = rate_act * (1.0 + smoothness * normal(state, zig_x, zig_ratio))
+                w[0] = rate_k * u[0] + om_b0[0] * ct - co0 * st + u[0] * uo * (1.0 - ct)
+                w[1] = rate_k * u[1] + om_b0[1] * ct - co1 * st + u[1] * uo * (1.0 - ct)
+                w[2] = rate_k * u[2] + om_b0[2] * ct - co2 * st + u[2] * uo * (1.0 - ct)
+                sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+                c_next = ct * cd - st * sd
+                st = st * cd + ct * sd
+                ct = c_next
+            for c in range(6):
+                val = y[c] + drift[0, c] + drift[1, c] + drift[2, c]
+                if white[c] > 0.0:
+                    val += white[c] * normal(state, zig_x, zig_ratio)
+                if c < 3:
+                    val = quantise(val, acquisition[0], acquisition[2], acquisition[4])
+                else:
+                    val = quantise(val, acquisition[1], acquisition[3], acquisition[5])
+                acc[c] += val
+                if record:
+                    samples_out[offset + k, c] = val
+            if (k + 1) % hold == 0 and k + 1 < n:
+                advance_drift(hold * dt, drift, noise, noise_times, state, zig_x, zig_ratio)
+        tail = n % hold  # to the end of the recording: the last (partial) hold interval
+        advance_drift((tail if tail else hold) * dt, drift, noise, noise_times, state, zig_x, zig_ratio)
+        for c in range(6):
+            means_out[s, c] = acc[c] / n
+        offset += n
+
+
+@parallel_jit
+def simulate_chunk(first_trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind, error_scale,
+                   seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                   sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
+                   means_out, truth_out):
+    """Trials ``first_trial … first_trial + len(means_out) − 1`` in parallel (one stream per trial)."""
+    no_samples = np.empty((0, 6))
+    n_seg = seg_n.shape[0]
+    for t in numba.prange(means_out.shape[0]):
+        draws = np.empty(draws_length_jit(n_seg))
+        draw_systematic(first_trial + t, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind,
+                        error_scale, n_seg, draws)
+        for k in range(N_TRUTH):
+            truth_out[t, k] = draws[k]
+        simulate_trial(first_trial + t, key, zig_x, zig_ratio, draws,
+                       seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                       sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
+                       means_out[t], no_samples, False)
+
+
+draws_length_jit = jit(draws_length)
