@@ -19,7 +19,7 @@ import xarray as xr
 from plansim.estimate import reduce
 from plansim.model.parameters import PARAMETERS, PARAMETER_NAMES
 from plansim.scenario import Scenario, load_scenario
-from plansim.simulate.engine import ProgressCallback, simulate_segment_means
+from plansim.simulate.engine import PATH_NAMES, ProgressCallback, choose_path, simulate_segment_means
 
 
 def package_version() -> str:
@@ -39,7 +39,7 @@ def _scenario_of(scenario: Scenario | str) -> Scenario:
 
 def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: int | None = None,
         chunk_size: int = 256, progress: ProgressCallback | None = None,
-        keep_segment_means: bool = False) -> xr.Dataset:
+        keep_segment_means: bool = False, path: str = "auto") -> xr.Dataset:
     """Monte Carlo of the scenario's calibration.
 
     Parameters
@@ -54,6 +54,10 @@ def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: i
         ``progress(done, total)`` after each chunk.
     keep_segment_means : bool
         Also return the mean output of every segment (trial × segment × channel).
+    path : {"auto", "sample", "segment"}
+        Simulation path. ``auto`` takes the segment-statistics path only where it is exact
+        (:func:`plansim.simulate.engine.segment_path_exactness`); the path used and, if the
+        segment path was not exact, why, are in ``attrs``.
 
     Returns
     -------
@@ -63,9 +67,14 @@ def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: i
     sc = _scenario_of(scenario)
     trials = sc.trials if trials is None else trials
     seed = sc.seed if seed is None else seed
-    means, truth = simulate_segment_means(sc, trials, seed, chunk_size=chunk_size, progress=progress)
+    chosen, reasons = choose_path(sc, path)
+    means, truth = simulate_segment_means(sc, trials, seed, chunk_size=chunk_size, progress=progress, path=chosen)
     estimate = reduce(means, sc.schedule, sc.reduction.reference_gravity, sc.reduction.omega_squared_sign)
-    return results_dataset(sc, truth, estimate, seed, means if keep_segment_means else None)
+    results = results_dataset(sc, truth, estimate, seed, means if keep_segment_means else None)
+    results.attrs["simulation_path"] = PATH_NAMES[chosen]
+    results.attrs["simulation_path_requested"] = path
+    results.attrs["segment_path_not_exact_because"] = "; ".join(reasons) if reasons else "(exact)"
+    return results
 
 
 def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed: int,

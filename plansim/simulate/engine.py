@@ -13,7 +13,7 @@ from scipy.optimize import minimize_scalar
 from plansim.model.parameters import N_PARAMETERS
 from plansim.scenario import Scenario
 from plansim.schedule.segments import Schedule, axis_vector, body_to_level
-from plansim.simulate import sample_path
+from plansim.simulate import sample_path, segment_path
 from plansim.simulate.physics import EFFECT_ROWS, draw_systematic, draws_length
 from plansim.simulate.random import ZIG_RATIO, ZIG_X, root_key
 
@@ -118,9 +118,120 @@ def stderr_progress(label: str = "simulating") -> ProgressCallback:
     return report
 
 
+PATHS = ("auto", "sample", "segment")
+PATH_NAMES = {"sample": "sample-level", "segment": "segment-statistics"}
+
+
+def needed_channels(schedule: Schedule) -> np.ndarray:
+    """(S, 6) 1 where a JJF 2003 estimator uses the channel's mean: rate test -> gyros,
+    multi-position -> all six, ω² test -> accelerometers."""
+    out = np.zeros((len(schedule), 6), dtype=np.int64)
+    for k, s in enumerate(schedule.segments):
+        if s.test == "rate":
+            out[k, :3] = 1
+        elif s.test == "omega_squared":
+            out[k, 3:] = 1
+        else:
+            out[k, :] = 1
+    return out
+
+
+def drift_coefficient_table(scenario: Scenario) -> np.ndarray:
+    """(S, 3, 5) unit-σ drift coefficients per segment for GM bias instability, GM drift, random walk."""
+    n = scenario.noise
+    out = np.zeros((len(scenario.schedule), 3, 5))
+    for k, s in enumerate(scenario.schedule.segments):
+        dt = 1.0 / s.sample_rate
+        out[k, 0] = segment_path.drift_coefficients(s.samples, dt, n.drift_update_interval,
+                                                    n.bias_instability_correlation_time)
+        out[k, 1] = segment_path.drift_coefficients(s.samples, dt, n.drift_update_interval, n.markov_correlation_time)
+        out[k, 2] = segment_path.drift_coefficients(s.samples, dt, n.drift_update_interval, None)
+    return out
+
+
+def segment_path_exactness(scenario: Scenario) -> list[str]:
+    """Reasons the segment-statistics path would not be exact for *scenario* (empty list: it is).
+
+    Checks, each stated in :mod:`plansim.simulate.segment_path`: no gyro asymmetry; no
+    saturation (every output's bound — nominal maximum plus 6σ of noise and drift plus 6× the
+    unit-to-unit spread times the largest input — inside the output range and the acquisition full
+    scale); for quantised channels that the noise does not dither, drift small against the noise
+    (≤ 0.1σ) so that its variation within a segment does not move the quantiser.
+    """
+    reasons = []
+    e, n, a = scenario.effects, scenario.noise, scenario.acquisition
+    if np.any(e.gyro_asymmetry != 0):
+        reasons.append("gyro asymmetry is on: |ω| is not a polynomial in the table angle")
+    args = kernel_arguments(scenario)
+    draws = nominal_draws(scenario)
+    means = noise_free_segment_means(scenario, draws[None, :])[0]
+    noise = args["noise"]
+    rates = np.abs([s.rate for s in scenario.schedule.segments])
+    max_rate = float(rates.max()) if rates.size else 0.0
+    g = scenario.environment.gravity
+    spread = unpack_spread(scenario.truth_spread)
+    sample_dt = min(1.0 / s.sample_rate for s in scenario.schedule.segments)
+    white = noise[:, 0] / math.sqrt(sample_dt)
+    drift_sigma = np.sqrt(noise[:, 1] ** 2 + noise[:, 3] ** 2 + noise[:, 2] ** 2 * scenario.schedule.duration)
+    spread_bound = np.concatenate([spread["Kg"].sum(1) * max_rate + spread["Bg"] + spread["G"].sum(1) * g,
+                                   spread["Ka"].sum(1) * g + spread["Ba"] + spread["P"].sum(1) * max_rate**2])
+    bound = np.abs(means).max(axis=0) + 6 * (white + drift_sigma) + 6 * spread_bound
+    limits = np.array([e.gyro_output_range] * 3 + [e.accel_output_range] * 3)
+    if a.bits:
+        limits = np.minimum(limits, [a.gyro_full_scale] * 3 + [a.accel_full_scale] * 3)
+    for c in np.flatnonzero(bound >= limits):
+        reasons.append(f"channel {CHANNELS[c]} may saturate: bound {bound[c]:.4g} >= limit {limits[c]:.4g} (SI)")
+    if a.bits:
+        steps = np.array([a.gyro_step] * 3 + [a.accel_step] * 3)
+        dithered = steps / np.pi * np.exp(-2 * np.pi**2 * white**2 / steps**2) <= segment_path.DITHER_TOLERANCE * steps
+        for c in np.flatnonzero(~dithered & (drift_sigma > 0.1 * np.maximum(white, 1e-300))):
+            reasons.append(f"channel {CHANNELS[c]}: drift σ {drift_sigma[c]:.3g} > 0.1 × white σ {white[c]:.3g} "
+                           "in a quantiser the noise does not dither")
+    return reasons
+
+
+def unpack_spread(spread: np.ndarray) -> dict[str, np.ndarray]:
+    from plansim.model.parameters import unpack
+
+    return unpack(np.abs(spread))
+
+
+def choose_path(scenario: Scenario, path: str = "auto") -> tuple[str, list[str]]:
+    """``(path, reasons)``: *auto* takes the segment-statistics path only where it is exact."""
+    if path not in PATHS:
+        raise ValueError(f"path = {path!r}; allowed: {', '.join(PATHS)}")
+    if path == "sample":
+        return "sample", []
+    reasons = segment_path_exactness(scenario)
+    if path == "auto":
+        return ("sample" if reasons else "segment"), reasons
+    return "segment", reasons
+
+
+def nominal_draws(scenario: Scenario) -> np.ndarray:
+    """A draws vector with the nominal truth, every table error zero and every start phase zero."""
+    draws = np.zeros(draws_length(len(scenario.schedule)))
+    draws[:N_PARAMETERS] = scenario.truth_nominal
+    return draws
+
+
+def noise_free_segment_means(scenario: Scenario, draws: np.ndarray) -> np.ndarray:
+    """Exact noise-free segment means (n, S, 6) for draws vectors (n, D) (layout: plansim.simulate.physics)."""
+    draws = np.ascontiguousarray(draws, dtype=float)
+    if draws.ndim != 2 or draws.shape[1] != draws_length(len(scenario.schedule)):
+        raise ValueError(f"draws: expected shape (n, {draws_length(len(scenario.schedule))}), got {draws.shape}")
+    args = _as_float_arrays(kernel_arguments(scenario))
+    out = np.empty((draws.shape[0], len(scenario.schedule), 6))
+    keep = ("seg_n", "seg_dt", "seg_C0", "seg_rate", "seg_axis", "seg_axis_index", "seg_temp", "sensor", "S2",
+            "lever", "t_ref", "gravity", "earth_enu")
+    segment_path.noise_free_means(draws, **{k: args[k] for k in keep}, means_out=out)
+    return out
+
+
 def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_size: int = 256,
-                           progress: ProgressCallback | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run *trials* calibrations on the sample-level path.
+                           progress: ProgressCallback | None = None, path: str = "sample"
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """Run *trials* calibrations on the sample-level (``path="sample"``) or segment-statistics path.
 
     Returns
     -------
@@ -133,15 +244,22 @@ def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_siz
         raise ValueError(f"trials = {trials!r}: expected a whole number >= 1")
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ValueError(f"chunk_size = {chunk_size!r}: expected a whole number >= 1")
+    if path not in ("sample", "segment"):
+        raise ValueError(f"path = {path!r}; allowed: 'sample', 'segment'")
     key = root_key(seed)
     args = _as_float_arrays(kernel_arguments(scenario))
+    if path == "segment":
+        kernel = segment_path.simulate_chunk_statistics
+        args["drift_coeffs"] = drift_coefficient_table(scenario)
+        args["needed"] = needed_channels(scenario.schedule)
+    else:
+        kernel = sample_path.simulate_chunk
     S = len(scenario.schedule)
     means = np.empty((trials, S, 6))
     truth = np.empty((trials, N_PARAMETERS))
     for start in range(0, trials, chunk_size):
         stop = min(trials, start + chunk_size)
-        sample_path.simulate_chunk(start, key, ZIG_X, ZIG_RATIO, **args,
-                                   means_out=means[start:stop], truth_out=truth[start:stop])
+        kernel(start, key, ZIG_X, ZIG_RATIO, **args, means_out=means[start:stop], truth_out=truth[start:stop])
         if progress is not None:
             progress(stop, trials)
     return means, truth

@@ -132,24 +132,25 @@ def _matmul3(a, b, out):
 
 @jit
 def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity, earth_enu, lever,
-                     g_b0, om_b0, u, perp):
+                     g_b0, om_b0, u, perp, work):
     """Orientation of segment *s* under the trial's errors.
 
     Writes the body-frame gravity reaction ``g_b0`` and Earth rate ``om_b0`` at θ = 0, the table
     axis ``u`` (body frame, unit) and the centripetal term ``perp`` (3×3: row i for accelerometer
     i); returns ``(rate_act, phase)``: the actual table rate (rad/s) and start angle (rad).
+    ``work`` is scratch space of shape (6, 3, 3) (kernels allocate it once per trial).
     """
-    fixture = np.empty((3, 3))
-    tilt = np.empty((3, 3))
-    pos_err = np.empty((3, 3))
-    tmp = np.empty((3, 3))
-    c_actual = np.empty((3, 3))
+    fixture = work[0]
+    tilt = work[1]
+    pos_err = work[2]
+    tmp = work[3]
+    c_actual = work[4]
+    nominal = work[5]
     small_rotation(draws[39], draws[40], draws[41], fixture)  # C_fb: MIMU case in the fixture
     small_rotation(draws[42], draws[43], 0.0, tilt)  # platform tilt about East and North
     base = HEAD + PER_SEGMENT * s
     small_rotation(draws[base] + draws[base + 1], draws[base + 2] + draws[base + 3],
                    draws[base + 4] + draws[base + 5], pos_err)
-    nominal = np.empty((3, 3))
     for i in range(3):
         for j in range(3):
             nominal[i, j] = seg_C0[s, i, j]
@@ -162,7 +163,7 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     # table axis: nominal (a coordinate axis of the fixture) tilted by the perpendicularity error,
     # expressed in the MIMU case frame (C_bf = C_fbᵀ)
     a = seg_axis_index[s]
-    v = np.empty(3)
+    v = tmp[0]  # scratch row (tmp is free again)
     for i in range(3):
         v[i] = seg_axis[s, i]
     ia = 0 if abs(v[0]) > 0.5 else (1 if abs(v[1]) > 0.5 else 2)

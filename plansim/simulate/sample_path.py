@@ -95,10 +95,11 @@ def simulate_trial(trial, key, zig_x, zig_ratio, draws,
     y = np.empty(6)
     acc = np.empty(6)
     white = np.empty(6)
+    work = np.empty((6, 3, 3))
     offset = 0
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                           earth_enu, lever, g_b0, om_b0, u, perp)
+                                           earth_enu, lever, g_b0, om_b0, u, perp, work)
         rotating = seg_rate[s] != 0.0
         advance_drift(seg_gap[s], drift, noise, noise_times, state, zig_x, zig_ratio)  # settling
         dt = seg_dt[s]

@@ -1,0 +1,367 @@
+"""Segment-statistics path: each segment's mean drawn from its exact distribution, no raw samples.
+
+The estimators only see segment means (JJF 2003 eq. (3)), so a calibration can be simulated from
+the distribution of those means:
+
+- **Deterministic part** (orientation within a rate point, every sensor effect): the output is a
+  trigonometric polynomial of degree ≤ 3 in the table angle θ (eq. (1)/(2) are linear in the
+  rotated vectors; the cubic nonlinearity is the highest power), so the average over the N samples
+  ``θ_k = θ0 + kΔ`` equals ``Σ_j W_j f(θ0 + 2πj/J)`` over J = 7 nodes, with weights from the
+  discrete averages ``D_m = (1/N) Σ_k e^{imkΔ}`` (:func:`arc_weights`). Exact, whole turns or not.
+- **White noise**: the mean of N samples is normal with variance σ²/N.
+- **Drift** (Gauss–Markov bias instability and drift, random walk), held over the drift update
+  interval as in the sample-level path: the segment mean and the end state are jointly normal
+  given the start state; their 2×2 covariance is factorised once per schedule.
+- **Rate smoothness**: the per-sample rate jitter enters the gyros linearly; its segment mean is a
+  common normal variable for the three gyros.
+- **Quantisation** of a Gaussian sample ``Q(μ + σZ)``: where the noise dithers the quantiser
+  (bias amplitude (q/π)·exp(−2π²σ²/q²) below 1e-9·q) the mean is unbiased and each sample adds
+  q²/12 of variance (Sheppard; Widrow's quantisation theorem); otherwise the exact mean and
+  variance of the quantised Gaussian are summed over the quantisation thresholds within ±8σ and
+  averaged over the segment's θ with as many nodes as the output's variation over σ requires.
+
+What is not exact, and the runner's checks (:func:`plansim.simulate.engine.segment_path_exactness`):
+saturation (excluded), gyro asymmetry (|w| is not a polynomial; excluded), drift that moves a
+non-dithered quantised output within a segment (excluded above 0.1σ), the cross-channel
+correlation of the rate jitter inside non-dithered quantisers (dropped), and channels that no
+estimator uses (returned without quantisation: e.g. the accelerometers during the rate test).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from plansim._jit import jit, parallel_jit
+from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, rotated_inputs,
+                                      segment_geometry, sensor_outputs, unpack_truth)
+from plansim.simulate.random import normal, seed_trial
+from plansim.simulate.sample_path import advance_drift, initial_drift
+
+DETERMINISTIC_NODES = 7  # degree ≤ 3 in θ -> 2·3 + 1 nodes
+MAX_NODES = 401
+QUANTISER_WINDOW = 8.0  # thresholds within ±8σ (Φ(−8) ≈ 6e-16)
+DITHER_TOLERANCE = 1e-9  # relative to the step: bias amplitude below this -> treated as dithered
+
+
+@jit
+def arc_weights(J, delta, n, weights):
+    """Weights with ``(1/n) Σ_{k<n} f(θ0 + kΔ) = Σ_{j<J} W_j f(θ0 + 2πj/J)`` for trigonometric
+    polynomials f of degree ≤ (J − 1)/2 (J odd)."""
+    M = (J - 1) // 2
+    for j in range(J):
+        weights[j] = 1.0 / J
+    for m in range(1, M + 1):
+        x = m * delta
+        # D_m = (1/n) Σ_k e^{i m k Δ} = (1 − e^{i m n Δ}) / (n (1 − e^{i m Δ}))
+        den_re = 1.0 - math.cos(x)
+        den_im = -math.sin(x)
+        if den_re * den_re + den_im * den_im < 1e-24:
+            d_re, d_im = 1.0, 0.0
+        else:
+            num_re = 1.0 - math.cos(n * x)
+            num_im = -math.sin(n * x)
+            den2 = n * (den_re * den_re + den_im * den_im)
+            d_re = (num_re * den_re + num_im * den_im) / den2
+            d_im = (num_im * den_re - num_re * den_im) / den2
+        for j in range(J):
+            phi = 2.0 * math.pi * j / J
+            # Re(D_m e^{−i m φ_j})
+            weights[j] += 2.0 / J * (d_re * math.cos(m * phi) + d_im * math.sin(m * phi))
+
+
+@jit
+def quantised_gaussian_moments(mu, sigma, step):
+    """Mean and variance of ``Q(x) = step·floor(x/step + ½)`` for ``x = μ + σZ``, Z standard normal.
+
+    For σ ≥ 0.2·step by the Fourier series of the quantisation error ε = x − Q(x) (a sawtooth),
+    with γ_k = exp(−2π²k²σ²/q²) and α_k = 2πkμ/q (terms to γ_k < 1e-16):
+
+        E[ε]  = Σ_k (−1)^{k+1} q/(πk) γ_k sin α_k
+        E[ε²] = q²/12 + Σ_k (−1)^k q²/(π²k²) γ_k cos α_k
+        Cov(x, ε) = 2σ² Σ_k (−1)^{k+1} γ_k cos α_k          (Stein's lemma)
+        E[Q] = μ − E[ε],  Var Q = σ² + E[ε²] − E[ε]² − 2 Cov(x, ε);
+
+    below that, by summing the threshold-crossing probabilities within ±8σ.
+    """
+    if sigma >= 0.2 * step:
+        r = sigma / step
+        kmax = int(math.ceil(1.366 / r))
+        a1 = 2.0 * math.pi * mu / step
+        # reduce the angle: only μ mod q matters (keeps sin/cos accurate for large μ/q)
+        a1 = a1 - 2.0 * math.pi * math.floor(a1 / (2.0 * math.pi))
+        c1 = math.cos(a1)
+        s1 = math.sin(a1)
+        ck, sk = c1, s1
+        e1 = 0.0
+        e2 = step * step / 12.0
+        cov = 0.0
+        sign = 1.0
+        for k in range(1, kmax + 1):
+            g = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
+            e1 += sign * step / (math.pi * k) * g * sk
+            e2 -= sign * step * step / (math.pi * math.pi * k * k) * g * ck
+            cov += sign * g * ck
+            c_next = ck * c1 - sk * s1
+            sk = sk * c1 + ck * s1
+            ck = c_next
+            sign = -sign
+        cov *= 2.0 * sigma * sigma
+        return mu - e1, max(sigma * sigma + e2 - e1 * e1 - 2.0 * cov, 0.0)
+    if sigma <= 0.0:
+        return step * math.floor(mu / step + 0.5), 0.0
+    low = math.floor((mu - QUANTISER_WINDOW * sigma) / step + 0.5)
+    high = math.floor((mu + QUANTISER_WINDOW * sigma) / step + 0.5)
+    s1 = 0.0  # E[S], S = number of thresholds below x
+    s2 = 0.0  # E[S²] = Σ_j (2j + 1) P_j
+    j = 0
+    level = low
+    while level < high:
+        t = (level + 0.5) * step
+        p = 0.5 * math.erfc((t - mu) / (sigma * math.sqrt(2.0)))
+        s1 += p
+        s2 += (2.0 * j + 1.0) * p
+        level += 1.0
+        j += 1
+    return step * (low + s1), step * step * max(s2 - s1 * s1, 0.0)
+
+
+@jit
+def _node_outputs(theta, rate, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y):
+    rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc)
+    sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+
+
+@jit
+def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                        sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
+    """Exact noise-free segment means (S, 6) of one trial's draws: the average over the samples."""
+    Kg = np.empty((3, 3))
+    G = np.empty((3, 3))
+    Ka = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Bg = np.empty(3)
+    Ba = np.empty(3)
+    unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
+    u = np.empty(3)
+    g_b0 = np.empty(3)
+    om_b0 = np.empty(3)
+    perp = np.empty((3, 3))
+    w = np.empty(3)
+    fc = np.empty(3)
+    y = np.empty(6)
+    weights = np.empty(DETERMINISTIC_NODES)
+    work = np.empty((6, 3, 3))
+    for s in range(seg_n.shape[0]):
+        rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                           earth_enu, lever, g_b0, om_b0, u, perp, work)
+        dT = seg_temp[s] - t_ref
+        if seg_rate[s] == 0.0:
+            _node_outputs(0.0, 0.0, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+            for c in range(6):
+                means_out[s, c] = y[c]
+            continue
+        arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
+        for c in range(6):
+            means_out[s, c] = 0.0
+        for j in range(DETERMINISTIC_NODES):
+            theta = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
+            _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+            for c in range(6):
+                means_out[s, c] += weights[j] * y[c]
+
+
+@parallel_jit
+def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                     sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
+    """:func:`deterministic_means` for many draws vectors (n, D) -> (n, S, 6), in parallel."""
+    for t in numba.prange(draws.shape[0]):
+        deterministic_means(draws[t], seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                            sensor, S2, lever, t_ref, gravity, earth_enu, means_out[t])
+
+
+@jit
+def _segment_drift(drift, coeffs, noise, state, zig_x, zig_ratio, mean_out):
+    """Draw the segment-mean drift per channel and move the states to the end of the recording.
+
+    ``coeffs`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
+    coefficients a, c, L11, L21, L22 of mean = a·x0 + σ L11 z1, end = c·x0 + σ(L21 z1 + L22 z2).
+    """
+    for c in range(6):
+        mean_out[c] = 0.0
+        for p in range(3):
+            sigma = noise[c, 1] if p == 0 else (noise[c, 3] if p == 1 else noise[c, 2])
+            if sigma <= 0.0:
+                continue
+            z1 = normal(state, zig_x, zig_ratio)
+            z2 = normal(state, zig_x, zig_ratio)
+            x0 = drift[p, c]
+            mean_out[c] += coeffs[p, 0] * x0 + sigma * coeffs[p, 2] * z1
+            drift[p, c] = coeffs[p, 1] * x0 + sigma * (coeffs[p, 3] * z1 + coeffs[p, 4] * z2)
+
+
+@jit
+def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
+                              seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                              sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity,
+                              earth_enu, drift_coeffs, needed, means_out):
+    """One calibration on the segment-statistics path; segment means into ``means_out`` (S, 6)."""
+    state = np.empty(4, np.uint64)
+    seed_trial(key, trial, STREAM_NOISE, state)
+    Kg = np.empty((3, 3))
+    G = np.empty((3, 3))
+    Ka = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Bg = np.empty(3)
+    Ba = np.empty(3)
+    unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
+    drift = initial_drift(noise, state, zig_x, zig_ratio)
+    u = np.empty(3)
+    g_b0 = np.empty(3)
+    om_b0 = np.empty(3)
+    perp = np.empty((3, 3))
+    w = np.empty(3)
+    fc = np.empty(3)
+    y = np.empty(6)
+    y2 = np.empty(6)
+    det = np.empty(6)
+    spread = np.empty(6)
+    jitter = np.empty(6)
+    dbar = np.empty(6)
+    w7 = np.empty(DETERMINISTIC_NODES)
+    nodes = np.empty((DETERMINISTIC_NODES, 6))
+    wj = np.empty(MAX_NODES)
+    work = np.empty((6, 3, 3))
+    for s in range(seg_n.shape[0]):
+        rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                           earth_enu, lever, g_b0, om_b0, u, perp, work)
+        rotating = seg_rate[s] != 0.0
+        advance_drift(seg_gap[s], drift, noise, noise_times, state, zig_x, zig_ratio)  # settling
+        _segment_drift(drift, drift_coeffs[s], noise, state, zig_x, zig_ratio, dbar)
+        n = seg_n[s]
+        dt = seg_dt[s]
+        dT = seg_temp[s] - t_ref
+        # deterministic segment mean (exact) and the output's variation over θ
+        if rotating:
+            arc_weights(DETERMINISTIC_NODES, rate_act * dt, n, w7)
+            for c in range(6):
+                det[c] = 0.0
+            for j in range(DETERMINISTIC_NODES):
+                theta = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
+                _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+                for c in range(6):
+                    nodes[j, c] = y[c]
+                    det[c] += w7[j] * y[c]
+            for c in range(6):
+                lo = nodes[0, c]
+                hi = nodes[0, c]
+                for j in range(1, DETERMINISTIC_NODES):
+                    lo = min(lo, nodes[j, c])
+                    hi = max(hi, nodes[j, c])
+                spread[c] = hi - lo
+            # rate jitter: linear response of each output to the table rate (central difference)
+            h = 1e-6 * abs(rate_act)
+            _node_outputs(phase, rate_act + h, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+            _node_outputs(phase, rate_act - h, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y2)
+            for c in range(6):
+                # the sample path jitters the gyro input w (so also P·w²), not the centripetal term
+                jitter[c] = smoothness * rate_act * (y[c] - y2[c]) / (2.0 * h)
+        else:
+            _node_outputs(0.0, 0.0, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+            for c in range(6):
+                det[c] = y[c]
+                spread[c] = 0.0
+                jitter[c] = 0.0
+        zbar = normal(state, zig_x, zig_ratio) / math.sqrt(n) if (rotating and smoothness > 0.0) else 0.0
+        for c in range(6):
+            white = noise[c, 0] / math.sqrt(dt)
+            step = acquisition[2] if c < 3 else acquisition[3]
+            sigma_eff = math.sqrt(white * white + jitter[c] * jitter[c])
+            z = normal(state, zig_x, zig_ratio)
+            base = det[c] + dbar[c]
+            if step <= 0.0 or needed[s, c] == 0:
+                means_out[s, c] = base + white / math.sqrt(n) * z + jitter[c] * zbar
+                continue
+            bias_amplitude = step / math.pi * math.exp(-2.0 * math.pi * math.pi * sigma_eff * sigma_eff / (step * step))
+            if bias_amplitude <= DITHER_TOLERANCE * step:
+                # dithered: unbiased, each sample adds q²/12 of independent variance
+                means_out[s, c] = base + math.sqrt((white * white + step * step / 12.0) / n) * z + jitter[c] * zbar
+                continue
+            if spread[c] <= 1e-6 * max(sigma_eff, step):
+                m, v = quantised_gaussian_moments(base, sigma_eff, step)
+                means_out[s, c] = m + math.sqrt(v / n) * z
+                continue
+            # the output sweeps across the quantiser within the segment: average its moments over θ
+            J = 2 * int(min(math.ceil(4.0 * spread[c] / max(sigma_eff, 1e-300)) + 4, (MAX_NODES - 1) // 2)) + 1
+            J = max(J, DETERMINISTIC_NODES)
+            arc_weights(J, rate_act * dt, n, wj)
+            mbar = 0.0
+            vbar = 0.0
+            for j in range(J):
+                theta = phase + 2.0 * math.pi * j / J
+                _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+                m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_eff, step)
+                mbar += wj[j] * m
+                vbar += wj[j] * v
+            means_out[s, c] = mbar + math.sqrt(max(vbar, 0.0) / n) * z
+
+
+@parallel_jit
+def simulate_chunk_statistics(first_trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind,
+                              error_scale, seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index,
+                              seg_temp, sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness,
+                              gravity, earth_enu, drift_coeffs, needed, means_out, truth_out):
+    """Trials ``first_trial …`` in parallel on the segment-statistics path (same systematic draws as the sample path)."""
+    n_seg = seg_n.shape[0]
+    for t in numba.prange(means_out.shape[0]):
+        draws = np.empty(_draws_length(n_seg))
+        draw_systematic(first_trial + t, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind,
+                        error_scale, n_seg, draws)
+        for k in range(N_TRUTH):
+            truth_out[t, k] = draws[k]
+        simulate_trial_statistics(first_trial + t, key, zig_x, zig_ratio, draws, seg_n, seg_dt, seg_gap, seg_C0,
+                                  seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
+                                  acquisition, noise, noise_times, smoothness, gravity, earth_enu, drift_coeffs,
+                                  needed, means_out[t])
+
+
+_draws_length = jit(draws_length)
+
+
+def drift_coefficients(n: int, dt: float, hold_interval: float, tau: float | None) -> np.ndarray:
+    """Unit-σ coefficients (a, c, L11, L21, L22) of a held drift process over one recorded segment.
+
+    The process is advanced (exactly) at the end of each block of ``hold`` samples, as the
+    sample-level path does; ``tau=None`` means a random walk (φ = 1, increments √Δt). Returns the
+    coefficients of ``mean = a·x0 + L11 z1`` and ``end = c·x0 + L21 z1 + L22 z2`` (z independent
+    standard normals) for a process of unit σ (or unit random-walk coefficient).
+    """
+    hold = max(1, int(math.floor(hold_interval / dt + 0.5)))
+    blocks = -(-n // hold)
+    sizes = np.full(blocks, hold, dtype=float)
+    sizes[-1] = n - (blocks - 1) * hold
+    durations = sizes * dt
+    if tau is None:
+        phi = np.ones(blocks)
+        q = np.sqrt(durations)
+    else:
+        phi = np.exp(-durations / tau)
+        q = np.sqrt(1.0 - phi**2)
+    weight = sizes / n
+    A = np.concatenate([[1.0], np.cumprod(phi)])  # A_j = Π_{l<j} φ_l
+    a = float(np.sum(weight * A[:-1]))
+    c = float(A[-1])
+    T = np.zeros(blocks)  # T_i = Σ_{j>i} w_j Π_{i<l<j} φ_l
+    E = np.ones(blocks)  # E_i = Π_{i<l<B} φ_l
+    for i in range(blocks - 2, -1, -1):
+        T[i] = weight[i + 1] + phi[i + 1] * T[i + 1]
+        E[i] = phi[i + 1] * E[i + 1]
+    b = q * T
+    d = q * E
+    cov = np.array([[b @ b, b @ d], [b @ d, d @ d]])
+    L11 = math.sqrt(cov[0, 0])
+    L21 = cov[0, 1] / L11 if L11 > 0 else 0.0
+    L22 = math.sqrt(max(cov[1, 1] - L21**2, 0.0))
+    return np.array([a, c, L11, L21, L22])
