@@ -49,27 +49,44 @@ DITHER_TOLERANCE = 1e-9  # relative to the step: bias amplitude below this -> tr
 @jit
 def arc_weights(J, delta, n, weights):
     """Weights with ``(1/n) Σ_{k<n} f(θ0 + kΔ) = Σ_{j<J} W_j f(θ0 + 2πj/J)`` for trigonometric
-    polynomials f of degree ≤ (J − 1)/2 (J odd)."""
+    polynomials f of degree ≤ M = (J − 1)/2 (J odd):
+
+        W_j = (1/J)·[1 + 2 Re Σ_{m=1..M} D_m e^{−i m 2πj/J}],  D_m = (1/n) Σ_k e^{i m k Δ}
+            = (1 − e^{i m n Δ}) / (n (1 − e^{i m Δ})).
+
+    Powers by recurrence and the twiddles from one table: no trigonometric call inside the loops.
+    """
     M = (J - 1) // 2
-    for j in range(J):
-        weights[j] = 1.0 / J
+    d_re = np.empty(M + 1)
+    d_im = np.empty(M + 1)
+    c1, s1 = math.cos(delta), math.sin(delta)
+    cn, sn = math.cos(n * delta), math.sin(n * delta)
+    a_re, a_im = 1.0, 0.0  # e^{i m Δ}
+    b_re, b_im = 1.0, 0.0  # e^{i m n Δ}
     for m in range(1, M + 1):
-        x = m * delta
-        # D_m = (1/n) Σ_k e^{i m k Δ} = (1 − e^{i m n Δ}) / (n (1 − e^{i m Δ}))
-        den_re = 1.0 - math.cos(x)
-        den_im = -math.sin(x)
-        if den_re * den_re + den_im * den_im < 1e-24:
-            d_re, d_im = 1.0, 0.0
+        a_re, a_im = a_re * c1 - a_im * s1, a_re * s1 + a_im * c1
+        b_re, b_im = b_re * cn - b_im * sn, b_re * sn + b_im * cn
+        den_re = 1.0 - a_re
+        den_im = -a_im
+        den2 = den_re * den_re + den_im * den_im
+        if den2 < 1e-24:  # e^{imΔ} = 1: every sample at the same phase
+            d_re[m], d_im[m] = 1.0, 0.0
         else:
-            num_re = 1.0 - math.cos(n * x)
-            num_im = -math.sin(n * x)
-            den2 = n * (den_re * den_re + den_im * den_im)
-            d_re = (num_re * den_re + num_im * den_im) / den2
-            d_im = (num_im * den_re - num_re * den_im) / den2
-        for j in range(J):
-            phi = 2.0 * math.pi * j / J
-            # Re(D_m e^{−i m φ_j})
-            weights[j] += 2.0 / J * (d_re * math.cos(m * phi) + d_im * math.sin(m * phi))
+            num_re = 1.0 - b_re
+            num_im = -b_im
+            d_re[m] = (num_re * den_re + num_im * den_im) / (n * den2)
+            d_im[m] = (num_im * den_re - num_re * den_im) / (n * den2)
+    cos_table = np.empty(J)
+    sin_table = np.empty(J)
+    for k in range(J):
+        cos_table[k] = math.cos(2.0 * math.pi * k / J)
+        sin_table[k] = math.sin(2.0 * math.pi * k / J)
+    for j in range(J):
+        acc = 0.0
+        for m in range(1, M + 1):
+            k = (m * j) % J
+            acc += d_re[m] * cos_table[k] + d_im[m] * sin_table[k]  # Re(D_m e^{−i m φ_j})
+        weights[j] = (1.0 + 2.0 * acc) / J
 
 
 @jit
@@ -234,6 +251,12 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
     nodes = np.empty((DETERMINISTIC_NODES, 6))
     wj = np.empty(MAX_NODES)
     work = np.empty((6, 3, 3))
+    z_all = np.empty(6)
+    white_all = np.empty(6)
+    sigma_all = np.empty(6)
+    mbar = np.empty(6)
+    vbar = np.empty(6)
+    mode = np.empty(6, np.int64)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
@@ -275,37 +298,55 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
                 spread[c] = 0.0
                 jitter[c] = 0.0
         zbar = normal(state, zig_x, zig_ratio) / math.sqrt(n) if (rotating and smoothness > 0.0) else 0.0
+        # per channel: 0 linear (no quantiser, or no estimator uses it), 1 dithered, 2 quantised
+        # with a constant mean, 3 quantised while the output sweeps across it (average over θ)
+        J = 0
         for c in range(6):
-            white = noise[c, 0] / math.sqrt(dt)
+            z_all[c] = normal(state, zig_x, zig_ratio)
+            white_all[c] = noise[c, 0] / math.sqrt(dt)
             step = acquisition[2] if c < 3 else acquisition[3]
-            sigma_eff = math.sqrt(white * white + jitter[c] * jitter[c])
-            z = normal(state, zig_x, zig_ratio)
-            base = det[c] + dbar[c]
+            sigma_all[c] = math.sqrt(white_all[c] * white_all[c] + jitter[c] * jitter[c])
             if step <= 0.0 or needed[s, c] == 0:
-                means_out[s, c] = base + white / math.sqrt(n) * z + jitter[c] * zbar
+                mode[c] = 0
                 continue
-            bias_amplitude = step / math.pi * math.exp(-2.0 * math.pi * math.pi * sigma_eff * sigma_eff / (step * step))
+            bias_amplitude = step / math.pi * math.exp(-2.0 * math.pi * math.pi * sigma_all[c] * sigma_all[c]
+                                                       / (step * step))
             if bias_amplitude <= DITHER_TOLERANCE * step:
-                # dithered: unbiased, each sample adds q²/12 of independent variance
-                means_out[s, c] = base + math.sqrt((white * white + step * step / 12.0) / n) * z + jitter[c] * zbar
-                continue
-            if spread[c] <= 1e-6 * max(sigma_eff, step):
-                m, v = quantised_gaussian_moments(base, sigma_eff, step)
-                means_out[s, c] = m + math.sqrt(v / n) * z
-                continue
-            # the output sweeps across the quantiser within the segment: average its moments over θ
-            J = 2 * int(min(math.ceil(4.0 * spread[c] / max(sigma_eff, 1e-300)) + 4, (MAX_NODES - 1) // 2)) + 1
-            J = max(J, DETERMINISTIC_NODES)
+                mode[c] = 1
+            elif spread[c] <= 1e-6 * max(sigma_all[c], step):
+                mode[c] = 2
+            else:
+                mode[c] = 3
+                # harmonics of m(μ(θ)) fade beyond ~3·spread/σ (Gaussian smoothing of the staircase)
+                half = int(min(math.ceil(3.0 * spread[c] / max(sigma_all[c], 1e-300)) + 4, (MAX_NODES - 1) // 2))
+                J = max(J, 2 * half + 1)
+        if J > 0:
             arc_weights(J, rate_act * dt, n, wj)
-            mbar = 0.0
-            vbar = 0.0
+            for c in range(6):
+                mbar[c] = 0.0
+                vbar[c] = 0.0
             for j in range(J):
                 theta = phase + 2.0 * math.pi * j / J
                 _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
-                m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_eff, step)
-                mbar += wj[j] * m
-                vbar += wj[j] * v
-            means_out[s, c] = mbar + math.sqrt(max(vbar, 0.0) / n) * z
+                for c in range(6):
+                    if mode[c] == 3:
+                        step = acquisition[2] if c < 3 else acquisition[3]
+                        m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_all[c], step)
+                        mbar[c] += wj[j] * m
+                        vbar[c] += wj[j] * v
+        for c in range(6):
+            base = det[c] + dbar[c]
+            step = acquisition[2] if c < 3 else acquisition[3]
+            if mode[c] == 0:
+                means_out[s, c] = base + white_all[c] / math.sqrt(n) * z_all[c] + jitter[c] * zbar
+            elif mode[c] == 1:  # dithered: unbiased, each sample adds q²/12 of independent variance
+                means_out[s, c] = (base + math.sqrt((white_all[c] * white_all[c] + step * step / 12.0) / n) * z_all[c]
+                                   + jitter[c] * zbar)
+            elif mode[c] == 2:
+                m, v = quantised_gaussian_moments(base, sigma_all[c], step)
+                means_out[s, c] = m + math.sqrt(v / n) * z_all[c]
+            else:
+                means_out[s, c] = mbar[c] + math.sqrt(max(vbar[c], 0.0) / n) * z_all[c]
 
 
 @parallel_jit
