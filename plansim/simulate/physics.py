@@ -131,6 +131,14 @@ def _matmul3(a, b, out):
 
 
 @jit
+def trial_frames(draws, work):
+    """Per-trial rotations into ``work[0]`` (fixture: MIMU case in the fixture, C_fb) and
+    ``work[1]`` (platform tilt about East and North); call once before :func:`segment_geometry`."""
+    small_rotation(draws[39], draws[40], draws[41], work[0])
+    small_rotation(draws[42], draws[43], 0.0, work[1])
+
+
+@jit
 def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity, earth_enu, lever,
                      g_b0, om_b0, u, perp, work):
     """Orientation of segment *s* under the trial's errors.
@@ -138,7 +146,8 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     Writes the body-frame gravity reaction ``g_b0`` and Earth rate ``om_b0`` at θ = 0, the table
     axis ``u`` (body frame, unit) and the centripetal term ``perp`` (3×3: row i for accelerometer
     i); returns ``(rate_act, phase)``: the actual table rate (rad/s) and start angle (rad).
-    ``work`` is scratch space of shape (6, 3, 3) (kernels allocate it once per trial).
+    ``work`` (6, 3, 3) holds the trial's frames (:func:`trial_frames`) in ``work[0:2]`` and is
+    scratch space otherwise.
     """
     fixture = work[0]
     tilt = work[1]
@@ -146,8 +155,6 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     tmp = work[3]
     c_actual = work[4]
     nominal = work[5]
-    small_rotation(draws[39], draws[40], draws[41], fixture)  # C_fb: MIMU case in the fixture
-    small_rotation(draws[42], draws[43], 0.0, tilt)  # platform tilt about East and North
     base = HEAD + PER_SEGMENT * s
     small_rotation(draws[base] + draws[base + 1], draws[base + 2] + draws[base + 3],
                    draws[base + 4] + draws[base + 5], pos_err)

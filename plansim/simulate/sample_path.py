@@ -27,7 +27,7 @@ import numpy as np
 
 from plansim._jit import jit, parallel_jit
 from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, quantise,
-                                      segment_geometry, sensor_outputs, unpack_truth)
+                                      segment_geometry, sensor_outputs, trial_frames, unpack_truth)
 from plansim.simulate.random import normal, seed_trial
 
 
@@ -96,6 +96,7 @@ def simulate_trial(trial, key, zig_x, zig_ratio, draws,
     acc = np.empty(6)
     white = np.empty(6)
     work = np.empty((6, 3, 3))
+    trial_frames(draws, work)
     offset = 0
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,

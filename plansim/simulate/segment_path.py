@@ -15,10 +15,12 @@ the distribution of those means:
 - **Rate smoothness**: the per-sample rate jitter enters the gyros linearly; its segment mean is a
   common normal variable for the three gyros.
 - **Quantisation** of a Gaussian sample ``Q(μ + σZ)``: where the noise dithers the quantiser
-  (bias amplitude (q/π)·exp(−2π²σ²/q²) below 1e-9·q) the mean is unbiased and each sample adds
-  q²/12 of variance (Sheppard; Widrow's quantisation theorem); otherwise the exact mean and
-  variance of the quantised Gaussian are summed over the quantisation thresholds within ±8σ and
-  averaged over the segment's θ with as many nodes as the output's variation over σ requires.
+  (bias amplitude Σ_k q/(πk)·exp(−2π²k²σ²/q²) below the tolerance) the mean is unbiased and each
+  sample adds q²/12 of variance (Sheppard; Widrow's quantisation theorem); otherwise the exact
+  mean and variance of the quantised Gaussian (Fourier series for σ ≥ 0.2q, threshold sums below)
+  are averaged over the segment's θ with as many nodes as the output's sweep requires.
+  Tolerance: every such approximation stays below 0.1 % of the segment mean's own noise σ/√N
+  (:data:`RELATIVE_TOLERANCE`).
 
 What is not exact, and the runner's checks (:func:`plansim.simulate.engine.segment_path_exactness`):
 saturation (excluded), gyro asymmetry (|w| is not a polynomial; excluded), drift that moves a
@@ -36,14 +38,15 @@ import numpy as np
 
 from plansim._jit import jit, parallel_jit
 from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, rotated_inputs,
-                                      segment_geometry, sensor_outputs, unpack_truth)
+                                      segment_geometry, sensor_outputs, trial_frames, unpack_truth)
 from plansim.simulate.random import normal, seed_trial
 from plansim.simulate.sample_path import advance_drift, initial_drift
 
 DETERMINISTIC_NODES = 7  # degree ≤ 3 in θ -> 2·3 + 1 nodes
 MAX_NODES = 401
 QUANTISER_WINDOW = 8.0  # thresholds within ±8σ (Φ(−8) ≈ 6e-16)
-DITHER_TOLERANCE = 1e-9  # relative to the step: bias amplitude below this -> treated as dithered
+#: every approximation of the quantiser stays below this fraction of the segment mean's noise σ/√N
+RELATIVE_TOLERANCE = 1e-3
 
 
 @jit
@@ -90,6 +93,43 @@ def arc_weights(J, delta, n, weights):
 
 
 @jit
+def fourier_damping(sigma, step, gammas):
+    """γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16 (into *gammas*); returns the count, 0 if σ < 0.2q."""
+    if sigma < 0.2 * step:
+        return 0
+    r = sigma / step
+    kmax = min(int(math.ceil(1.366 / r)), gammas.shape[0])
+    for k in range(1, kmax + 1):
+        gammas[k - 1] = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
+    return kmax
+
+
+@jit
+def moments_from_damping(mu, sigma, step, gammas, kmax):
+    """The Fourier branch of :func:`quantised_gaussian_moments` with γ_k given (σ ≥ 0.2q)."""
+    a1 = 2.0 * math.pi * mu / step
+    a1 = a1 - 2.0 * math.pi * math.floor(a1 / (2.0 * math.pi))  # only μ mod q matters
+    c1 = math.cos(a1)
+    s1 = math.sin(a1)
+    ck, sk = c1, s1
+    e1 = 0.0
+    e2 = step * step / 12.0
+    cov = 0.0
+    sign = 1.0
+    for k in range(1, kmax + 1):
+        g = gammas[k - 1]
+        e1 += sign * step / (math.pi * k) * g * sk
+        e2 -= sign * step * step / (math.pi * math.pi * k * k) * g * ck
+        cov += sign * g * ck
+        c_next = ck * c1 - sk * s1
+        sk = sk * c1 + ck * s1
+        ck = c_next
+        sign = -sign
+    cov *= 2.0 * sigma * sigma
+    return mu - e1, max(sigma * sigma + e2 - e1 * e1 - 2.0 * cov, 0.0)
+
+
+@jit
 def quantised_gaussian_moments(mu, sigma, step):
     """Mean and variance of ``Q(x) = step·floor(x/step + ½)`` for ``x = μ + σZ``, Z standard normal.
 
@@ -104,29 +144,9 @@ def quantised_gaussian_moments(mu, sigma, step):
     below that, by summing the threshold-crossing probabilities within ±8σ.
     """
     if sigma >= 0.2 * step:
-        r = sigma / step
-        kmax = int(math.ceil(1.366 / r))
-        a1 = 2.0 * math.pi * mu / step
-        # reduce the angle: only μ mod q matters (keeps sin/cos accurate for large μ/q)
-        a1 = a1 - 2.0 * math.pi * math.floor(a1 / (2.0 * math.pi))
-        c1 = math.cos(a1)
-        s1 = math.sin(a1)
-        ck, sk = c1, s1
-        e1 = 0.0
-        e2 = step * step / 12.0
-        cov = 0.0
-        sign = 1.0
-        for k in range(1, kmax + 1):
-            g = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
-            e1 += sign * step / (math.pi * k) * g * sk
-            e2 -= sign * step * step / (math.pi * math.pi * k * k) * g * ck
-            cov += sign * g * ck
-            c_next = ck * c1 - sk * s1
-            sk = sk * c1 + ck * s1
-            ck = c_next
-            sign = -sign
-        cov *= 2.0 * sigma * sigma
-        return mu - e1, max(sigma * sigma + e2 - e1 * e1 - 2.0 * cov, 0.0)
+        gammas = np.empty(8)
+        kmax = fourier_damping(sigma, step, gammas)
+        return moments_from_damping(mu, sigma, step, gammas, kmax)
     if sigma <= 0.0:
         return step * math.floor(mu / step + 0.5), 0.0
     low = math.floor((mu - QUANTISER_WINDOW * sigma) / step + 0.5)
@@ -143,6 +163,33 @@ def quantised_gaussian_moments(mu, sigma, step):
         level += 1.0
         j += 1
     return step * (low + s1), step * step * max(s2 - s1 * s1, 0.0)
+
+
+@jit
+def _harmonics_needed(spread, sigma, step, gammas, kmax, tolerance):
+    """Half the number of θ nodes for averaging a quantiser's moments while its input sweeps *spread*.
+
+    The output's deterministic part has degree ≤ 3 in θ. In the Fourier regime (σ ≥ 0.2q) the
+    quantiser's bias is Σ_k A_k sin(2πkμ/q) with A_k = q/(πk)·γ_k; with μ = μ̄ + δ(θ), |δ| ≤ spread,
+    the Jacobi–Anger expansion bounds harmonic n of sin(2πkμ/q) by (πk·spread/q)^n / n!, so M is
+    raised until Σ_k A_k (πk·spread/q)^{M+1}/(M+1)! ≤ tolerance (times 3 for the cubic's own
+    degree). Below 0.2q (a sharp staircase) the Gaussian smoothing sets the bandwidth:
+    M = 3·spread/σ + 4.
+    """
+    cap = (MAX_NODES - 1) // 2
+    if kmax == 0:
+        return int(min(math.ceil(3.0 * spread / max(sigma, 1e-300)) + 4, cap))
+    for M in range(3, cap + 1):
+        bound = 0.0
+        for k in range(1, kmax + 1):
+            x = math.pi * k * spread / step
+            term = step / (math.pi * k) * gammas[k - 1]
+            for j in range(1, M + 2):
+                term *= x / j
+            bound += term
+        if bound <= tolerance:
+            return min(3 * (M // 3 + 1), cap) if M > 3 else 3
+    return cap
 
 
 @jit
@@ -171,6 +218,7 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
     y = np.empty(6)
     weights = np.empty(DETERMINISTIC_NODES)
     work = np.empty((6, 3, 3))
+    trial_frames(draws, work)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
@@ -251,12 +299,15 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
     nodes = np.empty((DETERMINISTIC_NODES, 6))
     wj = np.empty(MAX_NODES)
     work = np.empty((6, 3, 3))
+    trial_frames(draws, work)
     z_all = np.empty(6)
     white_all = np.empty(6)
     sigma_all = np.empty(6)
     mbar = np.empty(6)
     vbar = np.empty(6)
     mode = np.empty(6, np.int64)
+    gammas_all = np.empty((6, 8))
+    kmax_all = np.zeros(6, np.int64)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
@@ -309,29 +360,45 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
             if step <= 0.0 or needed[s, c] == 0:
                 mode[c] = 0
                 continue
-            bias_amplitude = step / math.pi * math.exp(-2.0 * math.pi * math.pi * sigma_all[c] * sigma_all[c]
-                                                       / (step * step))
-            if bias_amplitude <= DITHER_TOLERANCE * step:
+            tolerance = RELATIVE_TOLERANCE * sigma_all[c] / math.sqrt(n)
+            kmax_all[c] = fourier_damping(sigma_all[c], step, gammas_all[c])
+            # bias of the quantised mean: Σ_k q/(πk) γ_k (the first term when γ_1 is small)
+            bias_amplitude = 0.0
+            for k in range(kmax_all[c]):
+                bias_amplitude += step / (math.pi * (k + 1)) * gammas_all[c, k]
+            if kmax_all[c] > 0 and bias_amplitude <= tolerance:
                 mode[c] = 1
-            elif spread[c] <= 1e-6 * max(sigma_all[c], step):
+            elif spread[c] == 0.0:
                 mode[c] = 2
             else:
                 mode[c] = 3
-                # harmonics of m(μ(θ)) fade beyond ~3·spread/σ (Gaussian smoothing of the staircase)
-                half = int(min(math.ceil(3.0 * spread[c] / max(sigma_all[c], 1e-300)) + 4, (MAX_NODES - 1) // 2))
+                half = _harmonics_needed(spread[c], sigma_all[c], step, gammas_all[c], kmax_all[c], tolerance)
                 J = max(J, 2 * half + 1)
         if J > 0:
-            arc_weights(J, rate_act * dt, n, wj)
+            if J == DETERMINISTIC_NODES:
+                for j in range(J):
+                    wj[j] = w7[j]
+            else:
+                arc_weights(J, rate_act * dt, n, wj)
             for c in range(6):
                 mbar[c] = 0.0
                 vbar[c] = 0.0
             for j in range(J):
-                theta = phase + 2.0 * math.pi * j / J
-                _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+                if J == DETERMINISTIC_NODES:  # the nodes of the deterministic mean: reuse them
+                    for c in range(6):
+                        y[c] = nodes[j, c]
+                else:
+                    theta = phase + 2.0 * math.pi * j / J
+                    _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
+                                  w, fc, y)
                 for c in range(6):
                     if mode[c] == 3:
                         step = acquisition[2] if c < 3 else acquisition[3]
-                        m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_all[c], step)
+                        if kmax_all[c] > 0:
+                            m, v = moments_from_damping(y[c] + dbar[c], sigma_all[c], step, gammas_all[c],
+                                                        kmax_all[c])
+                        else:
+                            m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_all[c], step)
                         mbar[c] += wj[j] * m
                         vbar[c] += wj[j] * v
         for c in range(6):
