@@ -48,7 +48,8 @@ def _cmd_run(args) -> int:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
     progress = None if args.quiet else stderr_progress(f"plansim run {scenario.name}")
     start = time.perf_counter()
-    results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress)
+    results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress,
+                  path=args.path)
     elapsed = time.perf_counter() - start
     comparisons = compare_with_appendix_a(results["truth"].values, results["estimate"].values, scenario) \
         if trials >= 2 else []
@@ -119,7 +120,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
     p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
-    p.add_argument("--chunk-size", type=int, default=256, help="trials per kernel call (results do not depend on it)")
+    p.add_argument("--chunk-size", type=int, default=4096,
+                   help="trials per kernel call (results do not depend on it; memory grows with it)")
+    p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
+                   help="simulation path: auto takes the segment-statistics path only where it is exact")
     p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
     p.set_defaults(func=_cmd_run)
 

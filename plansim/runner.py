@@ -19,7 +19,8 @@ import xarray as xr
 from plansim.estimate import reduce
 from plansim.model.parameters import PARAMETERS, PARAMETER_NAMES
 from plansim.scenario import Scenario, load_scenario
-from plansim.simulate.engine import PATH_NAMES, ProgressCallback, choose_path, simulate_segment_means
+from plansim.model.parameters import N_PARAMETERS
+from plansim.simulate.engine import PATH_NAMES, ProgressCallback, choose_path, iterate_chunks
 
 
 def package_version() -> str:
@@ -38,7 +39,7 @@ def _scenario_of(scenario: Scenario | str) -> Scenario:
 
 
 def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: int | None = None,
-        chunk_size: int = 256, progress: ProgressCallback | None = None,
+        chunk_size: int = 4096, progress: ProgressCallback | None = None,
         keep_segment_means: bool = False, path: str = "auto") -> xr.Dataset:
     """Monte Carlo of the scenario's calibration.
 
@@ -68,9 +69,16 @@ def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: i
     trials = sc.trials if trials is None else trials
     seed = sc.seed if seed is None else seed
     chosen, reasons = choose_path(sc, path)
-    means, truth = simulate_segment_means(sc, trials, seed, chunk_size=chunk_size, progress=progress, path=chosen)
-    estimate = reduce(means, sc.schedule, sc.reduction.reference_gravity, sc.reduction.omega_squared_sign)
-    results = results_dataset(sc, truth, estimate, seed, means if keep_segment_means else None)
+    # reduce chunk by chunk: memory beyond the (trials × 39) results is bounded by chunk_size
+    truth = np.empty((trials, N_PARAMETERS))
+    estimate = np.empty((trials, N_PARAMETERS))
+    means = np.empty((trials, len(sc.schedule), 6)) if keep_segment_means else None
+    for start, stop, m, t in iterate_chunks(sc, trials, seed, chunk_size, chosen, progress):
+        truth[start:stop] = t
+        estimate[start:stop] = reduce(m, sc.schedule, sc.reduction.reference_gravity, sc.reduction.omega_squared_sign)
+        if means is not None:
+            means[start:stop] = m
+    results = results_dataset(sc, truth, estimate, seed, means)
     results.attrs["simulation_path"] = PATH_NAMES[chosen]
     results.attrs["simulation_path_requested"] = path
     results.attrs["segment_path_not_exact_because"] = "; ".join(reasons) if reasons else "(exact)"

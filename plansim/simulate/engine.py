@@ -183,7 +183,9 @@ def segment_path_exactness(scenario: Scenario) -> list[str]:
         reasons.append(f"channel {CHANNELS[c]} may saturate: bound {bound[c]:.4g} >= limit {limits[c]:.4g} (SI)")
     if a.bits:
         steps = np.array([a.gyro_step] * 3 + [a.accel_step] * 3)
-        dithered = steps / np.pi * np.exp(-2 * np.pi**2 * white**2 / steps**2) <= segment_path.DITHER_TOLERANCE * steps
+        n_max = max(seg.samples for seg in scenario.schedule.segments)
+        bias = steps / np.pi * np.exp(-2 * np.pi**2 * white**2 / steps**2)
+        dithered = bias <= segment_path.RELATIVE_TOLERANCE * white / math.sqrt(n_max)
         for c in np.flatnonzero(~dithered & (drift_sigma > 0.1 * np.maximum(white, 1e-300))):
             reasons.append(f"channel {CHANNELS[c]}: drift σ {drift_sigma[c]:.3g} > 0.1 × white σ {white[c]:.3g} "
                            "in a quantiser the noise does not dither")
@@ -228,6 +230,43 @@ def noise_free_segment_means(scenario: Scenario, draws: np.ndarray) -> np.ndarra
     return out
 
 
+def _check_run_arguments(trials, chunk_size, path):
+    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
+        raise ValueError(f"trials = {trials!r}: expected a whole number >= 1")
+    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
+        raise ValueError(f"chunk_size = {chunk_size!r}: expected a whole number >= 1")
+    if path not in ("sample", "segment"):
+        raise ValueError(f"path = {path!r}; allowed: 'sample', 'segment'")
+
+
+def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int = 4096, path: str = "sample",
+                   progress: ProgressCallback | None = None):
+    """Yield ``(start, stop, means, truth)`` chunk by chunk; the buffers are reused (copy what you keep).
+
+    Working memory is bounded by *chunk_size* whatever the number of trials; trial *i* gives the
+    same numbers in any chunk (its random streams depend on the seed and *i* only).
+    """
+    _check_run_arguments(trials, chunk_size, path)
+    key = root_key(seed)
+    args = _as_float_arrays(kernel_arguments(scenario))
+    if path == "segment":
+        kernel = segment_path.simulate_chunk_statistics
+        args["drift_coeffs"] = drift_coefficient_table(scenario)
+        args["needed"] = needed_channels(scenario.schedule)
+    else:
+        kernel = sample_path.simulate_chunk
+    size = min(chunk_size, trials)
+    means = np.empty((size, len(scenario.schedule), 6))
+    truth = np.empty((size, N_PARAMETERS))
+    for start in range(0, trials, chunk_size):
+        stop = min(trials, start + chunk_size)
+        m, t = means[: stop - start], truth[: stop - start]
+        kernel(start, key, ZIG_X, ZIG_RATIO, **args, means_out=m, truth_out=t)
+        yield start, stop, m, t
+        if progress is not None:
+            progress(stop, trials)
+
+
 def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_size: int = 256,
                            progress: ProgressCallback | None = None, path: str = "sample"
                            ) -> tuple[np.ndarray, np.ndarray]:
@@ -240,28 +279,12 @@ def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_siz
     truth : (trials, 39) array
         The parameters each simulated unit really had (SI).
     """
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ValueError(f"trials = {trials!r}: expected a whole number >= 1")
-    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
-        raise ValueError(f"chunk_size = {chunk_size!r}: expected a whole number >= 1")
-    if path not in ("sample", "segment"):
-        raise ValueError(f"path = {path!r}; allowed: 'sample', 'segment'")
-    key = root_key(seed)
-    args = _as_float_arrays(kernel_arguments(scenario))
-    if path == "segment":
-        kernel = segment_path.simulate_chunk_statistics
-        args["drift_coeffs"] = drift_coefficient_table(scenario)
-        args["needed"] = needed_channels(scenario.schedule)
-    else:
-        kernel = sample_path.simulate_chunk
-    S = len(scenario.schedule)
-    means = np.empty((trials, S, 6))
+    _check_run_arguments(trials, chunk_size, path)
+    means = np.empty((trials, len(scenario.schedule), 6))
     truth = np.empty((trials, N_PARAMETERS))
-    for start in range(0, trials, chunk_size):
-        stop = min(trials, start + chunk_size)
-        kernel(start, key, ZIG_X, ZIG_RATIO, **args, means_out=means[start:stop], truth_out=truth[start:stop])
-        if progress is not None:
-            progress(stop, trials)
+    for start, stop, m, t in iterate_chunks(scenario, trials, seed, chunk_size, path, progress):
+        means[start:stop] = m
+        truth[start:stop] = t
     return means, truth
 
 
