@@ -11,6 +11,10 @@ JIT_OPTIONS = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 jit = numba.njit(**JIT_OPTIONS)
 
+#: for small helpers called per sample with array arguments: inlined at numba's IR level, so the
+#: call does not pay a reference-count round trip per array argument
+inline_jit = numba.njit(inline="always", **JIT_OPTIONS)
+
 
 def parallel_jit(function):
     """Compile *function* with ``parallel=True`` (its outer loop is a ``numba.prange`` over trials)."""

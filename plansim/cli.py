@@ -108,6 +108,18 @@ def _cmd_record(args) -> int:
     return 0
 
 
+def _cmd_bench(args) -> int:
+    import numba
+
+    from plansim.bench import main as bench_main
+
+    if args.threads is not None:
+        if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+            raise ValueError(f"--threads {args.threads}: allowed 1 to {numba.config.NUMBA_NUM_THREADS}")
+        numba.set_num_threads(args.threads)
+    return bench_main(json_output=args.json, quick=args.quick)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="plansim", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -136,6 +148,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None)
     p.add_argument("--trial", type=int, default=0, help="which trial of the seed's Monte Carlo to record")
     p.set_defaults(func=_cmd_record)
+
+    p = sub.add_parser("bench", help="measure speed and memory on this machine (takes a few minutes)")
+    p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    p.add_argument("--quick", action="store_true", help="small sizes (seconds): checks the method, not the speed")
+    p.add_argument("--threads", type=int, default=None, help="pin the kernel thread count (default: all cores)")
+    p.set_defaults(func=_cmd_bench)
     return parser
 
 

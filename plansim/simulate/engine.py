@@ -15,7 +15,7 @@ from plansim.scenario import Scenario
 from plansim.schedule.segments import Schedule, axis_vector, body_to_level
 from plansim.simulate import sample_path, segment_path
 from plansim.simulate.physics import EFFECT_ROWS, draw_systematic, draws_length
-from plansim.simulate.random import ZIG_RATIO, ZIG_X, root_key
+from plansim.simulate.random import root_key
 
 CHANNELS = ("gx", "gy", "gz", "ax", "ay", "az")
 
@@ -261,7 +261,7 @@ def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int =
     for start in range(0, trials, chunk_size):
         stop = min(trials, start + chunk_size)
         m, t = means[: stop - start], truth[: stop - start]
-        kernel(start, key, ZIG_X, ZIG_RATIO, **args, means_out=m, truth_out=t)
+        kernel(start, key, **args, means_out=m, truth_out=t)
         yield start, stop, m, t
         if progress is not None:
             progress(stop, trials)
@@ -300,9 +300,9 @@ def simulate_recording(scenario: Scenario, seed: int, trial: int = 0) -> tuple[n
     samples = np.empty((scenario.schedule.total_samples, 6))
     means = np.empty((len(scenario.schedule), 6))
     draws = np.empty(draws_length(len(scenario.schedule)))
-    draw_systematic(int(trial), key, ZIG_X, ZIG_RATIO, args.pop("truth_nominal"), args.pop("truth_spread"),
+    draw_systematic(int(trial), key, args.pop("truth_nominal"), args.pop("truth_spread"),
                     args.pop("error_kind"), args.pop("error_scale"), len(scenario.schedule), draws)
-    sample_path.simulate_trial(int(trial), key, ZIG_X, ZIG_RATIO, draws, **args, means_out=means,
+    sample_path.simulate_trial(int(trial), key, draws, **args, means_out=means,
                                samples_out=samples, record=True)
     truth = draws[:N_PARAMETERS].copy()
     return samples, means, truth

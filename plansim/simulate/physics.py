@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from plansim._jit import jit
+from plansim._jit import inline_jit, jit
 from plansim.simulate.random import draw_error, normal, seed_trial, uniform
 
 N_TRUTH = 39
@@ -50,7 +50,7 @@ def draws_length(n_segments: int) -> int:
 
 
 @jit
-def draw_systematic(trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind, error_scale,
+def draw_systematic(trial, key, truth_nominal, truth_spread, error_kind, error_scale,
                     n_segments, draws):
     """Fill *draws* with trial *trial*'s truth and table errors (stream 0 of its random stream).
 
@@ -61,20 +61,20 @@ def draw_systematic(trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, e
     state = np.empty(4, np.uint64)
     seed_trial(key, trial, STREAM_SYSTEMATIC, state)
     for k in range(N_TRUTH):
-        draws[k] = truth_nominal[k] + truth_spread[k] * normal(state, zig_x, zig_ratio)
+        draws[k] = truth_nominal[k] + truth_spread[k] * normal(state)
     for k in range(3):
-        draws[39 + k] = draw_error(state, error_kind[4], error_scale[4], zig_x, zig_ratio)
-    draws[42] = draw_error(state, error_kind[3], error_scale[3], zig_x, zig_ratio)
-    draws[43] = draw_error(state, error_kind[3], error_scale[3], zig_x, zig_ratio)
-    draws[44] = draw_error(state, error_kind[5], error_scale[5], zig_x, zig_ratio)
+        draws[39 + k] = draw_error(state, error_kind[4], error_scale[4])
+    draws[42] = draw_error(state, error_kind[3], error_scale[3])
+    draws[43] = draw_error(state, error_kind[3], error_scale[3])
+    draws[44] = draw_error(state, error_kind[5], error_scale[5])
     for k in range(6):
-        draws[45 + k] = draw_error(state, error_kind[2], error_scale[2], zig_x, zig_ratio)
+        draws[45 + k] = draw_error(state, error_kind[2], error_scale[2])
     for s in range(n_segments):
         base = HEAD + PER_SEGMENT * s
         for axis in range(3):
-            draws[base + 2 * axis] = draw_error(state, error_kind[0], error_scale[0], zig_x, zig_ratio)
-            draws[base + 2 * axis + 1] = draw_error(state, error_kind[1], error_scale[1], zig_x, zig_ratio)
-        draws[base + 6] = draw_error(state, error_kind[6], error_scale[6], zig_x, zig_ratio)
+            draws[base + 2 * axis] = draw_error(state, error_kind[0], error_scale[0])
+            draws[base + 2 * axis + 1] = draw_error(state, error_kind[1], error_scale[1])
+        draws[base + 6] = draw_error(state, error_kind[6], error_scale[6])
         draws[base + 7] = 2.0 * math.pi * uniform(state)
 
 
@@ -187,7 +187,7 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     return rate_act, draws[base + 7]
 
 
-@jit
+@inline_jit
 def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
     """Gyro input *w* and specific force *fc* at table angle θ with table rate *rate* (Rodrigues, angle −θ)."""
     ct = math.cos(theta)
@@ -202,7 +202,7 @@ def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
     w[2] = rate * u[2] + om_b0[2] * ct - (u[0] * om_b0[1] - u[1] * om_b0[0]) * st + u[2] * uo * (1.0 - ct)
 
 
-@jit
+@inline_jit
 def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
     """Noise-free outputs (6) for gyro input *w* and specific force *fc* at the IMU centre.
 
@@ -229,15 +229,18 @@ def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
         y[3 + i] = val
 
 
-@jit
-def quantise(y, output_range, step, full_scale):
-    """Saturate at ± output range, then quantise to *step* (round half up), clipped at ± full scale."""
+@inline_jit
+def quantise(y, output_range, step, inverse_step, full_scale):
+    """Saturate at ± output range, then quantise to *step* (round half up), clipped at ± full scale.
+
+    *inverse_step* = 1/step, precomputed: a multiplication per sample instead of a division.
+    """
     if y > output_range:
         y = output_range
     elif y < -output_range:
         y = -output_range
     if step > 0.0:
-        y = step * math.floor(y / step + 0.5)
+        y = step * math.floor(y * inverse_step + 0.5)
         if y > full_scale:
             y = full_scale
         elif y < -full_scale:

@@ -111,8 +111,14 @@ def uniform_open(state):
 
 
 @jit
-def normal(state, zig_x, zig_ratio):
-    """Standard normal by the ZIGNOR ziggurat (one 64-bit draw ~98.8 % of the time)."""
+def normal(state):
+    """Standard normal by the ZIGNOR ziggurat (one 64-bit draw ~97 % of the time).
+
+    The tables are module constants (numba freezes them into the code): passed as array
+    arguments they cost a reference-count round trip per call, several times the draw itself.
+    """
+    zig_x = ZIG_X
+    zig_ratio = ZIG_RATIO
     while True:
         r = next_u64(state)
         u = np.int64(r >> _U64(11)) * (2.0 * _TO_UNIT) - 1.0
@@ -135,7 +141,7 @@ def normal(state, zig_x, zig_ratio):
 
 
 @jit
-def draw_error(state, kind, scale, zig_x, zig_ratio):
+def draw_error(state, kind, scale):
     """One draw of a table or fixture error: ``kind`` 0 = uniform on ±scale, 1 = normal with σ = scale.
 
     A draw is always consumed, whatever the scale, so that switching one error on or off does
@@ -143,4 +149,4 @@ def draw_error(state, kind, scale, zig_x, zig_ratio):
     """
     if kind == 0:
         return scale * (2.0 * uniform(state) - 1.0)
-    return scale * normal(state, zig_x, zig_ratio)
+    return scale * normal(state)

@@ -32,13 +32,13 @@ from plansim.simulate.random import normal, seed_trial
 
 
 @jit
-def _gauss_markov_step(x, phi, sigma, state, zig_x, zig_ratio):
+def _gauss_markov_step(x, phi, sigma, state):
     """Exact first-order Gauss–Markov update over a step with φ = exp(−Δt/τ), stationary σ."""
-    return phi * x + sigma * math.sqrt(1.0 - phi * phi) * normal(state, zig_x, zig_ratio)
+    return phi * x + sigma * math.sqrt(1.0 - phi * phi) * normal(state)
 
 
 @jit
-def advance_drift(interval, drift, noise, noise_times, state, zig_x, zig_ratio):
+def advance_drift(interval, drift, noise, noise_times, state):
     """Exact update of the drift processes over *interval* s; ``drift`` (3, 6): GM bias instability,
     GM drift, random walk per channel."""
     if interval <= 0.0:
@@ -48,27 +48,27 @@ def advance_drift(interval, drift, noise, noise_times, state, zig_x, zig_ratio):
     sq = math.sqrt(interval)
     for c in range(6):
         if noise[c, 1] > 0.0:
-            drift[0, c] = _gauss_markov_step(drift[0, c], phi_bi, noise[c, 1], state, zig_x, zig_ratio)
+            drift[0, c] = _gauss_markov_step(drift[0, c], phi_bi, noise[c, 1], state)
         if noise[c, 3] > 0.0:
-            drift[1, c] = _gauss_markov_step(drift[1, c], phi_mk, noise[c, 3], state, zig_x, zig_ratio)
+            drift[1, c] = _gauss_markov_step(drift[1, c], phi_mk, noise[c, 3], state)
         if noise[c, 2] > 0.0:
-            drift[2, c] += noise[c, 2] * sq * normal(state, zig_x, zig_ratio)
+            drift[2, c] += noise[c, 2] * sq * normal(state)
 
 
 @jit
-def initial_drift(noise, state, zig_x, zig_ratio):
+def initial_drift(noise, state):
     """Drift states at the start of the test: Gauss–Markov processes stationary, random walks at 0."""
     drift = np.zeros((3, 6))
     for c in range(6):
         if noise[c, 1] > 0.0:
-            drift[0, c] = noise[c, 1] * normal(state, zig_x, zig_ratio)
+            drift[0, c] = noise[c, 1] * normal(state)
         if noise[c, 3] > 0.0:
-            drift[1, c] = noise[c, 3] * normal(state, zig_x, zig_ratio)
+            drift[1, c] = noise[c, 3] * normal(state)
     return drift
 
 
 @jit
-def simulate_trial(trial, key, zig_x, zig_ratio, draws,
+def simulate_trial(trial, key, draws,
                    seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                    sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
                    means_out, samples_out, record):
@@ -85,7 +85,7 @@ def simulate_trial(trial, key, zig_x, zig_ratio, draws,
     Bg = np.empty(3)
     Ba = np.empty(3)
     unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
-    drift = initial_drift(noise, state, zig_x, zig_ratio)
+    drift = initial_drift(noise, state)
     u = np.empty(3)
     g_b0 = np.empty(3)
     om_b0 = np.empty(3)
@@ -97,12 +97,14 @@ def simulate_trial(trial, key, zig_x, zig_ratio, draws,
     white = np.empty(6)
     work = np.empty((6, 3, 3))
     trial_frames(draws, work)
+    inverse_gyro_step = 1.0 / acquisition[2] if acquisition[2] > 0.0 else 0.0
+    inverse_accel_step = 1.0 / acquisition[3] if acquisition[3] > 0.0 else 0.0
     offset = 0
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
         rotating = seg_rate[s] != 0.0
-        advance_drift(seg_gap[s], drift, noise, noise_times, state, zig_x, zig_ratio)  # settling
+        advance_drift(seg_gap[s], drift, noise, noise_times, state)  # settling
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
         for c in range(6):
@@ -137,7 +139,7 @@ def simulate_trial(trial, key, zig_x, zig_ratio, draws,
                 fc[2] = g_b0[2] * ct - cg2 * st + u[2] * ug * (1.0 - ct)
                 rate_k = rate_act
                 if smoothness > 0.0:
-                    rate_k = rate_act * (1.0 + smoothness * normal(state, zig_x, zig_ratio))
+                    rate_k = rate_act * (1.0 + smoothness * normal(state))
                 w[0] = rate_k * u[0] + om_b0[0] * ct - co0 * st + u[0] * uo * (1.0 - ct)
                 w[1] = rate_k * u[1] + om_b0[1] * ct - co1 * st + u[1] * uo * (1.0 - ct)
                 w[2] = rate_k * u[2] + om_b0[2] * ct - co2 * st + u[2] * uo * (1.0 - ct)
@@ -148,25 +150,25 @@ def simulate_trial(trial, key, zig_x, zig_ratio, draws,
             for c in range(6):
                 val = y[c] + drift[0, c] + drift[1, c] + drift[2, c]
                 if white[c] > 0.0:
-                    val += white[c] * normal(state, zig_x, zig_ratio)
+                    val += white[c] * normal(state)
                 if c < 3:
-                    val = quantise(val, acquisition[0], acquisition[2], acquisition[4])
+                    val = quantise(val, acquisition[0], acquisition[2], inverse_gyro_step, acquisition[4])
                 else:
-                    val = quantise(val, acquisition[1], acquisition[3], acquisition[5])
+                    val = quantise(val, acquisition[1], acquisition[3], inverse_accel_step, acquisition[5])
                 acc[c] += val
                 if record:
                     samples_out[offset + k, c] = val
             if (k + 1) % hold == 0 and k + 1 < n:
-                advance_drift(hold * dt, drift, noise, noise_times, state, zig_x, zig_ratio)
+                advance_drift(hold * dt, drift, noise, noise_times, state)
         tail = n % hold  # to the end of the recording: the last (partial) hold interval
-        advance_drift((tail if tail else hold) * dt, drift, noise, noise_times, state, zig_x, zig_ratio)
+        advance_drift((tail if tail else hold) * dt, drift, noise, noise_times, state)
         for c in range(6):
             means_out[s, c] = acc[c] / n
         offset += n
 
 
 @parallel_jit
-def simulate_chunk(first_trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind, error_scale,
+def simulate_chunk(first_trial, key, truth_nominal, truth_spread, error_kind, error_scale,
                    seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                    sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
                    means_out, truth_out):
@@ -175,11 +177,11 @@ def simulate_chunk(first_trial, key, zig_x, zig_ratio, truth_nominal, truth_spre
     n_seg = seg_n.shape[0]
     for t in numba.prange(means_out.shape[0]):
         draws = np.empty(draws_length_jit(n_seg))
-        draw_systematic(first_trial + t, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind,
+        draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
                         error_scale, n_seg, draws)
         for k in range(N_TRUTH):
             truth_out[t, k] = draws[k]
-        simulate_trial(first_trial + t, key, zig_x, zig_ratio, draws,
+        simulate_trial(first_trial + t, key, draws,
                        seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                        sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
                        means_out[t], no_samples, False)

@@ -248,7 +248,7 @@ def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_
 
 
 @jit
-def _segment_drift(drift, coeffs, noise, state, zig_x, zig_ratio, mean_out):
+def _segment_drift(drift, coeffs, noise, state, mean_out):
     """Draw the segment-mean drift per channel and move the states to the end of the recording.
 
     ``coeffs`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
@@ -260,15 +260,15 @@ def _segment_drift(drift, coeffs, noise, state, zig_x, zig_ratio, mean_out):
             sigma = noise[c, 1] if p == 0 else (noise[c, 3] if p == 1 else noise[c, 2])
             if sigma <= 0.0:
                 continue
-            z1 = normal(state, zig_x, zig_ratio)
-            z2 = normal(state, zig_x, zig_ratio)
+            z1 = normal(state)
+            z2 = normal(state)
             x0 = drift[p, c]
             mean_out[c] += coeffs[p, 0] * x0 + sigma * coeffs[p, 2] * z1
             drift[p, c] = coeffs[p, 1] * x0 + sigma * (coeffs[p, 3] * z1 + coeffs[p, 4] * z2)
 
 
 @jit
-def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
+def simulate_trial_statistics(trial, key, draws,
                               seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                               sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity,
                               earth_enu, drift_coeffs, needed, means_out):
@@ -282,7 +282,7 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
     Bg = np.empty(3)
     Ba = np.empty(3)
     unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
-    drift = initial_drift(noise, state, zig_x, zig_ratio)
+    drift = initial_drift(noise, state)
     u = np.empty(3)
     g_b0 = np.empty(3)
     om_b0 = np.empty(3)
@@ -312,8 +312,8 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
         rotating = seg_rate[s] != 0.0
-        advance_drift(seg_gap[s], drift, noise, noise_times, state, zig_x, zig_ratio)  # settling
-        _segment_drift(drift, drift_coeffs[s], noise, state, zig_x, zig_ratio, dbar)
+        advance_drift(seg_gap[s], drift, noise, noise_times, state)  # settling
+        _segment_drift(drift, drift_coeffs[s], noise, state, dbar)
         n = seg_n[s]
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
@@ -348,12 +348,12 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
                 det[c] = y[c]
                 spread[c] = 0.0
                 jitter[c] = 0.0
-        zbar = normal(state, zig_x, zig_ratio) / math.sqrt(n) if (rotating and smoothness > 0.0) else 0.0
+        zbar = normal(state) / math.sqrt(n) if (rotating and smoothness > 0.0) else 0.0
         # per channel: 0 linear (no quantiser, or no estimator uses it), 1 dithered, 2 quantised
         # with a constant mean, 3 quantised while the output sweeps across it (average over θ)
         J = 0
         for c in range(6):
-            z_all[c] = normal(state, zig_x, zig_ratio)
+            z_all[c] = normal(state)
             white_all[c] = noise[c, 0] / math.sqrt(dt)
             step = acquisition[2] if c < 3 else acquisition[3]
             sigma_all[c] = math.sqrt(white_all[c] * white_all[c] + jitter[c] * jitter[c])
@@ -417,7 +417,7 @@ def simulate_trial_statistics(trial, key, zig_x, zig_ratio, draws,
 
 
 @parallel_jit
-def simulate_chunk_statistics(first_trial, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind,
+def simulate_chunk_statistics(first_trial, key, truth_nominal, truth_spread, error_kind,
                               error_scale, seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index,
                               seg_temp, sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness,
                               gravity, earth_enu, drift_coeffs, needed, means_out, truth_out):
@@ -425,11 +425,11 @@ def simulate_chunk_statistics(first_trial, key, zig_x, zig_ratio, truth_nominal,
     n_seg = seg_n.shape[0]
     for t in numba.prange(means_out.shape[0]):
         draws = np.empty(_draws_length(n_seg))
-        draw_systematic(first_trial + t, key, zig_x, zig_ratio, truth_nominal, truth_spread, error_kind,
+        draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
                         error_scale, n_seg, draws)
         for k in range(N_TRUTH):
             truth_out[t, k] = draws[k]
-        simulate_trial_statistics(first_trial + t, key, zig_x, zig_ratio, draws, seg_n, seg_dt, seg_gap, seg_C0,
+        simulate_trial_statistics(first_trial + t, key, draws, seg_n, seg_dt, seg_gap, seg_C0,
                                   seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
                                   acquisition, noise, noise_times, smoothness, gravity, earth_enu, drift_coeffs,
                                   needed, means_out[t])

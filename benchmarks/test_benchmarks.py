@@ -1,0 +1,63 @@
+"""pytest-benchmark suite. CI runs it once for correctness (``--benchmark-disable`` in pyproject);
+``python -m pytest benchmarks --benchmark-enable`` measures. The thread count is pinned to the
+machine's cores and every kernel is compiled (warmed up) before timing.
+
+The figures quoted in README and docs/performance.md come from ``plansim bench``, which measures
+them side by side in one run.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+import plansim
+from plansim.scenario import load_scenario
+from plansim.simulate.engine import simulate_segment_means
+
+
+@pytest.fixture(scope="module")
+def default_scenario():
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    sc = load_scenario("jjf2003")
+    simulate_segment_means(sc, 2, seed=1, path="sample")  # warm up (compile or load the cache)
+    simulate_segment_means(sc, 2, seed=1, path="segment")
+    return sc
+
+
+def test_numpy_standard_normal_reference(benchmark):
+    rng = np.random.default_rng(1)
+    buffer = np.empty(65536)
+    benchmark(rng.standard_normal, out=buffer)
+    assert np.isfinite(buffer).all()
+
+
+def test_sample_level_path(benchmark, default_scenario):
+    means, truth = benchmark(simulate_segment_means, default_scenario, 8, 1, 8, None, "sample")
+    assert means.shape == (8, len(default_scenario.schedule), 6) and np.isfinite(means).all()
+
+
+def test_segment_statistics_path(benchmark, default_scenario):
+    means, truth = benchmark(simulate_segment_means, default_scenario, 2000, 1, 2000, None, "segment")
+    assert np.isfinite(means).all()
+
+
+def test_complete_calibrations_default(benchmark, default_scenario):
+    results = benchmark(plansim.run, default_scenario, trials=2000, seed=1)
+    assert results.attrs["simulation_path"] == "segment-statistics"
+    assert np.isfinite(results["error"].values).all()
+
+
+def test_bench_command_quick(capsys):
+    """`plansim bench --quick --json` runs end to end and reports every documented figure."""
+    import json
+
+    from plansim.cli import main
+
+    assert main(["bench", "--quick", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    for key in ("numpy_normal_per_s", "samples_per_s", "calibrations_per_s", "peak_rss_mb", "cold_start_s",
+                "warm_start_s", "seconds_per_trial"):
+        assert key in figures
+    assert figures["calibrations_per_s"] > 0 and figures["peak_rss_mb"] > 0

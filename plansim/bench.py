@@ -1,0 +1,164 @@
+"""``plansim bench``: speed and memory measured side by side in one run on this machine.
+
+Figures (all per second of wall time, thread count reported):
+
+- ``numpy_normal_per_s`` — numpy's ``Generator.standard_normal`` drawing alone, the reference;
+- ``samples_per_s`` — the sample-level path on the default scenario: raw channel samples (one
+  sensor output value: noise drawn, drift added, saturated, quantised, folded into its segment
+  mean) per second; ``imu_samples_per_s`` counts 6-channel samples instead;
+- ``calibrations_per_s`` — complete default ``jjf2003`` calibrations (12 positions, every rate
+  point, the ω² test, every estimator) on the segment-statistics path, through ``plansim.run``;
+- ``seconds_per_trial`` at 10³, 10⁴, 10⁵ trials (it must not grow with the trial count);
+- ``peak_rss_mb`` of a separate process running the default with 10⁶ trials (results included);
+- cold start (first ``plansim run`` with an empty kernel cache: compiling) and warm start, both
+  for 10⁴ trials, as separate processes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+
+import numba
+import numpy as np
+
+SCENARIO = "jjf2003"
+
+
+def _best_of(function, repeats: int = 3) -> float:
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def numpy_normal_per_s(count: int = 10_000_000) -> float:
+    """numpy drawing alone: ``standard_normal`` into one reused 64 Ki buffer (in cache, no allocation),
+    the fastest way to draw normals with numpy, so the fairest reference."""
+    rng = np.random.default_rng(1)
+    buffer = np.empty(65536)
+    blocks = max(1, count // buffer.size)
+
+    def draw():
+        for _ in range(blocks):
+            rng.standard_normal(out=buffer)
+
+    return blocks * buffer.size / _best_of(draw)
+
+
+def sample_path_rates(trials: int = 32) -> tuple[float, float]:
+    """(channel samples/s, 6-channel samples/s) of the sample-level path on the default scenario."""
+    from plansim.scenario import load_scenario
+    from plansim.simulate.engine import simulate_segment_means
+
+    sc = load_scenario(SCENARIO)
+    simulate_segment_means(sc, 2, seed=1, path="sample")  # compile / load from cache
+    seconds = _best_of(lambda: simulate_segment_means(sc, trials, seed=1, chunk_size=trials, path="sample"), 2)
+    imu = trials * sc.schedule.total_samples / seconds
+    return 6 * imu, imu
+
+
+def calibrations_per_s(trials: int = 20000) -> float:
+    from plansim.runner import run
+
+    run(SCENARIO, trials=2, seed=1, path="segment")
+    return trials / _best_of(lambda: run(SCENARIO, trials=trials, seed=1, path="segment"), 2)
+
+
+def seconds_per_trial(counts=(1_000, 10_000, 100_000)) -> dict[str, float]:
+    from plansim.runner import run
+
+    run(SCENARIO, trials=2, seed=1, path="segment")
+    return {str(n): _best_of(lambda n=n: run(SCENARIO, trials=n, seed=1, path="segment"), 2 if n < 100_000 else 1) / n
+            for n in counts}
+
+
+def _child(code: str, env: dict | None = None) -> tuple[float, float]:
+    """Run Python *code* in a fresh process: (wall seconds, peak RSS of that process in MB)."""
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        raise RuntimeError(f"benchmark child failed:\n{done.stderr[-2000:]}")
+    return seconds, float(done.stdout.strip().splitlines()[-1])
+
+
+_RSS = "import resource; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)"
+
+
+def peak_rss_mb(trials: int = 1_000_000) -> tuple[float, float]:
+    """(peak RSS in MB, seconds) of a process running the default with *trials* trials."""
+    seconds, rss = _child(f"import plansim; plansim.run({SCENARIO!r}, trials={trials}, seed=1); {_RSS}")
+    return rss, seconds
+
+
+def start_times(trials: int = 10_000) -> tuple[float, float]:
+    """(cold, warm) wall seconds of ``plansim run`` in a new process: empty kernel cache, then filled."""
+    code = (f"from plansim.cli import main; main(['run', {SCENARIO!r}, '--trials', '{trials}', '--quiet', '--json']); "
+            f"{_RSS}")
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        cold, _ = _child(code, env)
+        warm, _ = _child(code, env)
+    return cold, warm
+
+
+def measure(quick: bool = False) -> dict:
+    """Every figure in one run. *quick* shrinks the sizes (for CI correctness runs), not the method."""
+    scale = 100 if quick else 1
+    normals = numpy_normal_per_s(10_000_000 // scale)
+    channel_samples, imu_samples = sample_path_rates(32 // min(scale, 16))
+    calibrations = calibrations_per_s(20_000 // scale)
+    per_trial = seconds_per_trial((1_000 // scale, 10_000 // scale, 100_000 // scale))
+    rss, big_seconds = peak_rss_mb(1_000_000 // scale)
+    cold, warm = start_times(10_000 // scale)
+    counts = sorted(per_trial, key=int)
+    return {
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_implementation()} "
+                   f"{platform.python_version()}, numba {numba.__version__}, numpy {np.__version__}",
+        "threads": numba.get_num_threads(),
+        "quick": quick,
+        "numpy_normal_per_s": normals,
+        "samples_per_s": channel_samples,
+        "imu_samples_per_s": imu_samples,
+        "samples_per_s_over_numpy_normal_per_s": channel_samples / normals,
+        "calibrations_per_s": calibrations,
+        "seconds_per_trial": per_trial,
+        "seconds_per_trial_growth": per_trial[counts[-1]] / per_trial[counts[0]],
+        "million_trials": 1_000_000 // scale,
+        "million_trials_seconds": big_seconds,
+        "peak_rss_mb": rss,
+        "cold_start_s": cold,
+        "warm_start_s": warm,
+        "start_trials": 10_000 // scale,
+    }
+
+
+def format_figures(f: dict) -> str:
+    lines = [f"plansim bench — {f['machine']}, {f['threads']} threads{' (quick sizes)' if f['quick'] else ''}",
+             f"  numpy standard_normal            {f['numpy_normal_per_s']:14,.0f} /s  (reference)",
+             f"  sample-level path                {f['samples_per_s']:14,.0f} channel samples/s "
+             f"({f['samples_per_s_over_numpy_normal_per_s']:.2f} × numpy; {f['imu_samples_per_s']:,.0f} 6-channel samples/s)",
+             f"  segment-statistics path          {f['calibrations_per_s']:14,.0f} calibrations/s (default jjf2003)"]
+    for n, s in sorted(f["seconds_per_trial"].items(), key=lambda kv: int(kv[0])):
+        lines.append(f"  time per trial at {int(n):>9,} trials {s * 1e6:10.1f} µs")
+    lines += [f"  growth of time per trial          {f['seconds_per_trial_growth']:10.2f} × (largest / smallest count)",
+              f"  {f['million_trials']:,} trials: {f['million_trials_seconds']:.1f} s in a new process, "
+              f"peak RSS {f['peak_rss_mb']:,.0f} MB",
+              f"  plansim run, {f['start_trials']:,} trials: cold start {f['cold_start_s']:.1f} s (compiling), "
+              f"warm {f['warm_start_s']:.1f} s"]
+    return "\n".join(lines)
+
+
+def main(json_output: bool = False, quick: bool = False) -> int:
+    figures = measure(quick)
+    print(json.dumps(figures, indent=2) if json_output else format_figures(figures))
+    return 0
+
