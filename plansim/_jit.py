@@ -2,7 +2,8 @@
 
 ``cache=True`` keeps compiled kernels on disk (cold start once per install); ``fastmath`` stays
 off so that results do not depend on the instruction set or reassociation; ``nogil`` lets the
-threading layer run kernels side by side.
+engine run kernels on several threads side by side (slices of trials; see
+:func:`plansim.simulate.engine.iterate_chunks`), which compiles far faster than ``parallel=True``.
 """
 
 import numba
@@ -15,7 +16,3 @@ jit = numba.njit(**JIT_OPTIONS)
 #: call does not pay a reference-count round trip per array argument
 inline_jit = numba.njit(inline="always", **JIT_OPTIONS)
 
-
-def parallel_jit(function):
-    """Compile *function* with ``parallel=True`` (its outer loop is a ``numba.prange`` over trials)."""
-    return numba.njit(parallel=True, **JIT_OPTIONS)(function)

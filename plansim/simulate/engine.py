@@ -5,8 +5,10 @@ from __future__ import annotations
 import math
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 from collections.abc import Callable
 
+import numba
 import numpy as np
 from scipy.optimize import minimize_scalar
 
@@ -258,13 +260,20 @@ def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int =
     size = min(chunk_size, trials)
     means = np.empty((size, len(scenario.schedule), 6))
     truth = np.empty((size, N_PARAMETERS))
-    for start in range(0, trials, chunk_size):
-        stop = min(trials, start + chunk_size)
-        m, t = means[: stop - start], truth[: stop - start]
-        kernel(start, key, **args, means_out=m, truth_out=t)
-        yield start, stop, m, t
-        if progress is not None:
-            progress(stop, trials)
+    workers = numba.get_num_threads()  # honours numba.set_num_threads / NUMBA_NUM_THREADS
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        for start in range(0, trials, chunk_size):
+            stop = min(trials, start + chunk_size)
+            m, t = means[: stop - start], truth[: stop - start]
+            # contiguous slices, one per thread; each trial's numbers depend on its index only
+            edges = np.linspace(0, stop - start, min(workers, stop - start) + 1).astype(int)
+            jobs = [pool.submit(kernel, start + int(a), key, **args, means_out=m[a:b], truth_out=t[a:b])
+                    for a, b in zip(edges[:-1], edges[1:])]
+            for job in jobs:
+                job.result()
+            yield start, stop, m, t
+            if progress is not None:
+                progress(stop, trials)
 
 
 def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_size: int = 256,

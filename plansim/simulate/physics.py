@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from plansim._jit import inline_jit, jit
+from plansim._jit import jit
 from plansim.simulate.random import draw_error, normal, seed_trial, uniform
 
 N_TRUTH = 39
@@ -187,7 +187,7 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     return rate_act, draws[base + 7]
 
 
-@inline_jit
+@jit
 def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
     """Gyro input *w* and specific force *fc* at table angle θ with table rate *rate* (Rodrigues, angle −θ)."""
     ct = math.cos(theta)
@@ -202,7 +202,7 @@ def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
     w[2] = rate * u[2] + om_b0[2] * ct - (u[0] * om_b0[1] - u[1] * om_b0[0]) * st + u[2] * uo * (1.0 - ct)
 
 
-@inline_jit
+@jit
 def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
     """Noise-free outputs (6) for gyro input *w* and specific force *fc* at the IMU centre.
 
@@ -229,7 +229,7 @@ def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
         y[3 + i] = val
 
 
-@inline_jit
+@jit
 def quantise(y, output_range, step, inverse_step, full_scale):
     """Saturate at ± output range, then quantise to *step* (round half up), clipped at ± full scale.
 

@@ -22,13 +22,21 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
-from plansim._jit import jit, parallel_jit
-from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, quantise,
-                                      segment_geometry, sensor_outputs, trial_frames, unpack_truth)
+from plansim._jit import inline_jit, jit
+from plansim.simulate import physics
 from plansim.simulate.random import normal, seed_trial
+from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry,
+                                      trial_frames, unpack_truth)
+
+# The per-sample helpers, inlined at numba's IR level here only: called with many array arguments
+# once per sample, a real call would cost a reference-count round trip per argument. (The
+# segment-statistics path calls them a few times per segment and keeps the ordinary compiled
+# versions, which keeps its compilation short.)
+sensor_outputs = inline_jit(physics.sensor_outputs.py_func)
+quantise = inline_jit(physics.quantise.py_func)
+
 
 
 @jit
@@ -167,15 +175,18 @@ def simulate_trial(trial, key, draws,
         offset += n
 
 
-@parallel_jit
+@jit
 def simulate_chunk(first_trial, key, truth_nominal, truth_spread, error_kind, error_scale,
                    seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                    sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
                    means_out, truth_out):
-    """Trials ``first_trial … first_trial + len(means_out) − 1`` in parallel (one stream per trial)."""
+    """Trials ``first_trial … first_trial + len(means_out) − 1`` (one random stream per trial).
+
+    Serial and ``nogil``: the engine runs slices of a chunk on a thread pool.
+    """
     no_samples = np.empty((0, 6))
     n_seg = seg_n.shape[0]
-    for t in numba.prange(means_out.shape[0]):
+    for t in range(means_out.shape[0]):
         draws = np.empty(draws_length_jit(n_seg))
         draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
                         error_scale, n_seg, draws)

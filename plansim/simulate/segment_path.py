@@ -33,10 +33,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
-from plansim._jit import jit, parallel_jit
+from plansim._jit import jit
 from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, rotated_inputs,
                                       segment_geometry, sensor_outputs, trial_frames, unpack_truth)
 from plansim.simulate.random import normal, seed_trial
@@ -238,11 +237,15 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
                 means_out[s, c] += weights[j] * y[c]
 
 
-@parallel_jit
+@jit
 def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                      sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
-    """:func:`deterministic_means` for many draws vectors (n, D) -> (n, S, 6), in parallel."""
-    for t in numba.prange(draws.shape[0]):
+    """:func:`deterministic_means` for many draws vectors (n, D) -> (n, S, 6).
+
+    Serial on purpose: it serves the path check and the GUM sensitivities (few vectors), and a
+    parallel kernel would add seconds of compilation to every cold start.
+    """
+    for t in range(draws.shape[0]):
         deterministic_means(draws[t], seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                             sensor, S2, lever, t_ref, gravity, earth_enu, means_out[t])
 
@@ -416,14 +419,17 @@ def simulate_trial_statistics(trial, key, draws,
                 means_out[s, c] = mbar[c] + math.sqrt(max(vbar[c], 0.0) / n) * z_all[c]
 
 
-@parallel_jit
+@jit
 def simulate_chunk_statistics(first_trial, key, truth_nominal, truth_spread, error_kind,
                               error_scale, seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index,
                               seg_temp, sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness,
                               gravity, earth_enu, drift_coeffs, needed, means_out, truth_out):
-    """Trials ``first_trial …`` in parallel on the segment-statistics path (same systematic draws as the sample path)."""
+    """Trials ``first_trial …`` on the segment-statistics path (same systematic draws as the sample path).
+
+    Serial and ``nogil``: the engine runs slices of a chunk on a thread pool.
+    """
     n_seg = seg_n.shape[0]
-    for t in numba.prange(means_out.shape[0]):
+    for t in range(means_out.shape[0]):
         draws = np.empty(_draws_length(n_seg))
         draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
                         error_scale, n_seg, draws)
