@@ -116,7 +116,8 @@ def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed:
         "scenario": sc.name,
         "scenario_description": sc.description,
         "scenario_toml": tomli_w.dumps(sc.document),
-        "seed": int(seed),
+        # NetCDF-3 attributes hold 32-bit integers only: larger seeds are kept as text
+        "seed": int(seed) if int(seed) <= 2**31 - 1 else str(int(seed)),
         "trials": int(n),
         "simulation_path": "sample-level",
         "plansim_version": package_version(),

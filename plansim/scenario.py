@@ -246,6 +246,10 @@ class _Section:
                              f"allowed: {', '.join(sorted(self.used | set(subtables)))}")
 
 
+def _missing(where: str, what: str):
+    raise ValueError(f"{where} is required: {what}")
+
+
 def _nonneg(value: float, where: str) -> float:
     if value < 0:
         raise ValueError(f"{where} = {value!r}: an error limit or uncertainty must be >= 0")
@@ -290,10 +294,11 @@ def _parse_schedule(document: dict) -> Schedule:
                 label=seg.string("label", f"segment {i}"),
                 test=seg.string("test", "multi_position"),
                 group=seg.integer("group", 0),
-                up=seg.string("up", "+z"),
+                up=seg.string("up", None) if "up" in raw else _missing(f"schedule.segments[{i}].up",
+                                                                        "the body axis pointing up, e.g. '+z'"),
                 heading=seg.quantity("heading", "angle", "0 deg"),
                 rate=seg.quantity("rate", "angular_rate", "0 deg/s"),
-                rate_axis=seg.string("rate_axis", "+z"),
+                rate_axis=seg.string("rate_axis", "+x"),
                 dwell=seg.quantity("dwell", "time", "30 s"),
                 settle=seg.quantity("settle", "time", "10 s"),
                 sample_rate=seg.quantity("sample_rate", "frequency", "100 Hz"),
@@ -485,7 +490,8 @@ def load_scenario(name_or_path: str | os.PathLike = "jjf2003") -> Scenario:
 
 
 def schedule_to_document(schedule: Schedule) -> dict:
-    """The ``[schedule]`` table of a custom schedule listing every segment (user units)."""
+    """The ``[schedule]`` table of a custom schedule listing every segment, in SI units written with
+    ``repr`` (rad, rad/s, s, Hz, degC) so that saving and loading round-trips exactly."""
     segments = []
     for s in schedule.segments:
         segments.append({

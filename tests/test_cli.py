@@ -99,3 +99,24 @@ def test_the_installed_console_script_runs():
     done = subprocess.run([sys.executable, "-m", "plansim.cli", "run", "--help"], capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0 and "--trials" in done.stdout
+
+
+def test_a_seed_beyond_32_bits_is_written_to_netcdf(capsys, tmp_path):
+    out = tmp_path / "r.nc"
+    code, _, err = run_cli(capsys, "run", "ideal", "--trials", "2", "--seed", str(2**40 + 3), "--out", str(out),
+                           "--quiet")
+    assert code == 0, err
+    with xr.open_dataset(out, engine="scipy") as ds:
+        assert int(ds.attrs["seed"]) == 2**40 + 3
+
+
+def test_a_custom_segment_without_up_is_an_error_naming_it(tmp_path):
+    import tomllib
+
+    from plansim.scenario import builtin_scenarios, parse_scenario
+
+    with open(builtin_scenarios()["ideal"], "rb") as fh:
+        doc = tomllib.load(fh)
+    doc["schedule"] = {"procedure": "custom", "segments": [{"label": "p", "test": "multi_position", "group": 1}]}
+    with pytest.raises(ValueError, match=r"schedule\.segments\[0\]\.up is required"):
+        parse_scenario(doc)

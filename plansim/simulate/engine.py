@@ -30,7 +30,7 @@ def _gauss_markov_allan_peak() -> float:
     """Peak of the Allan deviation of a unit-variance first-order Gauss–Markov process.
 
     σ_A²(τ)/σ² = (2/x)·[1 − (3 − 4e^{−x} + e^{−2x})/(2x)], x = τ/T_c (e.g. IEEE Std 952 Annex C);
-    the peak is ≈ 0.6185 at x ≈ 1.89.
+    the peak is ≈ 0.6174 at x ≈ 1.893.
     """
     def minus(x):
         return -(2.0 / x) * (1.0 - (3.0 - 4.0 * math.exp(-x) + math.exp(-2.0 * x)) / (2.0 * x))
