@@ -151,33 +151,50 @@ def drift_coefficient_table(scenario: Scenario) -> np.ndarray:
     return out
 
 
+def output_bound(scenario: Scenario) -> np.ndarray:
+    """A conservative bound on |noise-free output| per channel (gx…az, SI) over the whole schedule.
+
+    Every coefficient is taken at |nominal| + 6 × its unit-to-unit spread and every input at its
+    largest magnitude: rate r = max |table rate| + Ω_ie, specific force f = g + r²·|lever arm|,
+    temperature offset the largest |T − T_ref|. Plain NumPy (no kernel to compile).
+    """
+    from plansim.model.parameters import unpack
+
+    e = scenario.effects
+    m = unpack(np.abs(scenario.truth_nominal) + 6 * np.abs(scenario.truth_spread))
+    segments = scenario.schedule.segments
+    r = max(abs(s.rate) for s in segments) + float(np.linalg.norm(scenario.environment.earth_rate_vector))
+    dT = max(abs(s.temperature - e.reference_temperature) for s in segments)
+    g = scenario.environment.gravity
+    f = g + r * r * np.linalg.norm(e.accel_lever_arm, axis=1).max()
+    kg_diag = np.diag(m["Kg"])
+    gyro = (m["Kg"].sum(1) * r + m["Bg"] + np.abs(e.gyro_bias_temperature_coefficient) * dT + m["G"].sum(1) * f
+            + np.abs(e.gyro_g2_sensitivity).sum(1) * f * f + kg_diag * np.abs(e.gyro_scale_temperature_coefficient) * dT * r
+            + np.abs(e.gyro_nonlinearity_quadratic) * r**2 + np.abs(e.gyro_nonlinearity_cubic) * r**3
+            + 0.5 * np.abs(e.gyro_asymmetry) * kg_diag * r)
+    ka_diag = np.diag(m["Ka"])
+    accel = (m["Ka"].sum(1) * f + m["Ba"] + np.abs(e.accel_bias_temperature_coefficient) * dT + m["P"].sum(1) * r * r
+             + ka_diag * np.abs(e.accel_scale_temperature_coefficient) * dT * f + np.abs(e.accel_second_order) * f * f)
+    return np.concatenate([gyro, accel])
+
+
 def segment_path_exactness(scenario: Scenario) -> list[str]:
     """Reasons the segment-statistics path would not be exact for *scenario* (empty list: it is).
 
     Checks, each stated in :mod:`plansim.simulate.segment_path`: no gyro asymmetry; no
-    saturation (every output's bound — nominal maximum plus 6σ of noise and drift plus 6× the
-    unit-to-unit spread times the largest input — inside the output range and the acquisition full
-    scale); for quantised channels that the noise does not dither, drift small against the noise
-    (≤ 0.1σ) so that its variation within a segment does not move the quantiser.
+    saturation (:func:`output_bound` plus 6σ of white noise and drift inside the output range and
+    the acquisition full scale); for quantised channels that the noise does not dither, drift small
+    against the noise (≤ 0.1σ) so that its variation within a segment does not move the quantiser.
     """
     reasons = []
     e, n, a = scenario.effects, scenario.noise, scenario.acquisition
     if np.any(e.gyro_asymmetry != 0):
         reasons.append("gyro asymmetry is on: |ω| is not a polynomial in the table angle")
-    args = kernel_arguments(scenario)
-    draws = nominal_draws(scenario)
-    means = noise_free_segment_means(scenario, draws[None, :])[0]
-    noise = args["noise"]
-    rates = np.abs([s.rate for s in scenario.schedule.segments])
-    max_rate = float(rates.max()) if rates.size else 0.0
-    g = scenario.environment.gravity
-    spread = unpack_spread(scenario.truth_spread)
+    noise = kernel_arguments(scenario)["noise"]
     sample_dt = min(1.0 / s.sample_rate for s in scenario.schedule.segments)
     white = noise[:, 0] / math.sqrt(sample_dt)
     drift_sigma = np.sqrt(noise[:, 1] ** 2 + noise[:, 3] ** 2 + noise[:, 2] ** 2 * scenario.schedule.duration)
-    spread_bound = np.concatenate([spread["Kg"].sum(1) * max_rate + spread["Bg"] + spread["G"].sum(1) * g,
-                                   spread["Ka"].sum(1) * g + spread["Ba"] + spread["P"].sum(1) * max_rate**2])
-    bound = np.abs(means).max(axis=0) + 6 * (white + drift_sigma) + 6 * spread_bound
+    bound = output_bound(scenario) + 6 * (white + drift_sigma)
     limits = np.array([e.gyro_output_range] * 3 + [e.accel_output_range] * 3)
     if a.bits:
         limits = np.minimum(limits, [a.gyro_full_scale] * 3 + [a.accel_full_scale] * 3)
@@ -192,12 +209,6 @@ def segment_path_exactness(scenario: Scenario) -> list[str]:
             reasons.append(f"channel {CHANNELS[c]}: drift σ {drift_sigma[c]:.3g} > 0.1 × white σ {white[c]:.3g} "
                            "in a quantiser the noise does not dither")
     return reasons
-
-
-def unpack_spread(spread: np.ndarray) -> dict[str, np.ndarray]:
-    from plansim.model.parameters import unpack
-
-    return unpack(np.abs(spread))
 
 
 def choose_path(scenario: Scenario, path: str = "auto") -> tuple[str, list[str]]:

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from plansim._jit import jit
+from plansim._jit import inline_jit, jit
 from plansim.simulate.random import draw_error, normal, seed_trial, uniform
 
 N_TRUTH = 39
@@ -246,3 +246,24 @@ def quantise(y, output_range, step, inverse_step, full_scale):
         elif y < -full_scale:
             y = -full_scale
     return y
+
+
+# The same functions inlined at numba's IR level, for the loops that call them per sample or per
+# node: a real call passes each array argument with a reference-count round trip, which costs more
+# than the arithmetic. Inlined only inside those loops, to keep compilation short.
+rotated_inputs_inline = inline_jit(rotated_inputs.py_func)
+sensor_outputs_inline = inline_jit(sensor_outputs.py_func)
+quantise_inline = inline_jit(quantise.py_func)
+
+
+@jit
+def evaluate_outputs(count, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, out):
+    """Noise-free outputs ``out[j]`` (6) at table angle ``thetas[j]`` and rate ``rates[j]``, j < count."""
+    w = np.empty(3)
+    fc = np.empty(3)
+    y = np.empty(6)
+    for j in range(count):
+        rotated_inputs_inline(thetas[j], rates[j], u, g_b0, om_b0, w, fc)
+        sensor_outputs_inline(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+        for c in range(6):
+            out[j, c] = y[c]

@@ -24,18 +24,12 @@ import math
 
 import numpy as np
 
-from plansim._jit import inline_jit, jit
-from plansim.simulate import physics
+from plansim._jit import jit
 from plansim.simulate.random import normal, seed_trial
-from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry,
-                                      trial_frames, unpack_truth)
-
-# The per-sample helpers, inlined at numba's IR level here only: called with many array arguments
-# once per sample, a real call would cost a reference-count round trip per argument. (The
-# segment-statistics path calls them a few times per segment and keeps the ordinary compiled
-# versions, which keeps its compilation short.)
-sensor_outputs = inline_jit(physics.sensor_outputs.py_func)
-quantise = inline_jit(physics.quantise.py_func)
+from plansim.simulate.physics import N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry
+from plansim.simulate.physics import quantise_inline as quantise
+from plansim.simulate.physics import sensor_outputs_inline as sensor_outputs
+from plansim.simulate.physics import trial_frames, unpack_truth
 
 
 

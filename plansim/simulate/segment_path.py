@@ -36,8 +36,8 @@ import math
 import numpy as np
 
 from plansim._jit import jit
-from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, rotated_inputs,
-                                      segment_geometry, sensor_outputs, trial_frames, unpack_truth)
+from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, evaluate_outputs,
+                                      segment_geometry, trial_frames, unpack_truth)
 from plansim.simulate.random import normal, seed_trial
 from plansim.simulate.sample_path import advance_drift, initial_drift
 
@@ -192,12 +192,6 @@ def _harmonics_needed(spread, sigma, step, gammas, kmax, tolerance):
 
 
 @jit
-def _node_outputs(theta, rate, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y):
-    rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc)
-    sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
-
-
-@jit
 def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                         sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
     """Exact noise-free segment means (S, 6) of one trial's draws: the average over the samples."""
@@ -212,9 +206,9 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
     g_b0 = np.empty(3)
     om_b0 = np.empty(3)
     perp = np.empty((3, 3))
-    w = np.empty(3)
-    fc = np.empty(3)
-    y = np.empty(6)
+    thetas = np.empty(DETERMINISTIC_NODES)
+    rates = np.empty(DETERMINISTIC_NODES)
+    nodes = np.empty((DETERMINISTIC_NODES, 6))
     weights = np.empty(DETERMINISTIC_NODES)
     work = np.empty((6, 3, 3))
     trial_frames(draws, work)
@@ -223,18 +217,22 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
         dT = seg_temp[s] - t_ref
         if seg_rate[s] == 0.0:
-            _node_outputs(0.0, 0.0, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+            thetas[0] = 0.0
+            rates[0] = 0.0
+            evaluate_outputs(1, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for c in range(6):
-                means_out[s, c] = y[c]
+                means_out[s, c] = nodes[0, c]
             continue
         arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
+        for j in range(DETERMINISTIC_NODES):
+            thetas[j] = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
+            rates[j] = rate_act
+        evaluate_outputs(DETERMINISTIC_NODES, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor,
+                         S2, nodes)
         for c in range(6):
             means_out[s, c] = 0.0
-        for j in range(DETERMINISTIC_NODES):
-            theta = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
-            _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
-            for c in range(6):
-                means_out[s, c] += weights[j] * y[c]
+            for j in range(DETERMINISTIC_NODES):
+                means_out[s, c] += weights[j] * nodes[j, c]
 
 
 @jit
@@ -290,16 +288,15 @@ def simulate_trial_statistics(trial, key, draws,
     g_b0 = np.empty(3)
     om_b0 = np.empty(3)
     perp = np.empty((3, 3))
-    w = np.empty(3)
-    fc = np.empty(3)
     y = np.empty(6)
-    y2 = np.empty(6)
     det = np.empty(6)
     spread = np.empty(6)
     jitter = np.empty(6)
     dbar = np.empty(6)
     w7 = np.empty(DETERMINISTIC_NODES)
-    nodes = np.empty((DETERMINISTIC_NODES, 6))
+    nodes = np.empty((MAX_NODES + 2, 6))
+    thetas = np.empty(MAX_NODES + 2)
+    rates = np.empty(MAX_NODES + 2)
     wj = np.empty(MAX_NODES)
     work = np.empty((6, 3, 3))
     trial_frames(draws, work)
@@ -323,14 +320,21 @@ def simulate_trial_statistics(trial, key, draws,
         # deterministic segment mean (exact) and the output's variation over θ
         if rotating:
             arc_weights(DETERMINISTIC_NODES, rate_act * dt, n, w7)
+            # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
+            h = 1e-6 * abs(rate_act)
+            for j in range(DETERMINISTIC_NODES):
+                thetas[j] = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
+                rates[j] = rate_act
+            thetas[DETERMINISTIC_NODES] = phase
+            rates[DETERMINISTIC_NODES] = rate_act + h
+            thetas[DETERMINISTIC_NODES + 1] = phase
+            rates[DETERMINISTIC_NODES + 1] = rate_act - h
+            evaluate_outputs(DETERMINISTIC_NODES + 2, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
+                             sensor, S2, nodes)
             for c in range(6):
                 det[c] = 0.0
-            for j in range(DETERMINISTIC_NODES):
-                theta = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
-                _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
-                for c in range(6):
-                    nodes[j, c] = y[c]
-                    det[c] += w7[j] * y[c]
+                for j in range(DETERMINISTIC_NODES):
+                    det[c] += w7[j] * nodes[j, c]
             for c in range(6):
                 lo = nodes[0, c]
                 hi = nodes[0, c]
@@ -338,17 +342,17 @@ def simulate_trial_statistics(trial, key, draws,
                     lo = min(lo, nodes[j, c])
                     hi = max(hi, nodes[j, c])
                 spread[c] = hi - lo
-            # rate jitter: linear response of each output to the table rate (central difference)
-            h = 1e-6 * abs(rate_act)
-            _node_outputs(phase, rate_act + h, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
-            _node_outputs(phase, rate_act - h, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y2)
+            # rate jitter: linear response of each output to the table rate (central difference);
+            # the sample path jitters the gyro input w (so also P·w²), not the centripetal term
             for c in range(6):
-                # the sample path jitters the gyro input w (so also P·w²), not the centripetal term
-                jitter[c] = smoothness * rate_act * (y[c] - y2[c]) / (2.0 * h)
+                jitter[c] = (smoothness * rate_act * (nodes[DETERMINISTIC_NODES, c] - nodes[DETERMINISTIC_NODES + 1, c])
+                             / (2.0 * h))
         else:
-            _node_outputs(0.0, 0.0, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, w, fc, y)
+            thetas[0] = 0.0
+            rates[0] = 0.0
+            evaluate_outputs(1, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for c in range(6):
-                det[c] = y[c]
+                det[c] = nodes[0, c]
                 spread[c] = 0.0
                 jitter[c] = 0.0
         zbar = normal(state) / math.sqrt(n) if (rotating and smoothness > 0.0) else 0.0
@@ -386,20 +390,20 @@ def simulate_trial_statistics(trial, key, draws,
             for c in range(6):
                 mbar[c] = 0.0
                 vbar[c] = 0.0
+            if J != DETERMINISTIC_NODES:  # else the nodes of the deterministic mean serve
+                for j in range(J):
+                    thetas[j] = phase + 2.0 * math.pi * j / J
+                    rates[j] = rate_act
+                evaluate_outputs(J, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for j in range(J):
-                if J == DETERMINISTIC_NODES:  # the nodes of the deterministic mean: reuse them
-                    for c in range(6):
-                        y[c] = nodes[j, c]
-                else:
-                    theta = phase + 2.0 * math.pi * j / J
-                    _node_outputs(theta, rate_act, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
-                                  w, fc, y)
+                for c in range(6):
+                    y[c] = nodes[j, c]
                 for c in range(6):
                     if mode[c] == 3:
                         step = acquisition[2] if c < 3 else acquisition[3]
                         if kmax_all[c] > 0:
                             m, v = moments_from_damping(y[c] + dbar[c], sigma_all[c], step, gammas_all[c],
-                                                        kmax_all[c])
+                                                         kmax_all[c])
                         else:
                             m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_all[c], step)
                         mbar[c] += wj[j] * m
