@@ -4,15 +4,47 @@
 off so that results do not depend on the instruction set or reassociation; ``nogil`` lets the
 engine run kernels on several threads side by side (slices of trials; see
 :func:`plansim.simulate.engine.iterate_chunks`), which compiles far faster than ``parallel=True``.
+
+Numba's cache checks the source file of each cached function, not of the functions it calls in
+other files, so an edited kernel helper could be served stale. The cache therefore lives in a
+folder named after a hash of every kernel source file (and the numba version), unless the user
+chose one with ``NUMBA_CACHE_DIR``.
 """
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
 
 import numba
 
 JIT_OPTIONS = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+
+
+def _kernel_cache_dir() -> Path | None:
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return None
+    here = Path(__file__).resolve().parent
+    sources = [Path(__file__).resolve(), *sorted((here / "simulate").glob("*.py"))]
+    digest = hashlib.sha256(numba.__version__.encode())
+    for path in sources:
+        digest.update(path.read_bytes())
+    root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    folder = root / "plansim" / f"numba-{digest.hexdigest()[:16]}"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:  # no writable home: numba's default (__pycache__ beside the sources)
+        return None
+    return folder
+
+
+_folder = _kernel_cache_dir()
+if _folder is not None:
+    numba.config.CACHE_DIR = str(_folder)
 
 jit = numba.njit(**JIT_OPTIONS)
 
 #: for small helpers called per sample with array arguments: inlined at numba's IR level, so the
 #: call does not pay a reference-count round trip per array argument
 inline_jit = numba.njit(inline="always", **JIT_OPTIONS)
-
