@@ -154,6 +154,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="small sizes (seconds): checks the method, not the speed")
     p.add_argument("--threads", type=int, default=None, help="pin the kernel thread count (default: all cores)")
     p.set_defaults(func=_cmd_bench)
+    from plansim.uncertainty.validate import add_validate_command
+    add_validate_command(sub)
     return parser
 
 

@@ -102,8 +102,14 @@ def small_rotation(phi0, phi1, phi2, out):
 
 
 @jit
-def unpack_truth(p, Kg, Bg, G, Ka, Ba, P):
-    """Flat parameter vector (order of plansim.model.parameters) -> matrices."""
+def unpack_truth(p):
+    """Flat parameter vector (order of plansim.model.parameters) -> new arrays ``Kg, Bg, G, Ka, Ba, P``."""
+    Kg = np.empty((3, 3))
+    G = np.empty((3, 3))
+    Ka = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Bg = np.empty(3)
+    Ba = np.empty(3)
     for i in range(3):
         for j in range(3):
             Kg[i, j] = p[3 * i + j]
@@ -118,6 +124,7 @@ def unpack_truth(p, Kg, Bg, G, Ka, Ba, P):
     P[1, 2] = p[36]
     P[2, 0] = p[37]
     P[2, 1] = p[38]
+    return Kg, Bg, G, Ka, Ba, P
 
 
 @jit

@@ -195,13 +195,7 @@ def _harmonics_needed(spread, sigma, step, gammas, kmax, tolerance):
 def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                         sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
     """Exact noise-free segment means (S, 6) of one trial's draws: the average over the samples."""
-    Kg = np.empty((3, 3))
-    G = np.empty((3, 3))
-    Ka = np.empty((3, 3))
-    P = np.empty((3, 3))
-    Bg = np.empty(3)
-    Ba = np.empty(3)
-    unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
+    Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     u = np.empty(3)
     g_b0 = np.empty(3)
     om_b0 = np.empty(3)
@@ -276,13 +270,7 @@ def simulate_trial_statistics(trial, key, draws,
     """One calibration on the segment-statistics path; segment means into ``means_out`` (S, 6)."""
     state = np.empty(4, np.uint64)
     seed_trial(key, trial, STREAM_NOISE, state)
-    Kg = np.empty((3, 3))
-    G = np.empty((3, 3))
-    Ka = np.empty((3, 3))
-    P = np.empty((3, 3))
-    Bg = np.empty(3)
-    Ba = np.empty(3)
-    unpack_truth(draws[:N_TRUTH], Kg, Bg, G, Ka, Ba, P)
+    Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     drift = initial_drift(noise, state)
     u = np.empty(3)
     g_b0 = np.empty(3)
