@@ -197,8 +197,12 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
 @jit
 def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
     """Gyro input *w* and specific force *fc* at table angle θ with table rate *rate* (Rodrigues, angle −θ)."""
-    ct = math.cos(theta)
-    st = math.sin(theta)
+    rotated_inputs_cs(math.cos(theta), math.sin(theta), rate, u, g_b0, om_b0, w, fc)
+
+
+@jit
+def rotated_inputs_cs(ct, st, rate, u, g_b0, om_b0, w, fc):
+    """:func:`rotated_inputs` given cos θ and sin θ."""
     ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
     uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
     fc[0] = g_b0[0] * ct - (u[1] * g_b0[2] - u[2] * g_b0[1]) * st + u[0] * ug * (1.0 - ct)
@@ -258,19 +262,29 @@ def quantise(y, output_range, step, inverse_step, full_scale):
 # The same functions inlined at numba's IR level, for the loops that call them per sample or per
 # node: a real call passes each array argument with a reference-count round trip, which costs more
 # than the arithmetic. Inlined only inside those loops, to keep compilation short.
-rotated_inputs_inline = inline_jit(rotated_inputs.py_func)
+rotated_inputs_cs_inline = inline_jit(rotated_inputs_cs.py_func)
 sensor_outputs_inline = inline_jit(sensor_outputs.py_func)
 quantise_inline = inline_jit(quantise.py_func)
 
 
 @jit
-def evaluate_outputs(count, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, out):
-    """Noise-free outputs ``out[j]`` (6) at table angle ``thetas[j]`` and rate ``rates[j]``, j < count."""
+def evaluate_outputs(count, phase, nodes, extra, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
+                     out):
+    """Noise-free outputs ``out[j]`` (6) at table angles θ_j = phase + 2πj/nodes (j < nodes) and, for
+    j ≥ nodes (``extra`` more rows), at θ = phase; table rate ``rates[j]``. Angles by angle addition."""
     w = np.empty(3)
     fc = np.empty(3)
     y = np.empty(6)
-    for j in range(count):
-        rotated_inputs_inline(thetas[j], rates[j], u, g_b0, om_b0, w, fc)
+    c0 = math.cos(phase)
+    s0 = math.sin(phase)
+    cd = math.cos(2.0 * math.pi / nodes)
+    sd = math.sin(2.0 * math.pi / nodes)
+    ct, st = c0, s0
+    for j in range(count + extra):
+        if j >= count:
+            ct, st = c0, s0
+        rotated_inputs_cs_inline(ct, st, rates[j], u, g_b0, om_b0, w, fc)
         sensor_outputs_inline(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
         for c in range(6):
             out[j, c] = y[c]
+        ct, st = ct * cd - st * sd, st * cd + ct * sd

@@ -48,6 +48,10 @@ QUANTISER_WINDOW = 8.0  # thresholds within ±8σ (Φ(−8) ≈ 6e-16)
 RELATIVE_TOLERANCE = 1e-3
 
 
+_COS7 = np.cos(2.0 * np.pi * np.arange(7) / 7)
+_SIN7 = np.sin(2.0 * np.pi * np.arange(7) / 7)
+
+
 @jit
 def arc_weights(J, delta, n, weights):
     """Weights with ``(1/n) Σ_{k<n} f(θ0 + kΔ) = Σ_{j<J} W_j f(θ0 + 2πj/J)`` for trigonometric
@@ -56,11 +60,18 @@ def arc_weights(J, delta, n, weights):
         W_j = (1/J)·[1 + 2 Re Σ_{m=1..M} D_m e^{−i m 2πj/J}],  D_m = (1/n) Σ_k e^{i m k Δ}
             = (1 − e^{i m n Δ}) / (n (1 − e^{i m Δ})).
 
-    Powers by recurrence and the twiddles from one table: no trigonometric call inside the loops.
+    Powers by recurrence and the twiddles e^{−i2πk/J} from a table (a constant one for J = 7):
+    no allocation, and no trigonometric call inside the loops.
     """
     M = (J - 1) // 2
-    d_re = np.empty(M + 1)
-    d_im = np.empty(M + 1)
+    if J == 7:
+        cos_table = _COS7
+        sin_table = _SIN7
+    else:
+        cos_table = np.cos(2.0 * np.pi * np.arange(J) / J)
+        sin_table = np.sin(2.0 * np.pi * np.arange(J) / J)
+    for j in range(J):
+        weights[j] = 1.0 / J
     c1, s1 = math.cos(delta), math.sin(delta)
     cn, sn = math.cos(n * delta), math.sin(n * delta)
     a_re, a_im = 1.0, 0.0  # e^{i m Δ}
@@ -72,40 +83,39 @@ def arc_weights(J, delta, n, weights):
         den_im = -a_im
         den2 = den_re * den_re + den_im * den_im
         if den2 < 1e-24:  # e^{imΔ} = 1: every sample at the same phase
-            d_re[m], d_im[m] = 1.0, 0.0
+            d_re, d_im = 1.0, 0.0
         else:
             num_re = 1.0 - b_re
             num_im = -b_im
-            d_re[m] = (num_re * den_re + num_im * den_im) / (n * den2)
-            d_im[m] = (num_im * den_re - num_re * den_im) / (n * den2)
-    cos_table = np.empty(J)
-    sin_table = np.empty(J)
-    for k in range(J):
-        cos_table[k] = math.cos(2.0 * math.pi * k / J)
-        sin_table[k] = math.sin(2.0 * math.pi * k / J)
-    for j in range(J):
-        acc = 0.0
-        for m in range(1, M + 1):
+            d_re = (num_re * den_re + num_im * den_im) / (n * den2)
+            d_im = (num_im * den_re - num_re * den_im) / (n * den2)
+        for j in range(J):
             k = (m * j) % J
-            acc += d_re[m] * cos_table[k] + d_im[m] * sin_table[k]  # Re(D_m e^{−i m φ_j})
-        weights[j] = (1.0 + 2.0 * acc) / J
+            weights[j] += 2.0 / J * (d_re * cos_table[k] + d_im * sin_table[k])  # Re(D_m e^{−i m φ_j})
 
 
 @jit
-def fourier_damping(sigma, step, gammas):
-    """γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16 (into *gammas*); returns the count, 0 if σ < 0.2q."""
+def fourier_damping(sigma, step, coefficients):
+    """Series coefficients of :func:`quantised_gaussian_moments` for σ ≥ 0.2q into *coefficients* (3, K):
+    row 0: (−1)^{k+1} q/(πk) γ_k, row 1: (−1)^k q²/(π²k²) γ_k, row 2: (−1)^{k+1} γ_k, with
+    γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16. Returns the count, 0 if σ < 0.2q."""
     if sigma < 0.2 * step:
         return 0
     r = sigma / step
-    kmax = min(int(math.ceil(1.366 / r)), gammas.shape[0])
+    kmax = min(int(math.ceil(1.366 / r)), coefficients.shape[1])
+    sign = 1.0
     for k in range(1, kmax + 1):
-        gammas[k - 1] = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
+        g = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
+        coefficients[0, k - 1] = sign * step / (math.pi * k) * g
+        coefficients[1, k - 1] = -sign * step * step / (math.pi * math.pi * k * k) * g
+        coefficients[2, k - 1] = sign * g
+        sign = -sign
     return kmax
 
 
 @jit
-def moments_from_damping(mu, sigma, step, gammas, kmax):
-    """The Fourier branch of :func:`quantised_gaussian_moments` with γ_k given (σ ≥ 0.2q)."""
+def moments_from_damping(mu, sigma, step, coefficients, kmax):
+    """The Fourier branch of :func:`quantised_gaussian_moments` with the coefficients of :func:`fourier_damping`."""
     a1 = 2.0 * math.pi * mu / step
     a1 = a1 - 2.0 * math.pi * math.floor(a1 / (2.0 * math.pi))  # only μ mod q matters
     c1 = math.cos(a1)
@@ -114,16 +124,11 @@ def moments_from_damping(mu, sigma, step, gammas, kmax):
     e1 = 0.0
     e2 = step * step / 12.0
     cov = 0.0
-    sign = 1.0
-    for k in range(1, kmax + 1):
-        g = gammas[k - 1]
-        e1 += sign * step / (math.pi * k) * g * sk
-        e2 -= sign * step * step / (math.pi * math.pi * k * k) * g * ck
-        cov += sign * g * ck
-        c_next = ck * c1 - sk * s1
-        sk = sk * c1 + ck * s1
-        ck = c_next
-        sign = -sign
+    for k in range(kmax):
+        e1 += coefficients[0, k] * sk
+        e2 += coefficients[1, k] * ck
+        cov += coefficients[2, k] * ck
+        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
     cov *= 2.0 * sigma * sigma
     return mu - e1, max(sigma * sigma + e2 - e1 * e1 - 2.0 * cov, 0.0)
 
@@ -143,9 +148,9 @@ def quantised_gaussian_moments(mu, sigma, step):
     below that, by summing the threshold-crossing probabilities within ±8σ.
     """
     if sigma >= 0.2 * step:
-        gammas = np.empty(8)
-        kmax = fourier_damping(sigma, step, gammas)
-        return moments_from_damping(mu, sigma, step, gammas, kmax)
+        coefficients = np.empty((3, 8))
+        kmax = fourier_damping(sigma, step, coefficients)
+        return moments_from_damping(mu, sigma, step, coefficients, kmax)
     if sigma <= 0.0:
         return step * math.floor(mu / step + 0.5), 0.0
     low = math.floor((mu - QUANTISER_WINDOW * sigma) / step + 0.5)
@@ -165,7 +170,7 @@ def quantised_gaussian_moments(mu, sigma, step):
 
 
 @jit
-def _harmonics_needed(spread, sigma, step, gammas, kmax, tolerance):
+def _harmonics_needed(spread, sigma, step, coefficients, kmax, tolerance):
     """Half the number of θ nodes for averaging a quantiser's moments while its input sweeps *spread*.
 
     The output's deterministic part has degree ≤ 3 in θ. In the Fourier regime (σ ≥ 0.2q) the
@@ -182,7 +187,7 @@ def _harmonics_needed(spread, sigma, step, gammas, kmax, tolerance):
         bound = 0.0
         for k in range(1, kmax + 1):
             x = math.pi * k * spread / step
-            term = step / (math.pi * k) * gammas[k - 1]
+            term = abs(coefficients[0, k - 1])  # A_k = q/(πk)·γ_k
             for j in range(1, M + 2):
                 term *= x / j
             bound += term
@@ -200,7 +205,6 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
     g_b0 = np.empty(3)
     om_b0 = np.empty(3)
     perp = np.empty((3, 3))
-    thetas = np.empty(DETERMINISTIC_NODES)
     rates = np.empty(DETERMINISTIC_NODES)
     nodes = np.empty((DETERMINISTIC_NODES, 6))
     weights = np.empty(DETERMINISTIC_NODES)
@@ -211,18 +215,16 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
         dT = seg_temp[s] - t_ref
         if seg_rate[s] == 0.0:
-            thetas[0] = 0.0
             rates[0] = 0.0
-            evaluate_outputs(1, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
+            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for c in range(6):
                 means_out[s, c] = nodes[0, c]
             continue
         arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
         for j in range(DETERMINISTIC_NODES):
-            thetas[j] = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
             rates[j] = rate_act
-        evaluate_outputs(DETERMINISTIC_NODES, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor,
-                         S2, nodes)
+        evaluate_outputs(DETERMINISTIC_NODES, phase, DETERMINISTIC_NODES, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg,
+                         G, Ka, Ba, P, sensor, S2, nodes)
         for c in range(6):
             means_out[s, c] = 0.0
             for j in range(DETERMINISTIC_NODES):
@@ -283,7 +285,6 @@ def simulate_trial_statistics(trial, key, draws,
     dbar = np.empty(6)
     w7 = np.empty(DETERMINISTIC_NODES)
     nodes = np.empty((MAX_NODES + 2, 6))
-    thetas = np.empty(MAX_NODES + 2)
     rates = np.empty(MAX_NODES + 2)
     wj = np.empty(MAX_NODES)
     work = np.empty((6, 3, 3))
@@ -294,7 +295,7 @@ def simulate_trial_statistics(trial, key, draws,
     mbar = np.empty(6)
     vbar = np.empty(6)
     mode = np.empty(6, np.int64)
-    gammas_all = np.empty((6, 8))
+    gammas_all = np.empty((6, 3, 8))
     kmax_all = np.zeros(6, np.int64)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
@@ -311,14 +312,11 @@ def simulate_trial_statistics(trial, key, draws,
             # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
             h = 1e-6 * abs(rate_act)
             for j in range(DETERMINISTIC_NODES):
-                thetas[j] = phase + 2.0 * math.pi * j / DETERMINISTIC_NODES
                 rates[j] = rate_act
-            thetas[DETERMINISTIC_NODES] = phase
             rates[DETERMINISTIC_NODES] = rate_act + h
-            thetas[DETERMINISTIC_NODES + 1] = phase
             rates[DETERMINISTIC_NODES + 1] = rate_act - h
-            evaluate_outputs(DETERMINISTIC_NODES + 2, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
-                             sensor, S2, nodes)
+            evaluate_outputs(DETERMINISTIC_NODES, phase, DETERMINISTIC_NODES, 2, rates, u, g_b0, om_b0, perp, dT, Kg,
+                             Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for c in range(6):
                 det[c] = 0.0
                 for j in range(DETERMINISTIC_NODES):
@@ -336,9 +334,8 @@ def simulate_trial_statistics(trial, key, draws,
                 jitter[c] = (smoothness * rate_act * (nodes[DETERMINISTIC_NODES, c] - nodes[DETERMINISTIC_NODES + 1, c])
                              / (2.0 * h))
         else:
-            thetas[0] = 0.0
             rates[0] = 0.0
-            evaluate_outputs(1, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
+            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for c in range(6):
                 det[c] = nodes[0, c]
                 spread[c] = 0.0
@@ -360,7 +357,7 @@ def simulate_trial_statistics(trial, key, draws,
             # bias of the quantised mean: Σ_k q/(πk) γ_k (the first term when γ_1 is small)
             bias_amplitude = 0.0
             for k in range(kmax_all[c]):
-                bias_amplitude += step / (math.pi * (k + 1)) * gammas_all[c, k]
+                bias_amplitude += abs(gammas_all[c, 0, k])  # q/(πk)·γ_k
             if kmax_all[c] > 0 and bias_amplitude <= tolerance:
                 mode[c] = 1
             elif spread[c] == 0.0:
@@ -380,9 +377,8 @@ def simulate_trial_statistics(trial, key, draws,
                 vbar[c] = 0.0
             if J != DETERMINISTIC_NODES:  # else the nodes of the deterministic mean serve
                 for j in range(J):
-                    thetas[j] = phase + 2.0 * math.pi * j / J
                     rates[j] = rate_act
-                evaluate_outputs(J, thetas, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
+                evaluate_outputs(J, phase, J, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
             for j in range(J):
                 for c in range(6):
                     y[c] = nodes[j, c]

@@ -1,6 +1,10 @@
-"""Measurement uncertainty: the published JJF 2003-2022 Appendix A budgets and their check by Monte Carlo.
+"""Measurement uncertainty: the published JJF 2003-2022 Appendix A budgets, GUM budgets derived from
+the schedule, and their check by Monte Carlo.
 
-See :mod:`plansim.uncertainty.appendix_a`.
+- :mod:`plansim.uncertainty.appendix_a` — the five printed budgets as data, compared with the simulation;
+- :mod:`plansim.uncertainty.gum` — law of propagation of uncertainty through the actual estimators (JCGM 100);
+- :mod:`plansim.uncertainty.mcm` — adaptive Monte Carlo, coverage intervals, GUM validation (JCGM 101/102);
+- :mod:`plansim.uncertainty.validate` — ``plansim validate``: a stated budget against all of the above.
 """
 
 from plansim.uncertainty.appendix_a import (
