@@ -93,8 +93,18 @@ def simulate_trial(trial, key, draws,
     white = np.empty(6)
     work = np.empty((6, 3, 3))
     trial_frames(draws, work)
-    inverse_gyro_step = 1.0 / acquisition[2] if acquisition[2] > 0.0 else 0.0
-    inverse_accel_step = 1.0 / acquisition[3] if acquisition[3] > 0.0 else 0.0
+    # per-channel saturation and quantiser (1/step precomputed: a multiplication per sample)
+    out_range = np.empty(6)
+    step = np.empty(6)
+    inverse_step = np.empty(6)
+    full_scale = np.empty(6)
+    level = np.empty(6)  # total drift of each channel, held between drift updates
+    for c in range(6):
+        sensor_kind = 0 if c < 3 else 1
+        out_range[c] = acquisition[sensor_kind]
+        step[c] = acquisition[2 + sensor_kind]
+        inverse_step[c] = 1.0 / step[c] if step[c] > 0.0 else 0.0
+        full_scale[c] = acquisition[4 + sensor_kind]
     offset = 0
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
@@ -127,6 +137,8 @@ def simulate_trial(trial, key, draws,
         co0 = u[1] * om_b0[2] - u[2] * om_b0[1]
         co1 = u[2] * om_b0[0] - u[0] * om_b0[2]
         co2 = u[0] * om_b0[1] - u[1] * om_b0[0]
+        for c in range(6):
+            level[c] = drift[0, c] + drift[1, c] + drift[2, c]
         for k in range(n):
             if rotating:
                 # Rodrigues with angle −θ: v cosθ − (u×v) sinθ + u (u·v)(1 − cosθ)
@@ -144,18 +156,17 @@ def simulate_trial(trial, key, draws,
                 st = st * cd + ct * sd
                 ct = c_next
             for c in range(6):
-                val = y[c] + drift[0, c] + drift[1, c] + drift[2, c]
+                val = y[c] + level[c]
                 if white[c] > 0.0:
                     val += white[c] * normal(state)
-                if c < 3:
-                    val = quantise(val, acquisition[0], acquisition[2], inverse_gyro_step, acquisition[4])
-                else:
-                    val = quantise(val, acquisition[1], acquisition[3], inverse_accel_step, acquisition[5])
+                val = quantise(val, out_range[c], step[c], inverse_step[c], full_scale[c])
                 acc[c] += val
                 if record:
                     samples_out[offset + k, c] = val
             if (k + 1) % hold == 0 and k + 1 < n:
                 advance_drift(hold * dt, drift, noise, noise_times, state)
+                for c in range(6):
+                    level[c] = drift[0, c] + drift[1, c] + drift[2, c]
         tail = n % hold  # to the end of the recording: the last (partial) hold interval
         advance_drift((tail if tail else hold) * dt, drift, noise, noise_times, state)
         for c in range(6):
