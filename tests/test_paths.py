@@ -18,7 +18,6 @@ variance at n = 240), so a passing test is not a blind one.
 
 from __future__ import annotations
 
-import copy
 import math
 import tomllib
 

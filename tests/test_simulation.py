@@ -12,7 +12,7 @@ import pytest
 
 import plansim
 from plansim.model.environment import EARTH_RATE
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
+from plansim.model.parameters import PARAMETER_NAMES
 from plansim.scenario import builtin_scenarios, parse_scenario
 from plansim.simulate.engine import simulate_recording, simulate_segment_means
 

@@ -187,7 +187,7 @@ def segment_path_exactness(scenario: Scenario) -> list[str]:
     against the noise (≤ 0.1σ) so that its variation within a segment does not move the quantiser.
     """
     reasons = []
-    e, n, a = scenario.effects, scenario.noise, scenario.acquisition
+    e, a = scenario.effects, scenario.acquisition
     if np.any(e.gyro_asymmetry != 0):
         reasons.append("gyro asymmetry is on: |ω| is not a polynomial in the table angle")
     noise = kernel_arguments(scenario)["noise"]

@@ -138,6 +138,15 @@ def _matmul3(a, b, out):
 
 
 @jit
+def geometry_buffers(draws):
+    """Buffers for :func:`segment_geometry` — ``u, g_b0, om_b0, perp, work`` — with the trial's
+    frames already in ``work`` (:func:`trial_frames`)."""
+    work = np.empty((6, 3, 3))
+    trial_frames(draws, work)
+    return np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3)), work
+
+
+@jit
 def trial_frames(draws, work):
     """Per-trial rotations into ``work[0]`` (fixture: MIMU case in the fixture, C_fb) and
     ``work[1]`` (platform tilt about East and North); call once before :func:`segment_geometry`."""

@@ -29,7 +29,7 @@ from plansim.simulate.random import normal, seed_trial
 from plansim.simulate.physics import N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry
 from plansim.simulate.physics import quantise_inline as quantise
 from plansim.simulate.physics import sensor_outputs_inline as sensor_outputs
-from plansim.simulate.physics import trial_frames, unpack_truth
+from plansim.simulate.physics import geometry_buffers, unpack_truth
 
 
 
@@ -70,6 +70,14 @@ def initial_drift(noise, state):
 
 
 @jit
+def noise_stream(key, trial, noise):
+    """The trial's noise stream (stream 1) and its drift states at the start of the test."""
+    state = np.empty(4, np.uint64)
+    seed_trial(key, trial, STREAM_NOISE, state)
+    return state, initial_drift(noise, state)
+
+
+@jit
 def simulate_trial(trial, key, draws,
                    seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                    sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
@@ -78,21 +86,14 @@ def simulate_trial(trial, key, draws,
 
     If *record*, every raw sample is also written to ``samples_out`` (total samples, 6).
     """
-    state = np.empty(4, np.uint64)
-    seed_trial(key, trial, STREAM_NOISE, state)
+    state, drift = noise_stream(key, trial, noise)
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    drift = initial_drift(noise, state)
-    u = np.empty(3)
-    g_b0 = np.empty(3)
-    om_b0 = np.empty(3)
-    perp = np.empty((3, 3))
+    u, g_b0, om_b0, perp, work = geometry_buffers(draws)
     w = np.empty(3)
     fc = np.empty(3)
     y = np.empty(6)
     acc = np.empty(6)
     white = np.empty(6)
-    work = np.empty((6, 3, 3))
-    trial_frames(draws, work)
     # per-channel saturation and quantiser (1/step precomputed: a multiplication per sample)
     out_range = np.empty(6)
     step = np.empty(6)

@@ -36,10 +36,10 @@ import math
 import numpy as np
 
 from plansim._jit import jit
-from plansim.simulate.physics import (N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, evaluate_outputs,
-                                      segment_geometry, trial_frames, unpack_truth)
-from plansim.simulate.random import normal, seed_trial
-from plansim.simulate.sample_path import advance_drift, initial_drift
+from plansim.simulate.physics import (N_TRUTH, draw_systematic, draws_length, evaluate_outputs,
+                                      geometry_buffers, segment_geometry, unpack_truth)
+from plansim.simulate.random import normal
+from plansim.simulate.sample_path import advance_drift, noise_stream
 
 DETERMINISTIC_NODES = 7  # degree ≤ 3 in θ -> 2·3 + 1 nodes
 MAX_NODES = 401
@@ -201,15 +201,10 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
                         sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
     """Exact noise-free segment means (S, 6) of one trial's draws: the average over the samples."""
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    u = np.empty(3)
-    g_b0 = np.empty(3)
-    om_b0 = np.empty(3)
-    perp = np.empty((3, 3))
+    u, g_b0, om_b0, perp, work = geometry_buffers(draws)
     rates = np.empty(DETERMINISTIC_NODES)
     nodes = np.empty((DETERMINISTIC_NODES, 6))
     weights = np.empty(DETERMINISTIC_NODES)
-    work = np.empty((6, 3, 3))
-    trial_frames(draws, work)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
@@ -270,14 +265,9 @@ def simulate_trial_statistics(trial, key, draws,
                               sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity,
                               earth_enu, drift_coeffs, needed, means_out):
     """One calibration on the segment-statistics path; segment means into ``means_out`` (S, 6)."""
-    state = np.empty(4, np.uint64)
-    seed_trial(key, trial, STREAM_NOISE, state)
+    state, drift = noise_stream(key, trial, noise)
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    drift = initial_drift(noise, state)
-    u = np.empty(3)
-    g_b0 = np.empty(3)
-    om_b0 = np.empty(3)
-    perp = np.empty((3, 3))
+    u, g_b0, om_b0, perp, work = geometry_buffers(draws)
     y = np.empty(6)
     det = np.empty(6)
     spread = np.empty(6)
@@ -287,8 +277,6 @@ def simulate_trial_statistics(trial, key, draws,
     nodes = np.empty((MAX_NODES + 2, 6))
     rates = np.empty(MAX_NODES + 2)
     wj = np.empty(MAX_NODES)
-    work = np.empty((6, 3, 3))
-    trial_frames(draws, work)
     z_all = np.empty(6)
     white_all = np.empty(6)
     sigma_all = np.empty(6)
