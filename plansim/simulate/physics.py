@@ -278,12 +278,13 @@ quantise_inline = inline_jit(quantise.py_func)
 
 @jit
 def evaluate_outputs(count, phase, nodes, extra, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
-                     out):
+                     out, scratch):
     """Noise-free outputs ``out[j]`` (6) at table angles θ_j = phase + 2πj/nodes (j < nodes) and, for
-    j ≥ nodes (``extra`` more rows), at θ = phase; table rate ``rates[j]``. Angles by angle addition."""
-    w = np.empty(3)
-    fc = np.empty(3)
-    y = np.empty(6)
+    j ≥ nodes (``extra`` more rows), at θ = phase; table rate ``rates[j]``. Angles by angle addition.
+    ``scratch`` (3, 6) is work space (allocated once per trial by the caller)."""
+    w = scratch[0, :3]
+    fc = scratch[1, :3]
+    y = scratch[2]
     c0 = math.cos(phase)
     s0 = math.sin(phase)
     cd = math.cos(2.0 * math.pi / nodes)

@@ -203,6 +203,7 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     u, g_b0, om_b0, perp, work = geometry_buffers(draws)
     rates = np.empty(DETERMINISTIC_NODES)
+    scratch = np.empty((3, 6))
     nodes = np.empty((DETERMINISTIC_NODES, 6))
     weights = np.empty(DETERMINISTIC_NODES)
     for s in range(seg_n.shape[0]):
@@ -211,7 +212,7 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
         dT = seg_temp[s] - t_ref
         if seg_rate[s] == 0.0:
             rates[0] = 0.0
-            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
+            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for c in range(6):
                 means_out[s, c] = nodes[0, c]
             continue
@@ -219,7 +220,7 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
         for j in range(DETERMINISTIC_NODES):
             rates[j] = rate_act
         evaluate_outputs(DETERMINISTIC_NODES, phase, DETERMINISTIC_NODES, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg,
-                         G, Ka, Ba, P, sensor, S2, nodes)
+                         G, Ka, Ba, P, sensor, S2, nodes, scratch)
         for c in range(6):
             means_out[s, c] = 0.0
             for j in range(DETERMINISTIC_NODES):
@@ -276,6 +277,7 @@ def simulate_trial_statistics(trial, key, draws,
     w7 = np.empty(DETERMINISTIC_NODES)
     nodes = np.empty((MAX_NODES + 2, 6))
     rates = np.empty(MAX_NODES + 2)
+    scratch = np.empty((3, 6))
     wj = np.empty(MAX_NODES)
     z_all = np.empty(6)
     white_all = np.empty(6)
@@ -304,7 +306,7 @@ def simulate_trial_statistics(trial, key, draws,
             rates[DETERMINISTIC_NODES] = rate_act + h
             rates[DETERMINISTIC_NODES + 1] = rate_act - h
             evaluate_outputs(DETERMINISTIC_NODES, phase, DETERMINISTIC_NODES, 2, rates, u, g_b0, om_b0, perp, dT, Kg,
-                             Bg, G, Ka, Ba, P, sensor, S2, nodes)
+                             Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for c in range(6):
                 det[c] = 0.0
                 for j in range(DETERMINISTIC_NODES):
@@ -323,7 +325,7 @@ def simulate_trial_statistics(trial, key, draws,
                              / (2.0 * h))
         else:
             rates[0] = 0.0
-            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
+            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for c in range(6):
                 det[c] = nodes[0, c]
                 spread[c] = 0.0
@@ -366,7 +368,7 @@ def simulate_trial_statistics(trial, key, draws,
             if J != DETERMINISTIC_NODES:  # else the nodes of the deterministic mean serve
                 for j in range(J):
                     rates[j] = rate_act
-                evaluate_outputs(J, phase, J, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes)
+                evaluate_outputs(J, phase, J, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for j in range(J):
                 for c in range(6):
                     y[c] = nodes[j, c]
