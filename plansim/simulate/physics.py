@@ -203,15 +203,10 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     return rate_act, draws[base + 7]
 
 
-@jit
-def rotated_inputs(theta, rate, u, g_b0, om_b0, w, fc):
-    """Gyro input *w* and specific force *fc* at table angle θ with table rate *rate* (Rodrigues, angle −θ)."""
-    rotated_inputs_cs(math.cos(theta), math.sin(theta), rate, u, g_b0, om_b0, w, fc)
-
-
-@jit
-def rotated_inputs_cs(ct, st, rate, u, g_b0, om_b0, w, fc):
-    """:func:`rotated_inputs` given cos θ and sin θ."""
+@inline_jit
+def rotated_inputs(ct, st, rate, u, g_b0, om_b0, w, fc):
+    """Gyro input *w* and specific force *fc* at table angle θ (given cos θ, sin θ) with table rate
+    *rate*: Rodrigues with angle −θ, ``v cosθ − (u×v) sinθ + u (u·v)(1 − cosθ)``."""
     ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
     uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
     fc[0] = g_b0[0] * ct - (u[1] * g_b0[2] - u[2] * g_b0[1]) * st + u[0] * ug * (1.0 - ct)
@@ -222,7 +217,7 @@ def rotated_inputs_cs(ct, st, rate, u, g_b0, om_b0, w, fc):
     w[2] = rate * u[2] + om_b0[2] * ct - (u[0] * om_b0[1] - u[1] * om_b0[0]) * st + u[2] * uo * (1.0 - ct)
 
 
-@jit
+@inline_jit
 def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
     """Noise-free outputs (6) for gyro input *w* and specific force *fc* at the IMU centre.
 
@@ -249,7 +244,7 @@ def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
         y[3 + i] = val
 
 
-@jit
+@inline_jit
 def quantise(y, output_range, step, inverse_step, full_scale):
     """Saturate at ± output range, then quantise to *step* (round half up), clipped at ± full scale.
 
@@ -266,14 +261,6 @@ def quantise(y, output_range, step, inverse_step, full_scale):
         elif y < -full_scale:
             y = -full_scale
     return y
-
-
-# The same functions inlined at numba's IR level, for the loops that call them per sample or per
-# node: a real call passes each array argument with a reference-count round trip, which costs more
-# than the arithmetic. Inlined only inside those loops, to keep compilation short.
-rotated_inputs_cs_inline = inline_jit(rotated_inputs_cs.py_func)
-sensor_outputs_inline = inline_jit(sensor_outputs.py_func)
-quantise_inline = inline_jit(quantise.py_func)
 
 
 @jit
@@ -293,8 +280,8 @@ def evaluate_outputs(count, phase, nodes, extra, rates, u, g_b0, om_b0, perp, dT
     for j in range(count + extra):
         if j >= count:
             ct, st = c0, s0
-        rotated_inputs_cs_inline(ct, st, rates[j], u, g_b0, om_b0, w, fc)
-        sensor_outputs_inline(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+        rotated_inputs(ct, st, rates[j], u, g_b0, om_b0, w, fc)
+        sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
         for c in range(6):
             out[j, c] = y[c]
         ct, st = ct * cd - st * sd, st * cd + ct * sd

@@ -27,8 +27,7 @@ import numpy as np
 from plansim._jit import jit
 from plansim.simulate.random import normal, seed_trial
 from plansim.simulate.physics import N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry
-from plansim.simulate.physics import quantise_inline as quantise
-from plansim.simulate.physics import sensor_outputs_inline as sensor_outputs
+from plansim.simulate.physics import quantise, rotated_inputs, sensor_outputs
 from plansim.simulate.physics import geometry_buffers, unpack_truth
 
 
@@ -130,28 +129,14 @@ def simulate_trial(trial, key, draws,
         st = math.sin(phase)
         cd = math.cos(rate_act * dt)
         sd = math.sin(rate_act * dt)
-        ug = u[0] * g_b0[0] + u[1] * g_b0[1] + u[2] * g_b0[2]
-        uo = u[0] * om_b0[0] + u[1] * om_b0[1] + u[2] * om_b0[2]
-        cg0 = u[1] * g_b0[2] - u[2] * g_b0[1]
-        cg1 = u[2] * g_b0[0] - u[0] * g_b0[2]
-        cg2 = u[0] * g_b0[1] - u[1] * g_b0[0]
-        co0 = u[1] * om_b0[2] - u[2] * om_b0[1]
-        co1 = u[2] * om_b0[0] - u[0] * om_b0[2]
-        co2 = u[0] * om_b0[1] - u[1] * om_b0[0]
         for c in range(6):
             level[c] = drift[0, c] + drift[1, c] + drift[2, c]
         for k in range(n):
             if rotating:
-                # Rodrigues with angle −θ: v cosθ − (u×v) sinθ + u (u·v)(1 − cosθ)
-                fc[0] = g_b0[0] * ct - cg0 * st + u[0] * ug * (1.0 - ct)
-                fc[1] = g_b0[1] * ct - cg1 * st + u[1] * ug * (1.0 - ct)
-                fc[2] = g_b0[2] * ct - cg2 * st + u[2] * ug * (1.0 - ct)
                 rate_k = rate_act
                 if smoothness > 0.0:
                     rate_k = rate_act * (1.0 + smoothness * normal(state))
-                w[0] = rate_k * u[0] + om_b0[0] * ct - co0 * st + u[0] * uo * (1.0 - ct)
-                w[1] = rate_k * u[1] + om_b0[1] * ct - co1 * st + u[1] * uo * (1.0 - ct)
-                w[2] = rate_k * u[2] + om_b0[2] * ct - co2 * st + u[2] * uo * (1.0 - ct)
+                rotated_inputs(ct, st, rate_k, u, g_b0, om_b0, w, fc)
                 sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
                 c_next = ct * cd - st * sd
                 st = st * cd + ct * sd
