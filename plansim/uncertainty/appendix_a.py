@@ -330,6 +330,15 @@ def _acquisition_component(clause: str) -> UncertaintyComponent:
     )
 
 
+def _scale_factor_repeatability_component(clause: str) -> UncertaintyComponent:
+    """u3 of A.1 and A.4: the same printed type A value (A.1.2.3, A.4.2.3)."""
+    return UncertaintyComponent(
+        symbol="u3", source="measurement repeatability", clause=clause,
+        value_per_reading=1.22e-4, count=1, combination_as_printed="single", printed_value=1.22e-4,
+        derivation="from a large amount of experimental data on one MIMU type (type A)",
+    )
+
+
 #: The five budgets of JJF 2003-2022 Appendix A, as printed.
 APPENDIX_A: tuple[AppendixABudget, ...] = (
     AppendixABudget(
@@ -340,11 +349,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         components=(
             _table_component("A.1.2.1"),
             _acquisition_component("A.1.2.2"),
-            UncertaintyComponent(
-                symbol="u3", source="measurement repeatability", clause="A.1.2.3",
-                value_per_reading=1.22e-4, count=1, combination_as_printed="single", printed_value=1.22e-4,
-                derivation="from a large amount of experimental data on one MIMU type (type A)",
-            ),
+            _scale_factor_repeatability_component("A.1.2.3"),
         ),
         printed_combined_standard_uncertainty=2.12e-4,
         printed_expanded_uncertainty=4.3e-4,
@@ -403,11 +408,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         components=(
             _table_component("A.4.2.1"),
             _acquisition_component("A.4.2.2"),
-            UncertaintyComponent(
-                symbol="u3", source="measurement repeatability", clause="A.4.2.3",
-                value_per_reading=1.22e-4, count=1, combination_as_printed="single", printed_value=1.22e-4,
-                derivation="from a large amount of experimental data on one MIMU type (type A)",
-            ),
+            _scale_factor_repeatability_component("A.4.2.3"),
         ),
         printed_combined_standard_uncertainty=2.12e-4,
         printed_expanded_uncertainty=4.3e-4,

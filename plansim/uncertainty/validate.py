@@ -144,6 +144,14 @@ def _claim_number(raw, where: str) -> float:
     return value
 
 
+def _check_claim_entry(entry, where: str) -> None:
+    """A claim is a table with U (required) and k (optional)."""
+    if not isinstance(entry, Mapping):
+        raise TypeError(f"{where} must be a table with U (and k)")
+    if set(entry) - {"U", "k"} or "U" not in entry:
+        raise ValueError(f"{where}: keys {sorted(entry)}; expected U (required) and k (optional)")
+
+
 def _claim_k(entry: Mapping, where: str) -> float:
     k = entry.get("k", 2)
     if isinstance(k, bool) or not isinstance(k, (int, float)) or not (math.isfinite(k) and k > 0):
@@ -174,11 +182,7 @@ def parse_claims(document: Mapping, scenario: Scenario, source: str = "claims") 
         budget = appendix_a_budget(item) if item in {b.item for b in APPENDIX_A} else None
         if budget is None:
             raise ValueError(f"{where}: unknown Appendix A item; allowed: {', '.join(b.item for b in APPENDIX_A)}")
-        if not isinstance(entry, Mapping):
-            raise TypeError(f"{where} must be a table with U (and k)")
-        bad = set(entry) - {"U", "k"}
-        if bad or "U" not in entry:
-            raise ValueError(f"{where}: keys {sorted(entry)}; expected U (required) and k (optional)")
+        _check_claim_entry(entry, where)
         U = _claim_number(entry["U"], f"{where}.U")
         k = _claim_k(entry, where)
         for name in budget.parameters:
@@ -192,11 +196,7 @@ def parse_claims(document: Mapping, scenario: Scenario, source: str = "claims") 
         where = f"{source}: parameters.{name}"
         if name not in PARAMETER_INDEX:
             raise ValueError(f"{where}: unknown parameter; known: {', '.join(PARAMETER_NAMES)}")
-        if not isinstance(entry, Mapping):
-            raise TypeError(f"{where} must be a table with U (and k)")
-        bad = set(entry) - {"U", "k"}
-        if bad or "U" not in entry:
-            raise ValueError(f"{where}: keys {sorted(entry)}; expected U (required) and k (optional)")
+        _check_claim_entry(entry, where)
         U = parse_quantity(entry["U"], parameter(name).kind, f"{where}.U")
         if not (math.isfinite(U) and U > 0):
             raise ValueError(f"{where}.U = {entry['U']!r}: must be > 0")
