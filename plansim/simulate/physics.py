@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from plansim._jit import inline_jit, jit
-from plansim.simulate.random import draw_error, normal, seed_trial, uniform
+from plansim.simulate.random import draw_error, normal, seed_stream, uniform
 
 N_TRUTH = 39
 HEAD = 51
@@ -58,24 +58,25 @@ def draw_systematic(trial, key, truth_nominal, truth_spread, error_kind, error_s
     perpendicularity, platform tilt, fixture perpendicularity, rate error systematic, rate error
     per point (kind 0 = uniform ± scale, 1 = normal σ = scale).
     """
-    state = np.empty(4, np.uint64)
-    seed_trial(key, trial, STREAM_SYSTEMATIC, state)
+    stream = seed_stream(key, trial, STREAM_SYSTEMATIC)
     for k in range(N_TRUTH):
-        draws[k] = truth_nominal[k] + truth_spread[k] * normal(state)
+        z, stream = normal(stream)
+        draws[k] = truth_nominal[k] + truth_spread[k] * z
     for k in range(3):
-        draws[39 + k] = draw_error(state, error_kind[4], error_scale[4])
-    draws[42] = draw_error(state, error_kind[3], error_scale[3])
-    draws[43] = draw_error(state, error_kind[3], error_scale[3])
-    draws[44] = draw_error(state, error_kind[5], error_scale[5])
+        draws[39 + k], stream = draw_error(stream, error_kind[4], error_scale[4])
+    draws[42], stream = draw_error(stream, error_kind[3], error_scale[3])
+    draws[43], stream = draw_error(stream, error_kind[3], error_scale[3])
+    draws[44], stream = draw_error(stream, error_kind[5], error_scale[5])
     for k in range(6):
-        draws[45 + k] = draw_error(state, error_kind[2], error_scale[2])
+        draws[45 + k], stream = draw_error(stream, error_kind[2], error_scale[2])
     for s in range(n_segments):
         base = HEAD + PER_SEGMENT * s
         for axis in range(3):
-            draws[base + 2 * axis] = draw_error(state, error_kind[0], error_scale[0])
-            draws[base + 2 * axis + 1] = draw_error(state, error_kind[1], error_scale[1])
-        draws[base + 6] = draw_error(state, error_kind[6], error_scale[6])
-        draws[base + 7] = 2.0 * math.pi * uniform(state)
+            draws[base + 2 * axis], stream = draw_error(stream, error_kind[0], error_scale[0])
+            draws[base + 2 * axis + 1], stream = draw_error(stream, error_kind[1], error_scale[1])
+        draws[base + 6], stream = draw_error(stream, error_kind[6], error_scale[6])
+        phase, stream = uniform(stream)
+        draws[base + 7] = 2.0 * math.pi * phase
 
 
 @jit

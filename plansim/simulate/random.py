@@ -5,6 +5,11 @@ derived from ``(seed, trial index)`` alone (``numpy.random.SeedSequence`` gives 
 splitmix64 expands it per trial, as the xoshiro authors recommend for seeding). A trial draws its
 numbers in a fixed order, so trial *i* gives the same numbers in any chunk on any thread.
 
+A stream is a value, a tuple of four uint64 words, threaded through the kernels:
+``z, stream = normal(stream)``. Numba then keeps it in registers and inlines the draw; held in an
+array, it cost a memory round trip and a reference count per draw (5.8 ns against 2.2 ns a
+normal, measured on the machine of docs/performance.md).
+
 References
 ----------
 - D. Blackman, S. Vigna, "Scrambled linear pseudorandom number generators", ACM TOMS 47 (2021).
@@ -66,16 +71,23 @@ def _splitmix64(x):
 
 
 @jit
-def seed_trial(key, trial, stream, state):
-    """Fill *state* (4 × uint64) for trial number *trial* and sub-stream *stream* of root *key*."""
+def seed_stream(key, trial, stream):
+    """The random stream of trial number *trial*, sub-stream *stream*, of root *key*.
+
+    A stream is a tuple of four uint64 words (the xoshiro256** state), passed by value: every
+    draw takes a stream and returns ``(value, stream)``. As a value it lives in registers; as an
+    array it cost a memory round trip and a reference count per draw, 2.5× the draw itself.
+    """
     x = key[0] ^ _splitmix64(_U64(trial) ^ key[1])
     x = x ^ _splitmix64(_U64(stream) ^ key[2])
     x = x ^ key[3]
-    for j in range(4):
-        x = _splitmix64(x)
-        state[j] = x
-    if state[0] == 0 and state[1] == 0 and state[2] == 0 and state[3] == 0:
-        state[0] = _GOLDEN
+    s0 = _splitmix64(x)
+    s1 = _splitmix64(s0)
+    s2 = _splitmix64(s1)
+    s3 = _splitmix64(s2)
+    if s0 == 0 and s1 == 0 and s2 == 0 and s3 == 0:
+        s0 = _GOLDEN
+    return (s0, s1, s2, s3)
 
 
 @jit
@@ -84,69 +96,88 @@ def _rotl(x, k):
 
 
 @jit
-def next_u64(state):
-    """xoshiro256** step."""
-    result = _rotl(state[1] * _U64(5), 7) * _U64(9)
-    t = state[1] << _U64(17)
-    state[2] ^= state[0]
-    state[3] ^= state[1]
-    state[1] ^= state[2]
-    state[0] ^= state[3]
-    state[2] ^= t
-    state[3] = _rotl(state[3], 45)
-    return result
+def next_u64(stream):
+    """xoshiro256** step: ``(64 random bits, stream)``."""
+    s0, s1, s2, s3 = stream
+    result = _rotl(s1 * _U64(5), 7) * _U64(9)
+    t = s1 << _U64(17)
+    s2 ^= s0
+    s3 ^= s1
+    s1 ^= s2
+    s0 ^= s3
+    s2 ^= t
+    s3 = _rotl(s3, 45)
+    return result, (s0, s1, s2, s3)
 
 
 @jit
-def uniform(state):
-    """Uniform on [0, 1) with 53 random bits."""
+def uniform(stream):
+    """Uniform on [0, 1) with 53 random bits: ``(u, stream)``."""
+    r, stream = next_u64(stream)
     # via int64: LLVM's uint64 -> double conversion is several times slower
-    return np.int64(next_u64(state) >> _U64(11)) * _TO_UNIT
+    return np.int64(r >> _U64(11)) * _TO_UNIT, stream
 
 
 @jit
-def uniform_open(state):
-    """Uniform on (0, 1) (for logarithms)."""
-    return (np.int64(next_u64(state) >> _U64(11)) + 0.5) * _TO_UNIT
+def uniform_open(stream):
+    """Uniform on (0, 1) (for logarithms): ``(u, stream)``."""
+    r, stream = next_u64(stream)
+    return (np.int64(r >> _U64(11)) + 0.5) * _TO_UNIT, stream
 
 
 @jit
-def normal(state):
-    """Standard normal by the ZIGNOR ziggurat (one 64-bit draw ~97 % of the time).
-
-    The tables are module constants (numba freezes them into the code): passed as array
-    arguments they cost a reference-count round trip per call, several times the draw itself.
-    """
+def _normal_slow(u, i, stream):
+    """The ziggurat beyond its rectangles (about 1 draw in 80): the wedge test, the tail beyond R
+    (Marsaglia 1964), and new draws until one is accepted."""
     zig_x = ZIG_X
-    zig_ratio = ZIG_RATIO
     while True:
-        r = next_u64(state)
-        u = np.int64(r >> _U64(11)) * (2.0 * _TO_UNIT) - 1.0
-        i = np.int64(r & _U64(127))
-        if abs(u) < zig_ratio[i]:
-            return u * zig_x[i]
         if i == 0:
-            # tail beyond R (Marsaglia 1964)
             while True:
-                x = math.log(uniform_open(state)) / _ZIG_R
-                y = math.log(uniform_open(state))
+                a, stream = uniform_open(stream)
+                b, stream = uniform_open(stream)
+                x = math.log(a) / _ZIG_R
+                y = math.log(b)
                 if -2.0 * y >= x * x:
                     break
-            return x - _ZIG_R if u < 0.0 else _ZIG_R - x
+            return (x - _ZIG_R if u < 0.0 else _ZIG_R - x), stream
         x = u * zig_x[i]
         f0 = math.exp(-0.5 * (zig_x[i] * zig_x[i] - x * x))
         f1 = math.exp(-0.5 * (zig_x[i + 1] * zig_x[i + 1] - x * x))
-        if f1 + uniform(state) * (f0 - f1) < 1.0:
-            return x
+        a, stream = uniform(stream)
+        if f1 + a * (f0 - f1) < 1.0:
+            return x, stream
+        r, stream = next_u64(stream)
+        u = np.int64(r >> _U64(11)) * (2.0 * _TO_UNIT) - 1.0
+        i = np.int64(r & _U64(127))
+        if abs(u) < ZIG_RATIO[i]:
+            return u * zig_x[i], stream
 
 
 @jit
-def draw_error(state, kind, scale):
-    """One draw of a table or fixture error: ``kind`` 0 = uniform on ±scale, 1 = normal with σ = scale.
+def normal(stream):
+    """Standard normal by the ZIGNOR ziggurat: ``(z, stream)``; one 64-bit draw ~99 % of the time.
+
+    The fast path is small so that LLVM inlines it into the caller's loop; the rest is
+    :func:`_normal_slow`. The tables are module constants (numba freezes them into the code).
+    """
+    r, stream = next_u64(stream)
+    u = np.int64(r >> _U64(11)) * (2.0 * _TO_UNIT) - 1.0
+    i = np.int64(r & _U64(127))
+    if abs(u) < ZIG_RATIO[i]:
+        return u * ZIG_X[i], stream
+    return _normal_slow(u, i, stream)
+
+
+@jit
+def draw_error(stream, kind, scale):
+    """One draw of a table or fixture error: ``kind`` 0 = uniform on ±scale, 1 = normal with σ = scale;
+    returns ``(error, stream)``.
 
     A draw is always consumed, whatever the scale, so that switching one error on or off does
     not change the numbers any other error gets (common random numbers between scenarios).
     """
     if kind == 0:
-        return scale * (2.0 * uniform(state) - 1.0)
-    return scale * normal(state)
+        u, stream = uniform(stream)
+        return scale * (2.0 * u - 1.0), stream
+    z, stream = normal(stream)
+    return scale * z, stream

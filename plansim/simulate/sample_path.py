@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from plansim._jit import jit
-from plansim.simulate.random import normal, seed_trial
+from plansim.simulate.random import normal, seed_stream
 from plansim.simulate.physics import N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry
 from plansim.simulate.physics import quantise, rotated_inputs, sensor_outputs
 from plansim.simulate.physics import geometry_buffers, unpack_truth
@@ -33,47 +33,59 @@ from plansim.simulate.physics import geometry_buffers, unpack_truth
 
 
 @jit
-def _gauss_markov_step(x, phi, sigma, state):
-    """Exact first-order Gauss–Markov update over a step with φ = exp(−Δt/τ), stationary σ."""
-    return phi * x + sigma * math.sqrt(1.0 - phi * phi) * normal(state)
+def drift_transition(interval, noise, noise_times, transition):
+    """Exact update of the drift processes over *interval* s, as ``x ← carry·x + kick·z``.
 
-
-@jit
-def advance_drift(interval, drift, noise, noise_times, state):
-    """Exact update of the drift processes over *interval* s; ``drift`` (3, 6): GM bias instability,
-    GM drift, random walk per channel."""
-    if interval <= 0.0:
-        return
-    phi_bi = math.exp(-interval / noise_times[0])
-    phi_mk = math.exp(-interval / noise_times[1])
-    sq = math.sqrt(interval)
+    ``transition`` (2, 3, 6) receives ``carry`` and ``kick`` per process (GM bias instability,
+    GM drift, random walk) and channel: a first-order Gauss–Markov process with stationary σ and
+    correlation time τ has carry φ = exp(−Δt/τ) and kick σ√(1 − φ²); a random walk with
+    coefficient K has carry 1 and kick K√Δt. A process that is off has kick 0. Computed once per
+    interval length, so the per-sample loop pays no exp or sqrt.
+    """
+    phi_bi = math.exp(-interval / noise_times[0]) if interval > 0.0 else 1.0
+    phi_mk = math.exp(-interval / noise_times[1]) if interval > 0.0 else 1.0
+    root = math.sqrt(max(interval, 0.0))
     for c in range(6):
-        if noise[c, 1] > 0.0:
-            drift[0, c] = _gauss_markov_step(drift[0, c], phi_bi, noise[c, 1], state)
-        if noise[c, 3] > 0.0:
-            drift[1, c] = _gauss_markov_step(drift[1, c], phi_mk, noise[c, 3], state)
-        if noise[c, 2] > 0.0:
-            drift[2, c] += noise[c, 2] * sq * normal(state)
+        transition[0, 0, c] = phi_bi
+        transition[1, 0, c] = noise[c, 1] * math.sqrt(1.0 - phi_bi * phi_bi) if noise[c, 1] > 0.0 else 0.0
+        transition[0, 1, c] = phi_mk
+        transition[1, 1, c] = noise[c, 3] * math.sqrt(1.0 - phi_mk * phi_mk) if noise[c, 3] > 0.0 else 0.0
+        transition[0, 2, c] = 1.0
+        transition[1, 2, c] = noise[c, 2] * root if noise[c, 2] > 0.0 else 0.0
 
 
 @jit
-def initial_drift(noise, state):
-    """Drift states at the start of the test: Gauss–Markov processes stationary, random walks at 0."""
+def advance_drift(transition, drift, stream):
+    """Advance the drift states ``drift`` (3, 6) by one :func:`drift_transition`; returns the stream."""
+    for c in range(6):
+        for p in range(3):
+            if transition[1, p, c] > 0.0:
+                z, stream = normal(stream)
+                drift[p, c] = transition[0, p, c] * drift[p, c] + transition[1, p, c] * z
+    return stream
+
+
+@jit
+def initial_drift(noise, stream):
+    """Drift states at the start of the test, Gauss–Markov processes stationary and random walks
+    at 0: ``(drift (3, 6), stream)``."""
     drift = np.zeros((3, 6))
     for c in range(6):
         if noise[c, 1] > 0.0:
-            drift[0, c] = noise[c, 1] * normal(state)
+            z, stream = normal(stream)
+            drift[0, c] = noise[c, 1] * z
         if noise[c, 3] > 0.0:
-            drift[1, c] = noise[c, 3] * normal(state)
-    return drift
+            z, stream = normal(stream)
+            drift[1, c] = noise[c, 3] * z
+    return drift, stream
 
 
 @jit
 def noise_stream(key, trial, noise):
-    """The trial's noise stream (stream 1) and its drift states at the start of the test."""
-    state = np.empty(4, np.uint64)
-    seed_trial(key, trial, STREAM_NOISE, state)
-    return state, initial_drift(noise, state)
+    """The trial's noise stream (stream 1) and its drift states at the start of the test:
+    ``(stream, drift)``."""
+    drift, stream = initial_drift(noise, seed_stream(key, trial, STREAM_NOISE))
+    return stream, drift
 
 
 @jit
@@ -85,9 +97,10 @@ def simulate_trial(trial, key, draws,
 
     If *record*, every raw sample is also written to ``samples_out`` (total samples, 6).
     """
-    state, drift = noise_stream(key, trial, noise)
+    stream, drift = noise_stream(key, trial, noise)
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     u, g_b0, om_b0, perp, work = geometry_buffers(draws)
+    transition = np.empty((2, 3, 6))
     w = np.empty(3)
     fc = np.empty(3)
     y = np.empty(6)
@@ -110,7 +123,8 @@ def simulate_trial(trial, key, draws,
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
         rotating = seg_rate[s] != 0.0
-        advance_drift(seg_gap[s], drift, noise, noise_times, state)  # settling
+        drift_transition(seg_gap[s], noise, noise_times, transition)  # settling
+        stream = advance_drift(transition, drift, stream)
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
         for c in range(6):
@@ -118,6 +132,7 @@ def simulate_trial(trial, key, draws,
             acc[c] = 0.0
         # drift processes are advanced every `hold` samples (exactly, over hold·dt) and held between
         hold = max(1, int(math.floor(noise_times[2] / dt + 0.5)))
+        drift_transition(hold * dt, noise, noise_times, transition)
         n = seg_n[s]
         if not rotating:  # at rest the deterministic part of every sample is the same
             for i in range(3):
@@ -129,32 +144,35 @@ def simulate_trial(trial, key, draws,
         st = math.sin(phase)
         cd = math.cos(rate_act * dt)
         sd = math.sin(rate_act * dt)
-        for c in range(6):
-            level[c] = drift[0, c] + drift[1, c] + drift[2, c]
-        for k in range(n):
-            if rotating:
-                rate_k = rate_act
-                if smoothness > 0.0:
-                    rate_k = rate_act * (1.0 + smoothness * normal(state))
-                rotated_inputs(ct, st, rate_k, u, g_b0, om_b0, w, fc)
-                sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
-                c_next = ct * cd - st * sd
-                st = st * cd + ct * sd
-                ct = c_next
+        start = 0
+        while start < n:  # one hold interval of samples, then a drift update
+            stop = min(start + hold, n)
             for c in range(6):
-                val = y[c] + level[c]
-                if white[c] > 0.0:
-                    val += white[c] * normal(state)
-                val = quantise(val, out_range[c], step[c], inverse_step[c], full_scale[c])
-                acc[c] += val
-                if record:
-                    samples_out[offset + k, c] = val
-            if (k + 1) % hold == 0 and k + 1 < n:
-                advance_drift(hold * dt, drift, noise, noise_times, state)
+                level[c] = drift[0, c] + drift[1, c] + drift[2, c]
+            for k in range(start, stop):
+                if rotating:
+                    rate_k = rate_act
+                    if smoothness > 0.0:
+                        z, stream = normal(stream)
+                        rate_k = rate_act * (1.0 + smoothness * z)
+                    rotated_inputs(ct, st, rate_k, u, g_b0, om_b0, w, fc)
+                    sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+                    c_next = ct * cd - st * sd
+                    st = st * cd + ct * sd
+                    ct = c_next
                 for c in range(6):
-                    level[c] = drift[0, c] + drift[1, c] + drift[2, c]
-        tail = n % hold  # to the end of the recording: the last (partial) hold interval
-        advance_drift((tail if tail else hold) * dt, drift, noise, noise_times, state)
+                    val = y[c] + level[c]
+                    if white[c] > 0.0:
+                        z, stream = normal(stream)
+                        val += white[c] * z
+                    val = quantise(val, out_range[c], step[c], inverse_step[c], full_scale[c])
+                    acc[c] += val
+                    if record:
+                        samples_out[offset + k, c] = val
+            if stop - start < hold:  # to the end of the recording: the last, partial hold interval
+                drift_transition((stop - start) * dt, noise, noise_times, transition)
+            stream = advance_drift(transition, drift, stream)
+            start = stop
         for c in range(6):
             means_out[s, c] = acc[c] / n
         offset += n

@@ -39,7 +39,7 @@ from plansim._jit import jit
 from plansim.simulate.physics import (N_TRUTH, draw_systematic, draws_length, evaluate_outputs,
                                       geometry_buffers, segment_geometry, unpack_truth)
 from plansim.simulate.random import normal
-from plansim.simulate.sample_path import advance_drift, noise_stream
+from plansim.simulate.sample_path import advance_drift, drift_transition, noise_stream
 
 DETERMINISTIC_NODES = 7  # degree ≤ 3 in θ -> 2·3 + 1 nodes
 MAX_NODES = 401
@@ -241,8 +241,9 @@ def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_
 
 
 @jit
-def _segment_drift(drift, coeffs, noise, state, mean_out):
-    """Draw the segment-mean drift per channel and move the states to the end of the recording.
+def _segment_drift(drift, coeffs, noise, stream, mean_out):
+    """Draw the segment-mean drift per channel and move the states to the end of the recording;
+    returns the stream.
 
     ``coeffs`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
     coefficients a, c, L11, L21, L22 of mean = a·x0 + σ L11 z1, end = c·x0 + σ(L21 z1 + L22 z2).
@@ -253,20 +254,24 @@ def _segment_drift(drift, coeffs, noise, state, mean_out):
             sigma = noise[c, 1] if p == 0 else (noise[c, 3] if p == 1 else noise[c, 2])
             if sigma <= 0.0:
                 continue
-            z1 = normal(state)
-            z2 = normal(state)
+            z1, stream = normal(stream)
+            z2, stream = normal(stream)
             x0 = drift[p, c]
             mean_out[c] += coeffs[p, 0] * x0 + sigma * coeffs[p, 2] * z1
             drift[p, c] = coeffs[p, 1] * x0 + sigma * (coeffs[p, 3] * z1 + coeffs[p, 4] * z2)
+    return stream
 
 
 @jit
 def simulate_trial_statistics(trial, key, draws,
                               seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                               sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity,
-                              earth_enu, drift_coeffs, needed, means_out):
-    """One calibration on the segment-statistics path; segment means into ``means_out`` (S, 6)."""
-    state, drift = noise_stream(key, trial, noise)
+                              earth_enu, drift_coeffs, settling, needed, means_out):
+    """One calibration on the segment-statistics path; segment means into ``means_out`` (S, 6).
+
+    ``settling`` (S, 2, 3, 6): the drift transition over each segment's settling gap
+    (:func:`plansim.simulate.sample_path.drift_transition`), the same for every trial."""
+    stream, drift = noise_stream(key, trial, noise)
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     u, g_b0, om_b0, perp, work = geometry_buffers(draws)
     y = np.empty(6)
@@ -291,8 +296,8 @@ def simulate_trial_statistics(trial, key, draws,
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, work)
         rotating = seg_rate[s] != 0.0
-        advance_drift(seg_gap[s], drift, noise, noise_times, state)  # settling
-        _segment_drift(drift, drift_coeffs[s], noise, state, dbar)
+        stream = advance_drift(settling[s], drift, stream)
+        stream = _segment_drift(drift, drift_coeffs[s], noise, stream, dbar)
         n = seg_n[s]
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
@@ -330,12 +335,15 @@ def simulate_trial_statistics(trial, key, draws,
                 det[c] = nodes[0, c]
                 spread[c] = 0.0
                 jitter[c] = 0.0
-        zbar = normal(state) / math.sqrt(n) if (rotating and smoothness > 0.0) else 0.0
+        zbar = 0.0
+        if rotating and smoothness > 0.0:
+            zbar, stream = normal(stream)
+            zbar /= math.sqrt(n)
         # per channel: 0 linear (no quantiser, or no estimator uses it), 1 dithered, 2 quantised
         # with a constant mean, 3 quantised while the output sweeps across it (average over θ)
         J = 0
         for c in range(6):
-            z_all[c] = normal(state)
+            z_all[c], stream = normal(stream)
             white_all[c] = noise[c, 0] / math.sqrt(dt)
             step = acquisition[2] if c < 3 else acquisition[3]
             sigma_all[c] = math.sqrt(white_all[c] * white_all[c] + jitter[c] * jitter[c])
@@ -407,6 +415,9 @@ def simulate_chunk_statistics(first_trial, key, truth_nominal, truth_spread, err
     Serial and ``nogil``: the engine runs slices of a chunk on a thread pool.
     """
     n_seg = seg_n.shape[0]
+    settling = np.empty((n_seg, 2, 3, 6))
+    for s in range(n_seg):
+        drift_transition(seg_gap[s], noise, noise_times, settling[s])
     for t in range(means_out.shape[0]):
         draws = np.empty(_draws_length(n_seg))
         draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
@@ -416,7 +427,7 @@ def simulate_chunk_statistics(first_trial, key, truth_nominal, truth_spread, err
         simulate_trial_statistics(first_trial + t, key, draws, seg_n, seg_dt, seg_gap, seg_C0,
                                   seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
                                   acquisition, noise, noise_times, smoothness, gravity, earth_enu, drift_coeffs,
-                                  needed, means_out[t])
+                                  settling, needed, means_out[t])
 
 
 _draws_length = jit(draws_length)
