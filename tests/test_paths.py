@@ -29,7 +29,7 @@ import plansim
 from plansim.model.parameters import PARAMETER_NAMES
 from plansim.scenario import builtin_scenarios, parse_scenario
 from plansim.simulate.engine import choose_path, simulate_segment_means
-from plansim.simulate.segment_path import arc_weights, drift_coefficients, quantised_gaussian_moments
+from plansim.simulate.segment_path import arc_weights, drift_coefficients, quantised_gaussian_moments, sin_cos_turns
 
 Z = 5.0  # standard errors allowed; two-sided p ≈ 6e-7 per comparison (39 parameters × 3 scenarios)
 
@@ -165,6 +165,23 @@ def test_quantised_gaussian_moments_match_the_level_sums(sigma, mu):
     exact_mean = np.sum(levels * q * p)
     exact_var = np.sum((levels * q - exact_mean) ** 2 * p)
     assert abs(mean - exact_mean) < 1e-11 and abs(var - exact_var) < 1e-11
+
+
+def test_sin_cos_in_turns_matches_numpy_to_a_few_ulp():
+    """The quantiser phases use a polynomial sin/cos of 2πt; checked against numpy over many turns,
+    at the quarter-turn seams (where the reduction switches branch) and at exact quarters."""
+    rng = np.random.default_rng(7)
+    quarters = np.arange(-40, 41) / 4.0
+    seams = (np.arange(-40, 41) + 0.5) / 4.0
+    turns = np.concatenate([rng.uniform(-50.0, 50.0, 20_000), quarters, seams, seams + 1e-12, seams - 1e-12])
+    got = np.array([sin_cos_turns(t) for t in turns])
+    reference = 2.0 * np.pi * (turns - np.floor(turns))  # numpy's sin/cos on [0, 2π)
+    assert np.max(np.abs(got[:, 0] - np.sin(reference))) < 4e-15
+    assert np.max(np.abs(got[:, 1] - np.cos(reference))) < 4e-15
+    at_quarters = np.array([sin_cos_turns(t) for t in quarters])
+    k = np.arange(-40, 41) % 4  # exact at the quarter turns: (0, 1), (1, 0), (0, −1), (−1, 0)
+    assert np.array_equal(at_quarters[:, 0], np.array([0.0, 1.0, 0.0, -1.0])[k])
+    assert np.array_equal(at_quarters[:, 1], np.array([1.0, 0.0, -1.0, 0.0])[k])
 
 
 @pytest.mark.parametrize("tau", [None, 5.0, 100.0])

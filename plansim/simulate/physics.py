@@ -79,27 +79,31 @@ def draw_systematic(trial, key, truth_nominal, truth_spread, error_kind, error_s
         draws[base + 7] = 2.0 * math.pi * phase
 
 
-@jit
-def small_rotation(phi0, phi1, phi2, out):
-    """Exact rotation matrix of the rotation vector φ (Rodrigues), written into *out* (3×3)."""
+@inline_jit
+def small_rotation(phi0, phi1, phi2, frames, k):
+    """Exact rotation matrix of the rotation vector φ (Rodrigues), written into ``frames[k]`` (3×3).
+
+    Kernels index slabs of one ``frames`` array instead of taking views: in numba every view is
+    a reference-counted object, and an atomic count per view per segment cost 18 % of a trial.
+    """
     angle = math.sqrt(phi0 * phi0 + phi1 * phi1 + phi2 * phi2)
     for i in range(3):
         for j in range(3):
-            out[i, j] = 1.0 if i == j else 0.0
+            frames[k, i, j] = 1.0 if i == j else 0.0
     if angle == 0.0:
         return
     kx, ky, kz = phi0 / angle, phi1 / angle, phi2 / angle
     c, s = math.cos(angle), math.sin(angle)
     v = 1.0 - c
-    out[0, 0] = c + kx * kx * v
-    out[0, 1] = kx * ky * v - kz * s
-    out[0, 2] = kx * kz * v + ky * s
-    out[1, 0] = ky * kx * v + kz * s
-    out[1, 1] = c + ky * ky * v
-    out[1, 2] = ky * kz * v - kx * s
-    out[2, 0] = kz * kx * v - ky * s
-    out[2, 1] = kz * ky * v + kx * s
-    out[2, 2] = c + kz * kz * v
+    frames[k, 0, 0] = c + kx * kx * v
+    frames[k, 0, 1] = kx * ky * v - kz * s
+    frames[k, 0, 2] = kx * kz * v + ky * s
+    frames[k, 1, 0] = ky * kx * v + kz * s
+    frames[k, 1, 1] = c + ky * ky * v
+    frames[k, 1, 2] = ky * kz * v - kx * s
+    frames[k, 2, 0] = kz * kx * v - ky * s
+    frames[k, 2, 1] = kz * ky * v + kx * s
+    frames[k, 2, 2] = c + kz * kz * v
 
 
 @jit
@@ -128,74 +132,79 @@ def unpack_truth(p):
     return Kg, Bg, G, Ka, Ba, P
 
 
-@jit
-def _matmul3(a, b, out):
+@inline_jit
+def _matmul3(frames, a, b, out):
+    """``frames[out] = frames[a] · frames[b]`` (3×3 slabs of one array; see :func:`small_rotation`)."""
     for i in range(3):
         for j in range(3):
             acc = 0.0
             for k in range(3):
-                acc += a[i, k] * b[k, j]
-            out[i, j] = acc
+                acc += frames[a, i, k] * frames[b, k, j]
+            frames[out, i, j] = acc
+
+
+# slabs of the (6, 3, 3) ``frames`` array of :func:`geometry_buffers`
+_FIXTURE, _TILT, _POSITION_ERROR, _NOMINAL, _PRODUCT, _ACTUAL = 0, 1, 2, 3, 4, 5
 
 
 @jit
 def geometry_buffers(draws):
-    """Buffers for :func:`segment_geometry` — ``u, g_b0, om_b0, perp, work`` — with the trial's
-    frames already in ``work`` (:func:`trial_frames`)."""
-    work = np.empty((6, 3, 3))
-    trial_frames(draws, work)
-    return np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3)), work
+    """Buffers for :func:`segment_geometry` — ``u, g_b0, om_b0, perp, frames`` — with the trial's
+    frames already in ``frames`` (:func:`trial_frames`)."""
+    frames = np.empty((6, 3, 3))
+    trial_frames(draws, frames)
+    return np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3)), frames
 
 
 @jit
-def trial_frames(draws, work):
-    """Per-trial rotations into ``work[0]`` (fixture: MIMU case in the fixture, C_fb) and
-    ``work[1]`` (platform tilt about East and North); call once before :func:`segment_geometry`."""
-    small_rotation(draws[39], draws[40], draws[41], work[0])
-    small_rotation(draws[42], draws[43], 0.0, work[1])
+def trial_frames(draws, frames):
+    """Per-trial rotations into ``frames[0]`` (fixture: MIMU case in the fixture, C_fb) and
+    ``frames[1]`` (platform tilt about East and North); call once before :func:`segment_geometry`."""
+    small_rotation(draws[39], draws[40], draws[41], frames, _FIXTURE)
+    small_rotation(draws[42], draws[43], 0.0, frames, _TILT)
 
 
 @jit
 def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity, earth_enu, lever,
-                     g_b0, om_b0, u, perp, work):
+                     g_b0, om_b0, u, perp, frames):
     """Orientation of segment *s* under the trial's errors.
 
     Writes the body-frame gravity reaction ``g_b0`` and Earth rate ``om_b0`` at θ = 0, the table
     axis ``u`` (body frame, unit) and the centripetal term ``perp`` (3×3: row i for accelerometer
     i); returns ``(rate_act, phase)``: the actual table rate (rad/s) and start angle (rad).
-    ``work`` (6, 3, 3) holds the trial's frames (:func:`trial_frames`) in ``work[0:2]`` and is
+    ``frames`` (6, 3, 3) holds the trial's frames (:func:`trial_frames`) in ``frames[0:2]`` and is
     scratch space otherwise.
     """
-    fixture = work[0]
-    tilt = work[1]
-    pos_err = work[2]
-    tmp = work[3]
-    c_actual = work[4]
-    nominal = work[5]
     base = HEAD + PER_SEGMENT * s
     small_rotation(draws[base] + draws[base + 1], draws[base + 2] + draws[base + 3],
-                   draws[base + 4] + draws[base + 5], pos_err)
+                   draws[base + 4] + draws[base + 5], frames, _POSITION_ERROR)
     for i in range(3):
         for j in range(3):
-            nominal[i, j] = seg_C0[s, i, j]
-    _matmul3(pos_err, nominal, tmp)
-    _matmul3(tmp, fixture, c_actual)
-    _matmul3(tilt, c_actual, tmp)  # tmp = C_nb,actual
+            frames[_NOMINAL, i, j] = seg_C0[s, i, j]
+    _matmul3(frames, _POSITION_ERROR, _NOMINAL, _PRODUCT)
+    _matmul3(frames, _PRODUCT, _FIXTURE, _ACTUAL)
+    _matmul3(frames, _TILT, _ACTUAL, _PRODUCT)  # C_nb,actual
     for i in range(3):  # C_bn = C_nbᵀ: g_b0 = C_bn·(0, 0, g), Ω_b0 = C_bn·Ω_ie
-        g_b0[i] = tmp[2, i] * gravity
-        om_b0[i] = tmp[0, i] * earth_enu[0] + tmp[1, i] * earth_enu[1] + tmp[2, i] * earth_enu[2]
-    # table axis: nominal (a coordinate axis of the fixture) tilted by the perpendicularity error,
-    # expressed in the MIMU case frame (C_bf = C_fbᵀ)
+        g_b0[i] = frames[_PRODUCT, 2, i] * gravity
+        om_b0[i] = (frames[_PRODUCT, 0, i] * earth_enu[0] + frames[_PRODUCT, 1, i] * earth_enu[1]
+                    + frames[_PRODUCT, 2, i] * earth_enu[2])
+    # table axis: nominal (a coordinate axis of the fixture) tilted by the perpendicularity error
+    # about the two other axes, expressed in the MIMU case frame (C_bf = C_fbᵀ)
     a = seg_axis_index[s]
-    v = tmp[0]  # scratch row (tmp is free again)
+    v0, v1, v2 = seg_axis[s, 0], seg_axis[s, 1], seg_axis[s, 2]
+    first, second = draws[45 + 2 * a], draws[46 + 2 * a]
+    if abs(v0) > 0.5:
+        v1 += first
+        v2 += second
+    elif abs(v1) > 0.5:
+        v2 += first
+        v0 += second
+    else:
+        v0 += first
+        v1 += second
+    norm = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
     for i in range(3):
-        v[i] = seg_axis[s, i]
-    ia = 0 if abs(v[0]) > 0.5 else (1 if abs(v[1]) > 0.5 else 2)
-    v[(ia + 1) % 3] += draws[45 + 2 * a]
-    v[(ia + 2) % 3] += draws[46 + 2 * a]
-    norm = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-    for i in range(3):
-        u[i] = (fixture[0, i] * v[0] + fixture[1, i] * v[1] + fixture[2, i] * v[2]) / norm
+        u[i] = (frames[_FIXTURE, 0, i] * v0 + frames[_FIXTURE, 1, i] * v1 + frames[_FIXTURE, 2, i] * v2) / norm
     rate_act = seg_rate[s] * (1.0 + draws[44] + draws[base + 6])
     for i in range(3):  # centripetal acceleration of accelerometer i: −ω²(r_i − (r_i·u)u)
         ru = lever[i, 0] * u[0] + lever[i, 1] * u[1] + lever[i, 2] * u[2]

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from plansim._jit import jit
+from plansim._jit import inline_jit, jit
 from plansim.simulate.random import normal, seed_stream
 from plansim.simulate.physics import N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry
 from plansim.simulate.physics import quantise, rotated_inputs, sensor_outputs
@@ -33,10 +33,10 @@ from plansim.simulate.physics import geometry_buffers, unpack_truth
 
 
 @jit
-def drift_transition(interval, noise, noise_times, transition):
+def drift_transition(interval, noise, noise_times, transitions, k):
     """Exact update of the drift processes over *interval* s, as ``x ← carry·x + kick·z``.
 
-    ``transition`` (2, 3, 6) receives ``carry`` and ``kick`` per process (GM bias instability,
+    ``transitions[k]`` (2, 3, 6) receives ``carry`` and ``kick`` per process (GM bias instability,
     GM drift, random walk) and channel: a first-order Gauss–Markov process with stationary σ and
     correlation time τ has carry φ = exp(−Δt/τ) and kick σ√(1 − φ²); a random walk with
     coefficient K has carry 1 and kick K√Δt. A process that is off has kick 0. Computed once per
@@ -46,22 +46,23 @@ def drift_transition(interval, noise, noise_times, transition):
     phi_mk = math.exp(-interval / noise_times[1]) if interval > 0.0 else 1.0
     root = math.sqrt(max(interval, 0.0))
     for c in range(6):
-        transition[0, 0, c] = phi_bi
-        transition[1, 0, c] = noise[c, 1] * math.sqrt(1.0 - phi_bi * phi_bi) if noise[c, 1] > 0.0 else 0.0
-        transition[0, 1, c] = phi_mk
-        transition[1, 1, c] = noise[c, 3] * math.sqrt(1.0 - phi_mk * phi_mk) if noise[c, 3] > 0.0 else 0.0
-        transition[0, 2, c] = 1.0
-        transition[1, 2, c] = noise[c, 2] * root if noise[c, 2] > 0.0 else 0.0
+        transitions[k, 0, 0, c] = phi_bi
+        transitions[k, 1, 0, c] = noise[c, 1] * math.sqrt(1.0 - phi_bi * phi_bi) if noise[c, 1] > 0.0 else 0.0
+        transitions[k, 0, 1, c] = phi_mk
+        transitions[k, 1, 1, c] = noise[c, 3] * math.sqrt(1.0 - phi_mk * phi_mk) if noise[c, 3] > 0.0 else 0.0
+        transitions[k, 0, 2, c] = 1.0
+        transitions[k, 1, 2, c] = noise[c, 2] * root if noise[c, 2] > 0.0 else 0.0
 
 
-@jit
-def advance_drift(transition, drift, stream):
-    """Advance the drift states ``drift`` (3, 6) by one :func:`drift_transition`; returns the stream."""
+@inline_jit
+def advance_drift(transitions, k, drift, stream):
+    """Advance the drift states ``drift`` (3, 6) by the transition ``transitions[k]`` of
+    :func:`drift_transition`; returns the stream."""
     for c in range(6):
         for p in range(3):
-            if transition[1, p, c] > 0.0:
+            if transitions[k, 1, p, c] > 0.0:
                 z, stream = normal(stream)
-                drift[p, c] = transition[0, p, c] * drift[p, c] + transition[1, p, c] * z
+                drift[p, c] = transitions[k, 0, p, c] * drift[p, c] + transitions[k, 1, p, c] * z
     return stream
 
 
@@ -99,8 +100,8 @@ def simulate_trial(trial, key, draws,
     """
     stream, drift = noise_stream(key, trial, noise)
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    u, g_b0, om_b0, perp, work = geometry_buffers(draws)
-    transition = np.empty((2, 3, 6))
+    u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
+    transition = np.empty((1, 2, 3, 6))  # one transition at a time
     w = np.empty(3)
     fc = np.empty(3)
     y = np.empty(6)
@@ -121,10 +122,10 @@ def simulate_trial(trial, key, draws,
     offset = 0
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                           earth_enu, lever, g_b0, om_b0, u, perp, work)
+                                           earth_enu, lever, g_b0, om_b0, u, perp, frames)
         rotating = seg_rate[s] != 0.0
-        drift_transition(seg_gap[s], noise, noise_times, transition)  # settling
-        stream = advance_drift(transition, drift, stream)
+        drift_transition(seg_gap[s], noise, noise_times, transition, 0)  # settling
+        stream = advance_drift(transition, 0, drift, stream)
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
         for c in range(6):
@@ -132,7 +133,7 @@ def simulate_trial(trial, key, draws,
             acc[c] = 0.0
         # drift processes are advanced every `hold` samples (exactly, over hold·dt) and held between
         hold = max(1, int(math.floor(noise_times[2] / dt + 0.5)))
-        drift_transition(hold * dt, noise, noise_times, transition)
+        drift_transition(hold * dt, noise, noise_times, transition, 0)
         n = seg_n[s]
         if not rotating:  # at rest the deterministic part of every sample is the same
             for i in range(3):
@@ -170,8 +171,8 @@ def simulate_trial(trial, key, draws,
                     if record:
                         samples_out[offset + k, c] = val
             if stop - start < hold:  # to the end of the recording: the last, partial hold interval
-                drift_transition((stop - start) * dt, noise, noise_times, transition)
-            stream = advance_drift(transition, drift, stream)
+                drift_transition((stop - start) * dt, noise, noise_times, transition, 0)
+            stream = advance_drift(transition, 0, drift, stream)
             start = stop
         for c in range(6):
             means_out[s, c] = acc[c] / n

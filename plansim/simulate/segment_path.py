@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from plansim._jit import jit
+from plansim._jit import inline_jit, jit
 from plansim.simulate.physics import (N_TRUTH, draw_systematic, draws_length, evaluate_outputs,
                                       geometry_buffers, segment_geometry, unpack_truth)
 from plansim.simulate.random import normal
@@ -95,39 +95,62 @@ def arc_weights(J, delta, n, weights):
 
 
 @jit
-def fourier_damping(sigma, step, coefficients):
-    """Series coefficients of :func:`quantised_gaussian_moments` for σ ≥ 0.2q into *coefficients* (3, K):
+def fourier_damping(sigma, step, coefficients, row):
+    """Series coefficients of :func:`quantised_gaussian_moments` for σ ≥ 0.2q into ``coefficients[row]`` (3, K):
     row 0: (−1)^{k+1} q/(πk) γ_k, row 1: (−1)^k q²/(π²k²) γ_k, row 2: (−1)^{k+1} γ_k, with
     γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16. Returns the count, 0 if σ < 0.2q."""
     if sigma < 0.2 * step:
         return 0
     r = sigma / step
-    kmax = min(int(math.ceil(1.366 / r)), coefficients.shape[1])
+    kmax = min(int(math.ceil(1.366 / r)), coefficients.shape[2])
     sign = 1.0
     for k in range(1, kmax + 1):
         g = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
-        coefficients[0, k - 1] = sign * step / (math.pi * k) * g
-        coefficients[1, k - 1] = -sign * step * step / (math.pi * math.pi * k * k) * g
-        coefficients[2, k - 1] = sign * g
+        coefficients[row, 0, k - 1] = sign * step / (math.pi * k) * g
+        coefficients[row, 1, k - 1] = -sign * step * step / (math.pi * math.pi * k * k) * g
+        coefficients[row, 2, k - 1] = sign * g
         sign = -sign
     return kmax
 
 
-@jit
-def moments_from_damping(mu, sigma, step, coefficients, kmax):
-    """The Fourier branch of :func:`quantised_gaussian_moments` with the coefficients of :func:`fourier_damping`."""
-    a1 = 2.0 * math.pi * mu / step
-    a1 = a1 - 2.0 * math.pi * math.floor(a1 / (2.0 * math.pi))  # only μ mod q matters
-    c1 = math.cos(a1)
-    s1 = math.sin(a1)
+@inline_jit
+def sin_cos_turns(turns):
+    """``(sin 2πt, cos 2πt)`` for *t* in turns, to within 1e-15.
+
+    Reduced to the nearest quarter turn (exact in binary), then Taylor polynomials on
+    |x| ≤ π/4 (truncation below 2e-17). Twice as fast as libm's sincos, whose slow range
+    reduction above |x| ≈ 2.4 the quantiser phases hit half the time.
+    """
+    quarter = math.floor(4.0 * turns + 0.5)
+    x = 2.0 * math.pi * (turns - 0.25 * quarter)
+    x2 = x * x
+    s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 + x2 * (
+        -1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (-1.0 / 1307674368000.0))))))))
+    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
+        -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (1.0 / 20922789888000.0))))))))
+    k = int(quarter) & 3
+    if k == 0:
+        return s, c
+    if k == 1:
+        return c, -s
+    if k == 2:
+        return -s, -c
+    return -c, s
+
+
+@inline_jit
+def moments_from_damping(mu, sigma, step, coefficients, row, kmax):
+    """The Fourier branch of :func:`quantised_gaussian_moments` with the coefficients ``coefficients[row]``
+    of :func:`fourier_damping` (rows index, not views: a view is reference-counted per call)."""
+    s1, c1 = sin_cos_turns(mu / step)  # α_1 = 2πμ/q
     ck, sk = c1, s1
     e1 = 0.0
     e2 = step * step / 12.0
     cov = 0.0
     for k in range(kmax):
-        e1 += coefficients[0, k] * sk
-        e2 += coefficients[1, k] * ck
-        cov += coefficients[2, k] * ck
+        e1 += coefficients[row, 0, k] * sk
+        e2 += coefficients[row, 1, k] * ck
+        cov += coefficients[row, 2, k] * ck
         ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
     cov *= 2.0 * sigma * sigma
     return mu - e1, max(sigma * sigma + e2 - e1 * e1 - 2.0 * cov, 0.0)
@@ -148,9 +171,9 @@ def quantised_gaussian_moments(mu, sigma, step):
     below that, by summing the threshold-crossing probabilities within ±8σ.
     """
     if sigma >= 0.2 * step:
-        coefficients = np.empty((3, 8))
-        kmax = fourier_damping(sigma, step, coefficients)
-        return moments_from_damping(mu, sigma, step, coefficients, kmax)
+        coefficients = np.empty((1, 3, 8))
+        kmax = fourier_damping(sigma, step, coefficients, 0)
+        return moments_from_damping(mu, sigma, step, coefficients, 0, kmax)
     if sigma <= 0.0:
         return step * math.floor(mu / step + 0.5), 0.0
     low = math.floor((mu - QUANTISER_WINDOW * sigma) / step + 0.5)
@@ -169,8 +192,17 @@ def quantised_gaussian_moments(mu, sigma, step):
     return step * (low + s1), step * step * max(s2 - s1 * s1, 0.0)
 
 
+@inline_jit
+def _channel_moments(mu, sigma, step, coefficients, row, kmax):
+    """:func:`quantised_gaussian_moments` of a channel whose Fourier coefficients are
+    ``coefficients[row]`` (*kmax* of them; 0: σ < 0.2q, threshold sums)."""
+    if kmax > 0:
+        return moments_from_damping(mu, sigma, step, coefficients, row, kmax)
+    return quantised_gaussian_moments(mu, sigma, step)
+
+
 @jit
-def _harmonics_needed(spread, sigma, step, coefficients, kmax, tolerance):
+def _harmonics_needed(spread, sigma, step, coefficients, row, kmax, tolerance):
     """Half the number of θ nodes for averaging a quantiser's moments while its input sweeps *spread*.
 
     The output's deterministic part has degree ≤ 3 in θ. In the Fourier regime (σ ≥ 0.2q) the
@@ -187,7 +219,7 @@ def _harmonics_needed(spread, sigma, step, coefficients, kmax, tolerance):
         bound = 0.0
         for k in range(1, kmax + 1):
             x = math.pi * k * spread / step
-            term = abs(coefficients[0, k - 1])  # A_k = q/(πk)·γ_k
+            term = abs(coefficients[row, 0, k - 1])  # A_k = q/(πk)·γ_k
             for j in range(1, M + 2):
                 term *= x / j
             bound += term
@@ -201,14 +233,14 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
                         sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
     """Exact noise-free segment means (S, 6) of one trial's draws: the average over the samples."""
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    u, g_b0, om_b0, perp, work = geometry_buffers(draws)
+    u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
     rates = np.empty(DETERMINISTIC_NODES)
     scratch = np.empty((3, 6))
     nodes = np.empty((DETERMINISTIC_NODES, 6))
     weights = np.empty(DETERMINISTIC_NODES)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                           earth_enu, lever, g_b0, om_b0, u, perp, work)
+                                           earth_enu, lever, g_b0, om_b0, u, perp, frames)
         dT = seg_temp[s] - t_ref
         if seg_rate[s] == 0.0:
             rates[0] = 0.0
@@ -240,12 +272,12 @@ def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_
                             sensor, S2, lever, t_ref, gravity, earth_enu, means_out[t])
 
 
-@jit
-def _segment_drift(drift, coeffs, noise, stream, mean_out):
+@inline_jit
+def _segment_drift(drift, drift_coeffs, s, noise, stream, mean_out):
     """Draw the segment-mean drift per channel and move the states to the end of the recording;
     returns the stream.
 
-    ``coeffs`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
+    ``drift_coeffs[s]`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
     coefficients a, c, L11, L21, L22 of mean = a·x0 + σ L11 z1, end = c·x0 + σ(L21 z1 + L22 z2).
     """
     for c in range(6):
@@ -257,8 +289,8 @@ def _segment_drift(drift, coeffs, noise, stream, mean_out):
             z1, stream = normal(stream)
             z2, stream = normal(stream)
             x0 = drift[p, c]
-            mean_out[c] += coeffs[p, 0] * x0 + sigma * coeffs[p, 2] * z1
-            drift[p, c] = coeffs[p, 1] * x0 + sigma * (coeffs[p, 3] * z1 + coeffs[p, 4] * z2)
+            mean_out[c] += drift_coeffs[s, p, 0] * x0 + sigma * drift_coeffs[s, p, 2] * z1
+            drift[p, c] = drift_coeffs[s, p, 1] * x0 + sigma * (drift_coeffs[s, p, 3] * z1 + drift_coeffs[s, p, 4] * z2)
     return stream
 
 
@@ -273,7 +305,7 @@ def simulate_trial_statistics(trial, key, draws,
     (:func:`plansim.simulate.sample_path.drift_transition`), the same for every trial."""
     stream, drift = noise_stream(key, trial, noise)
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    u, g_b0, om_b0, perp, work = geometry_buffers(draws)
+    u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
     y = np.empty(6)
     det = np.empty(6)
     spread = np.empty(6)
@@ -294,10 +326,10 @@ def simulate_trial_statistics(trial, key, draws,
     kmax_all = np.zeros(6, np.int64)
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                           earth_enu, lever, g_b0, om_b0, u, perp, work)
+                                           earth_enu, lever, g_b0, om_b0, u, perp, frames)
         rotating = seg_rate[s] != 0.0
-        stream = advance_drift(settling[s], drift, stream)
-        stream = _segment_drift(drift, drift_coeffs[s], noise, stream, dbar)
+        stream = advance_drift(settling, s, drift, stream)
+        stream = _segment_drift(drift, drift_coeffs, s, noise, stream, dbar)
         n = seg_n[s]
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
@@ -351,7 +383,7 @@ def simulate_trial_statistics(trial, key, draws,
                 mode[c] = 0
                 continue
             tolerance = RELATIVE_TOLERANCE * sigma_all[c] / math.sqrt(n)
-            kmax_all[c] = fourier_damping(sigma_all[c], step, gammas_all[c])
+            kmax_all[c] = fourier_damping(sigma_all[c], step, gammas_all, c)
             # bias of the quantised mean: Σ_k q/(πk) γ_k (the first term when γ_1 is small)
             bias_amplitude = 0.0
             for k in range(kmax_all[c]):
@@ -362,7 +394,7 @@ def simulate_trial_statistics(trial, key, draws,
                 mode[c] = 2
             else:
                 mode[c] = 3
-                half = _harmonics_needed(spread[c], sigma_all[c], step, gammas_all[c], kmax_all[c], tolerance)
+                half = _harmonics_needed(spread[c], sigma_all[c], step, gammas_all, c, kmax_all[c], tolerance)
                 J = max(J, 2 * half + 1)
         if J > 0:
             if J == DETERMINISTIC_NODES:
@@ -383,11 +415,7 @@ def simulate_trial_statistics(trial, key, draws,
                 for c in range(6):
                     if mode[c] == 3:
                         step = acquisition[2] if c < 3 else acquisition[3]
-                        if kmax_all[c] > 0:
-                            m, v = moments_from_damping(y[c] + dbar[c], sigma_all[c], step, gammas_all[c],
-                                                         kmax_all[c])
-                        else:
-                            m, v = quantised_gaussian_moments(y[c] + dbar[c], sigma_all[c], step)
+                        m, v = _channel_moments(y[c] + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
                         mbar[c] += wj[j] * m
                         vbar[c] += wj[j] * v
         for c in range(6):
@@ -399,7 +427,7 @@ def simulate_trial_statistics(trial, key, draws,
                 means_out[s, c] = (base + math.sqrt((white_all[c] * white_all[c] + step * step / 12.0) / n) * z_all[c]
                                    + jitter[c] * zbar)
             elif mode[c] == 2:
-                m, v = quantised_gaussian_moments(base, sigma_all[c], step)
+                m, v = _channel_moments(base, sigma_all[c], step, gammas_all, c, kmax_all[c])
                 means_out[s, c] = m + math.sqrt(v / n) * z_all[c]
             else:
                 means_out[s, c] = mbar[c] + math.sqrt(max(vbar[c], 0.0) / n) * z_all[c]
@@ -417,7 +445,7 @@ def simulate_chunk_statistics(first_trial, key, truth_nominal, truth_spread, err
     n_seg = seg_n.shape[0]
     settling = np.empty((n_seg, 2, 3, 6))
     for s in range(n_seg):
-        drift_transition(seg_gap[s], noise, noise_times, settling[s])
+        drift_transition(seg_gap[s], noise, noise_times, settling, s)
     for t in range(means_out.shape[0]):
         draws = np.empty(_draws_length(n_seg))
         draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
