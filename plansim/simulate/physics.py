@@ -36,8 +36,10 @@ from plansim.simulate.random import draw_error, normal, seed_stream, uniform
 N_TRUTH = 39
 HEAD = 51
 PER_SEGMENT = 8
-STREAM_SYSTEMATIC = 0  # truth spread and table/fixture errors
-STREAM_NOISE = 1  # sensor noise, drift and rate smoothness
+# Integer constants that kernels pass to other kernels are numpy scalars, not Python ints: numba
+# types a Python int argument as a literal and compiles the callee once per distinct value.
+STREAM_SYSTEMATIC = np.int64(0)  # truth spread and table/fixture errors
+STREAM_NOISE = np.int64(1)  # sensor noise, drift and rate smoothness
 
 # rows of the `sensor` effects array (3 columns: x, y, z)
 EFFECT_ROWS = ("gyro_nonlinearity_quadratic", "gyro_nonlinearity_cubic", "gyro_asymmetry", "accel_second_order",
@@ -274,11 +276,12 @@ def quantise(y, output_range, step, inverse_step, full_scale):
 
 
 @jit
-def evaluate_outputs(count, phase, nodes, extra, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
+def evaluate_outputs(nodes, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
                      out, scratch):
     """Noise-free outputs ``out[j]`` (6) at table angles θ_j = phase + 2πj/nodes (j < nodes) and, for
     j ≥ nodes (``extra`` more rows), at θ = phase; table rate ``rates[j]``. Angles by angle addition.
-    ``scratch`` (3, 6) is work space (allocated once per trial by the caller)."""
+    ``scratch`` (3, 6) is work space (allocated once per trial by the caller). Pass *nodes* and
+    *extra* as int64 values, not int literals (one compiled copy; see :data:`STREAM_NOISE`)."""
     w = scratch[0, :3]
     fc = scratch[1, :3]
     y = scratch[2]
@@ -287,8 +290,8 @@ def evaluate_outputs(count, phase, nodes, extra, rates, u, g_b0, om_b0, perp, dT
     cd = math.cos(2.0 * math.pi / nodes)
     sd = math.sin(2.0 * math.pi / nodes)
     ct, st = c0, s0
-    for j in range(count + extra):
-        if j >= count:
+    for j in range(nodes + extra):
+        if j >= nodes:
             ct, st = c0, s0
         rotated_inputs(ct, st, rates[j], u, g_b0, om_b0, w, fc)
         sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)

@@ -30,6 +30,10 @@ _GOLDEN = _U64(0x9E3779B97F4A7C15)
 _MIX1 = _U64(0xBF58476D1CE4E5B9)
 _MIX2 = _U64(0x94D049BB133111EB)
 _TO_UNIT = 1.0 / 9007199254740992.0  # 2**-53
+# rotation amounts of xoshiro256** as int64 scalars: a Python int would be typed as a literal and
+# compile :func:`_rotl` once per amount (LLVM still folds them into the inlined rotation)
+_ROTATE_OUTPUT = np.int64(7)
+_ROTATE_STATE = np.int64(45)
 
 # ZIGNOR tables (Doornik 2005): 128 blocks
 _ZIG_C = 128
@@ -99,14 +103,14 @@ def _rotl(x, k):
 def next_u64(stream):
     """xoshiro256** step: ``(64 random bits, stream)``."""
     s0, s1, s2, s3 = stream
-    result = _rotl(s1 * _U64(5), 7) * _U64(9)
+    result = _rotl(s1 * _U64(5), _ROTATE_OUTPUT) * _U64(9)
     t = s1 << _U64(17)
     s2 ^= s0
     s3 ^= s1
     s1 ^= s2
     s0 ^= s3
     s2 ^= t
-    s3 = _rotl(s3, 45)
+    s3 = _rotl(s3, _ROTATE_STATE)
     return result, (s0, s1, s2, s3)
 
 

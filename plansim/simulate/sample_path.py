@@ -31,6 +31,13 @@ from plansim.simulate.physics import quantise, rotated_inputs, sensor_outputs
 from plansim.simulate.physics import geometry_buffers, unpack_truth
 
 
+#: ``record`` argument of :func:`simulate_trial` from the chunk kernel: a numpy bool, not a Python
+#: literal, so that the kernel and :func:`plansim.simulate.engine.simulate_recording` share one
+#: compiled copy
+_NO_RECORDING = np.bool_(False)
+#: index of the one-slot transition buffer of :func:`simulate_trial` (an int64 for the same reason)
+_ONLY_TRANSITION = np.int64(0)
+
 
 @jit
 def drift_transition(interval, noise, noise_times, transitions, k):
@@ -124,7 +131,7 @@ def simulate_trial(trial, key, draws,
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, frames)
         rotating = seg_rate[s] != 0.0
-        drift_transition(seg_gap[s], noise, noise_times, transition, 0)  # settling
+        drift_transition(seg_gap[s], noise, noise_times, transition, _ONLY_TRANSITION)  # settling
         stream = advance_drift(transition, 0, drift, stream)
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
@@ -133,7 +140,7 @@ def simulate_trial(trial, key, draws,
             acc[c] = 0.0
         # drift processes are advanced every `hold` samples (exactly, over hold·dt) and held between
         hold = max(1, int(math.floor(noise_times[2] / dt + 0.5)))
-        drift_transition(hold * dt, noise, noise_times, transition, 0)
+        drift_transition(hold * dt, noise, noise_times, transition, _ONLY_TRANSITION)
         n = seg_n[s]
         if not rotating:  # at rest the deterministic part of every sample is the same
             for i in range(3):
@@ -171,7 +178,7 @@ def simulate_trial(trial, key, draws,
                     if record:
                         samples_out[offset + k, c] = val
             if stop - start < hold:  # to the end of the recording: the last, partial hold interval
-                drift_transition((stop - start) * dt, noise, noise_times, transition, 0)
+                drift_transition((stop - start) * dt, noise, noise_times, transition, _ONLY_TRANSITION)
             stream = advance_drift(transition, 0, drift, stream)
             start = stop
         for c in range(6):
@@ -199,7 +206,7 @@ def simulate_chunk(first_trial, key, truth_nominal, truth_spread, error_kind, er
         simulate_trial(first_trial + t, key, draws,
                        seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                        sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity, earth_enu,
-                       means_out[t], no_samples, False)
+                       means_out[t], no_samples, _NO_RECORDING)
 
 
 draws_length_jit = jit(draws_length)

@@ -41,7 +41,12 @@ from plansim.simulate.physics import (N_TRUTH, draw_systematic, draws_length, ev
 from plansim.simulate.random import normal
 from plansim.simulate.sample_path import advance_drift, drift_transition, noise_stream
 
-DETERMINISTIC_NODES = 7  # degree ≤ 3 in θ -> 2·3 + 1 nodes
+# int64 scalars, not Python ints: passed to kernels, a literal would compile a copy per value
+DETERMINISTIC_NODES = np.int64(7)  # degree ≤ 3 in θ -> 2·3 + 1 nodes
+_ONE_NODE = np.int64(1)  # at rest: the output does not depend on θ
+_NO_EXTRA = np.int64(0)
+_JITTER_NODES = np.int64(2)  # θ0 at the rate ± h, for the response to rate jitter
+_FIRST_ROW = np.int64(0)
 MAX_NODES = 401
 QUANTISER_WINDOW = 8.0  # thresholds within ±8σ (Φ(−8) ≈ 6e-16)
 #: every approximation of the quantiser stays below this fraction of the segment mean's noise σ/√N
@@ -172,7 +177,7 @@ def quantised_gaussian_moments(mu, sigma, step):
     """
     if sigma >= 0.2 * step:
         coefficients = np.empty((1, 3, 8))
-        kmax = fourier_damping(sigma, step, coefficients, 0)
+        kmax = fourier_damping(sigma, step, coefficients, _FIRST_ROW)
         return moments_from_damping(mu, sigma, step, coefficients, 0, kmax)
     if sigma <= 0.0:
         return step * math.floor(mu / step + 0.5), 0.0
@@ -244,14 +249,14 @@ def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_ax
         dT = seg_temp[s] - t_ref
         if seg_rate[s] == 0.0:
             rates[0] = 0.0
-            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
+            evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for c in range(6):
                 means_out[s, c] = nodes[0, c]
             continue
         arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
         for j in range(DETERMINISTIC_NODES):
             rates[j] = rate_act
-        evaluate_outputs(DETERMINISTIC_NODES, phase, DETERMINISTIC_NODES, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg,
+        evaluate_outputs(DETERMINISTIC_NODES, _NO_EXTRA, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg,
                          G, Ka, Ba, P, sensor, S2, nodes, scratch)
         for c in range(6):
             means_out[s, c] = 0.0
@@ -342,7 +347,7 @@ def simulate_trial_statistics(trial, key, draws,
                 rates[j] = rate_act
             rates[DETERMINISTIC_NODES] = rate_act + h
             rates[DETERMINISTIC_NODES + 1] = rate_act - h
-            evaluate_outputs(DETERMINISTIC_NODES, phase, DETERMINISTIC_NODES, 2, rates, u, g_b0, om_b0, perp, dT, Kg,
+            evaluate_outputs(DETERMINISTIC_NODES, _JITTER_NODES, phase, rates, u, g_b0, om_b0, perp, dT, Kg,
                              Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for c in range(6):
                 det[c] = 0.0
@@ -362,7 +367,7 @@ def simulate_trial_statistics(trial, key, draws,
                              / (2.0 * h))
         else:
             rates[0] = 0.0
-            evaluate_outputs(1, 0.0, 1, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
+            evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for c in range(6):
                 det[c] = nodes[0, c]
                 spread[c] = 0.0
@@ -373,7 +378,7 @@ def simulate_trial_statistics(trial, key, draws,
             zbar /= math.sqrt(n)
         # per channel: 0 linear (no quantiser, or no estimator uses it), 1 dithered, 2 quantised
         # with a constant mean, 3 quantised while the output sweeps across it (average over θ)
-        J = 0
+        J = np.int64(0)  # not a literal 0 (see DETERMINISTIC_NODES)
         for c in range(6):
             z_all[c], stream = normal(stream)
             white_all[c] = noise[c, 0] / math.sqrt(dt)
@@ -408,7 +413,7 @@ def simulate_trial_statistics(trial, key, draws,
             if J != DETERMINISTIC_NODES:  # else the nodes of the deterministic mean serve
                 for j in range(J):
                     rates[j] = rate_act
-                evaluate_outputs(J, phase, J, 0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
+                evaluate_outputs(J, _NO_EXTRA, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
             for j in range(J):
                 for c in range(6):
                     y[c] = nodes[j, c]

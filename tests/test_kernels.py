@@ -1,0 +1,54 @@
+"""Compilation hygiene of the numba kernels: each is compiled once, whatever calls it.
+
+numba types a Python ``int``/``bool`` literal passed from one kernel to another as a *literal* type
+and compiles the callee once per distinct value; an accumulator that starts as ``J = 0`` is typed
+``Literal[int](0)`` before it becomes ``int64`` and compiles the callee a second time. Each copy
+costs a full compile (1–2 s for the output model), which is why the kernels pass numpy scalars
+(``np.int64``, ``np.bool_``) instead. This test compiles every kernel from an empty cache in a fresh
+process (kernels loaded from the cache never compile their callees, so a warm process would see
+nothing) and fails on any kernel with more than one compiled signature.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+_EXERCISE_EVERY_KERNEL = textwrap.dedent("""
+    import importlib, json, pkgutil
+    import numba
+    import plansim.simulate
+    from plansim.scenario import load_scenario
+    from plansim.simulate.engine import (nominal_draws, noise_free_segment_means, simulate_recording,
+                                         simulate_segment_means)
+
+    scenario = load_scenario("jjf2003")
+    simulate_segment_means(scenario, 3, 1, path="segment")
+    simulate_segment_means(scenario, 3, 1, path="sample")
+    simulate_recording(scenario, 1)
+    noise_free_segment_means(scenario, nominal_draws(scenario)[None])
+    copies = {}
+    for module_info in pkgutil.iter_modules(plansim.simulate.__path__):
+        module = importlib.import_module("plansim.simulate." + module_info.name)
+        for name, value in vars(module).items():
+            if isinstance(value, numba.core.registry.CPUDispatcher) and value.__module__ == module.__name__:
+                copies[module.__name__ + "." + name] = [str(s) for s in value.signatures]
+    print(json.dumps(copies))
+""")
+
+
+@pytest.mark.slow
+def test_every_kernel_is_compiled_once(tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))  # empty cache: everything compiles here
+    done = subprocess.run([sys.executable, "-c", _EXERCISE_EVERY_KERNEL], env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-3000:]
+    copies = json.loads(done.stdout.strip().splitlines()[-1])
+    compiled = {name: signatures for name, signatures in copies.items() if signatures}
+    assert len(compiled) >= 10, f"too few kernels compiled to mean anything: {sorted(compiled)}"
+    duplicated = {name: signatures for name, signatures in compiled.items() if len(signatures) > 1}
+    assert not duplicated, "kernels compiled more than once (literal arguments?):\n" + json.dumps(duplicated, indent=1)
