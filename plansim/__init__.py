@@ -3,11 +3,33 @@
 >>> import plansim
 >>> results = plansim.run("ideal", trials=10, seed=1)        # doctest: +SKIP
 >>> float(abs(results.error).max())                          # doctest: +SKIP
+
+The public names are imported on first use (PEP 562): ``import plansim.simulate…`` alone, as the
+process that compiles kernels in parallel does (:mod:`plansim.simulate.compilation`), does not
+pay for xarray and the rest of the orchestrator.
 """
 
-from plansim.runner import package_version, run
-from plansim.scenario import Scenario, builtin_scenarios, load_scenario, save_scenario
+from importlib import import_module
+from importlib.metadata import PackageNotFoundError, version
 
-__version__ = package_version()
+try:
+    __version__ = version("plansim")
+except PackageNotFoundError:  # running from a source tree that is not installed
+    __version__ = "unknown"
+
+_PUBLIC = {"run": "plansim.runner", "Scenario": "plansim.scenario", "builtin_scenarios": "plansim.scenario",
+           "load_scenario": "plansim.scenario", "save_scenario": "plansim.scenario"}
 
 __all__ = ["Scenario", "builtin_scenarios", "load_scenario", "run", "save_scenario", "__version__"]
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        value = getattr(import_module(_PUBLIC[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'plansim' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_PUBLIC))

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-from importlib.metadata import PackageNotFoundError, version
 
 import numpy as np
 import tomli_w
 import xarray as xr
 
+import plansim
 from plansim.estimate import reduce
 from plansim.model.parameters import PARAMETERS, PARAMETER_NAMES
 from plansim.scenario import Scenario, load_scenario
@@ -24,10 +24,7 @@ from plansim.simulate.engine import PATH_NAMES, ProgressCallback, choose_path, i
 
 
 def package_version() -> str:
-    try:
-        return version("plansim")
-    except PackageNotFoundError:  # running from a source tree that is not installed
-        return "unknown"
+    return plansim.__version__
 
 
 def _scenario_of(scenario: Scenario | str) -> Scenario:

@@ -17,6 +17,7 @@ from plansim.scenario import Scenario
 from plansim.schedule.segments import Schedule, axis_vector, body_to_level
 from plansim.simulate import sample_path, segment_path
 from plansim.simulate.physics import EFFECT_ROWS, draw_systematic, draws_length
+from plansim.simulate.compilation import bound_call, compile_kernels
 from plansim.simulate.random import root_key
 
 CHANNELS = ("gx", "gy", "gz", "ax", "ay", "az")
@@ -142,12 +143,14 @@ def drift_coefficient_table(scenario: Scenario) -> np.ndarray:
     """(S, 3, 5) unit-σ drift coefficients per segment for GM bias instability, GM drift, random walk."""
     n = scenario.noise
     out = np.zeros((len(scenario.schedule), 3, 5))
+    taus = (n.bias_instability_correlation_time, n.markov_correlation_time, None)
+    table = {}  # a schedule repeats few (samples, rate) pairs: 135 evaluations -> a handful
     for k, s in enumerate(scenario.schedule.segments):
-        dt = 1.0 / s.sample_rate
-        out[k, 0] = segment_path.drift_coefficients(s.samples, dt, n.drift_update_interval,
-                                                    n.bias_instability_correlation_time)
-        out[k, 1] = segment_path.drift_coefficients(s.samples, dt, n.drift_update_interval, n.markov_correlation_time)
-        out[k, 2] = segment_path.drift_coefficients(s.samples, dt, n.drift_update_interval, None)
+        for p, tau in enumerate(taus):
+            arguments = (s.samples, 1.0 / s.sample_rate, n.drift_update_interval, tau)
+            if arguments not in table:
+                table[arguments] = segment_path.drift_coefficients(*arguments)
+            out[k, p] = table[arguments]
     return out
 
 
@@ -252,22 +255,76 @@ def _check_run_arguments(trials, chunk_size, path):
         raise ValueError(f"path = {path!r}; allowed: 'sample', 'segment'")
 
 
+#: trials per call of the segment path's two kernels: their hand-over arrays (17.6 kB per trial for
+#: the default schedule) stay in the core's cache between the two calls
+SEGMENT_BLOCK = 64
+
+_NODES_ARGUMENTS = ("truth_nominal", "truth_spread", "error_kind", "error_scale", "seg_C0", "seg_rate", "seg_axis",
+                    "seg_axis_index", "seg_temp", "sensor", "S2", "lever", "t_ref", "smoothness", "gravity",
+                    "earth_enu")
+_STATISTICS_ARGUMENTS = ("seg_n", "seg_dt", "seg_gap", "seg_rate", "acquisition", "noise", "noise_times",
+                         "smoothness", "drift_coeffs", "needed")
+
+
+class _PathKernels:
+    """The kernels of one path with their scenario arguments bound: ``run_slice(first, key, means, truth)``
+    fills a slice of trials; ``calls(key)`` lists each entry kernel with arguments of the right types
+    (for :func:`plansim.simulate.compilation.compile_kernels`)."""
+
+    def __init__(self, scenario: Scenario, path: str):
+        args = _as_float_arrays(kernel_arguments(scenario))
+        self.path = path
+        self.segments = len(scenario.schedule)
+        if path == "segment":
+            args["drift_coeffs"] = drift_coefficient_table(scenario)
+            args["needed"] = needed_channels(scenario.schedule)
+            self.nodes_args = {k: args[k] for k in _NODES_ARGUMENTS}
+            self.statistics_args = {k: args[k] for k in _STATISTICS_ARGUMENTS}
+        else:
+            self.args = args
+
+    def _buffers(self, trials: int):
+        return (np.empty((trials, self.segments, segment_path.DETERMINISTIC_NODES, 6)),
+                np.empty((trials, self.segments)), np.empty((trials, self.segments, 6)))
+
+    def run_slice(self, first: int, key: np.ndarray, means: np.ndarray, truth: np.ndarray) -> None:
+        if self.path == "sample":
+            sample_path.simulate_chunk(first, key, **self.args, means_out=means, truth_out=truth)
+            return
+        count = means.shape[0]
+        nodes, rates, jitter = self._buffers(min(SEGMENT_BLOCK, count))
+        for a in range(0, count, SEGMENT_BLOCK):
+            b = min(count, a + SEGMENT_BLOCK)
+            k = b - a
+            segment_path.simulate_chunk_nodes(first + a, key, **self.nodes_args, truth_out=truth[a:b],
+                                              nodes_out=nodes[:k], rates_out=rates[:k], jitter_out=jitter[:k])
+            segment_path.simulate_chunk_statistics(first + a, key, nodes[:k], rates[:k], jitter[:k],
+                                                   **self.statistics_args, means_out=means[a:b])
+
+    def calls(self, key: np.ndarray) -> list[tuple[object, tuple]]:
+        means, truth = np.empty((1, self.segments, 6)), np.empty((1, N_PARAMETERS))
+        if self.path == "sample":
+            return [bound_call(sample_path.simulate_chunk, 0, key, **self.args, means_out=means, truth_out=truth)]
+        nodes, rates, jitter = self._buffers(1)
+        return [bound_call(segment_path.simulate_chunk_nodes, 0, key, **self.nodes_args, truth_out=truth,
+                           nodes_out=nodes, rates_out=rates, jitter_out=jitter),
+                bound_call(segment_path.simulate_chunk_statistics, 0, key, nodes, rates, jitter,
+                           **self.statistics_args, means_out=means)]
+
+
 def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int = 4096, path: str = "sample",
                    progress: ProgressCallback | None = None):
     """Yield ``(start, stop, means, truth)`` chunk by chunk; the buffers are reused (copy what you keep).
 
     Working memory is bounded by *chunk_size* whatever the number of trials; trial *i* gives the
-    same numbers in any chunk (its random streams depend on the seed and *i* only).
+    same numbers in any chunk (its random streams depend on the seed and *i* only). The path's
+    kernels are compiled (or loaded from numba's cache) first, on every core
+    (:func:`plansim.simulate.compilation.compile_kernels`).
     """
     _check_run_arguments(trials, chunk_size, path)
     key = root_key(seed)
-    args = _as_float_arrays(kernel_arguments(scenario))
-    if path == "segment":
-        kernel = segment_path.simulate_chunk_statistics
-        args["drift_coeffs"] = drift_coefficient_table(scenario)
-        args["needed"] = needed_channels(scenario.schedule)
-    else:
-        kernel = sample_path.simulate_chunk
+    kernels = _PathKernels(scenario, path)
+    compile_kernels(kernels.calls(key))
     size = min(chunk_size, trials)
     means = np.empty((size, len(scenario.schedule), 6))
     truth = np.empty((size, N_PARAMETERS))
@@ -278,7 +335,7 @@ def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int =
             m, t = means[: stop - start], truth[: stop - start]
             # contiguous slices, one per thread; each trial's numbers depend on its index only
             edges = np.linspace(0, stop - start, min(workers, stop - start) + 1).astype(int)
-            jobs = [pool.submit(kernel, start + int(a), key, **args, means_out=m[a:b], truth_out=t[a:b])
+            jobs = [pool.submit(kernels.run_slice, start + int(a), key, m[a:b], t[a:b])
                     for a, b in zip(edges[:-1], edges[1:])]
             for job in jobs:
                 job.result()

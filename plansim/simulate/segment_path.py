@@ -22,6 +22,17 @@ the distribution of those means:
   Tolerance: every such approximation stays below 0.1 % of the segment mean's own noise σ/√N
   (:data:`RELATIVE_TOLERANCE`).
 
+Two kernels, run one after the other on each slice of trials:
+
+- :func:`simulate_chunk_nodes` — the deterministic half: systematic draws (the same as on the
+  sample-level path), geometry, and the noise-free outputs at 7 table angles per segment
+  (:func:`noise_free_nodes`), which fix the output at every angle of the segment;
+- :func:`simulate_chunk_statistics` — the stochastic half: drift, white noise, rate jitter and the
+  quantiser's moments, from those node values alone (no output model inside).
+
+They are separate entry points so that, on a cold start, two processes compile them side by side
+(:mod:`plansim.simulate.compilation`).
+
 What is not exact, and the runner's checks (:func:`plansim.simulate.engine.segment_path_exactness`):
 saturation (excluded), gyro asymmetry (|w| is not a polynomial; excluded), drift that moves a
 non-dithered quantised output within a segment (excluded above 0.1σ), the cross-channel
@@ -65,25 +76,22 @@ def arc_weights(J, delta, n, weights):
         W_j = (1/J)·[1 + 2 Re Σ_{m=1..M} D_m e^{−i m 2πj/J}],  D_m = (1/n) Σ_k e^{i m k Δ}
             = (1 − e^{i m n Δ}) / (n (1 − e^{i m Δ})).
 
-    Powers by recurrence and the twiddles e^{−i2πk/J} from a table (a constant one for J = 7):
-    no allocation, and no trigonometric call inside the loops.
+    Powers by recurrence and the twiddles e^{−i m 2πj/J} from a constant table for J = 7, by angle
+    addition otherwise: no allocation, and no trigonometric call inside the loops.
     """
     M = (J - 1) // 2
-    if J == 7:
-        cos_table = _COS7
-        sin_table = _SIN7
-    else:
-        cos_table = np.cos(2.0 * np.pi * np.arange(J) / J)
-        sin_table = np.sin(2.0 * np.pi * np.arange(J) / J)
     for j in range(J):
         weights[j] = 1.0 / J
     c1, s1 = math.cos(delta), math.sin(delta)
     cn, sn = math.cos(n * delta), math.sin(n * delta)
     a_re, a_im = 1.0, 0.0  # e^{i m Δ}
     b_re, b_im = 1.0, 0.0  # e^{i m n Δ}
+    cj, sj = math.cos(2.0 * math.pi / J), math.sin(2.0 * math.pi / J)
+    cm, sm = 1.0, 0.0  # cos, sin of m·2π/J
     for m in range(1, M + 1):
         a_re, a_im = a_re * c1 - a_im * s1, a_re * s1 + a_im * c1
         b_re, b_im = b_re * cn - b_im * sn, b_re * sn + b_im * cn
+        cm, sm = cm * cj - sm * sj, sm * cj + cm * sj
         den_re = 1.0 - a_re
         den_im = -a_im
         den2 = den_re * den_re + den_im * den_im
@@ -94,23 +102,62 @@ def arc_weights(J, delta, n, weights):
             num_im = -b_im
             d_re = (num_re * den_re + num_im * den_im) / (n * den2)
             d_im = (num_im * den_re - num_re * den_im) / (n * den2)
-        for j in range(J):
-            k = (m * j) % J
-            weights[j] += 2.0 / J * (d_re * cos_table[k] + d_im * sin_table[k])  # Re(D_m e^{−i m φ_j})
+        if J == DETERMINISTIC_NODES:
+            for j in range(J):
+                k = (m * j) % J
+                weights[j] += 2.0 / J * (d_re * _COS7[k] + d_im * _SIN7[k])  # Re(D_m e^{−i m φ_j})
+        else:
+            tc, ts = 1.0, 0.0  # cos, sin of m·2πj/J
+            for j in range(J):
+                weights[j] += 2.0 / J * (d_re * tc + d_im * ts)
+                tc, ts = tc * cm - ts * sm, ts * cm + tc * sm
+
+
+@jit
+def trigonometric_coefficients(nodes, s, coefficients):
+    """The trigonometric polynomial of degree 3 through segment *s*'s 7 node values, per channel.
+
+    ``nodes[s, j, c]`` is the output at θ0 + φ_j, φ_j = 2πj/7 (:func:`noise_free_nodes`);
+    ``coefficients[c]`` receives (a0, a1, b1, a2, b2, a3, b3) with
+    ``y(θ0 + φ) = a0 + Σ_{m=1..3} a_m cos mφ + b_m sin mφ`` (the 7-point discrete Fourier
+    transform: a0 = ȳ, a_m = (2/7) Σ_j y_j cos mφ_j, b_m = (2/7) Σ_j y_j sin mφ_j).
+    """
+    for c in range(6):
+        total = 0.0
+        for j in range(DETERMINISTIC_NODES):
+            total += nodes[s, j, c]
+        coefficients[c, 0] = total / DETERMINISTIC_NODES
+        for m in range(1, 4):
+            a = 0.0
+            b = 0.0
+            for j in range(DETERMINISTIC_NODES):
+                k = (m * j) % DETERMINISTIC_NODES
+                a += nodes[s, j, c] * _COS7[k]
+                b += nodes[s, j, c] * _SIN7[k]
+            coefficients[c, 2 * m - 1] = 2.0 * a / DETERMINISTIC_NODES
+            coefficients[c, 2 * m] = 2.0 * b / DETERMINISTIC_NODES
 
 
 @jit
 def fourier_damping(sigma, step, coefficients, row):
     """Series coefficients of :func:`quantised_gaussian_moments` for σ ≥ 0.2q into ``coefficients[row]`` (3, K):
     row 0: (−1)^{k+1} q/(πk) γ_k, row 1: (−1)^k q²/(π²k²) γ_k, row 2: (−1)^{k+1} γ_k, with
-    γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16. Returns the count, 0 if σ < 0.2q."""
+    γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16. Returns the count, 0 if σ < 0.2q.
+
+    One exponential per call: γ_k = γ_1^{k²} = γ_{k−1}·γ_1^{2k−1}.
+    """
     if sigma < 0.2 * step:
         return 0
     r = sigma / step
     kmax = min(int(math.ceil(1.366 / r)), coefficients.shape[2])
+    g1 = math.exp(-2.0 * math.pi * math.pi * r * r)
+    g1_squared = g1 * g1
+    g = 1.0
+    factor = g1  # γ_1^{2k−1}
     sign = 1.0
     for k in range(1, kmax + 1):
-        g = math.exp(-2.0 * math.pi * math.pi * k * k * r * r)
+        g *= factor
+        factor *= g1_squared
         coefficients[row, 0, k - 1] = sign * step / (math.pi * k) * g
         coefficients[row, 1, k - 1] = -sign * step * step / (math.pi * math.pi * k * k) * g
         coefficients[row, 2, k - 1] = sign * g
@@ -220,61 +267,137 @@ def _harmonics_needed(spread, sigma, step, coefficients, row, kmax, tolerance):
     cap = (MAX_NODES - 1) // 2
     if kmax == 0:
         return int(min(math.ceil(3.0 * spread / max(sigma, 1e-300)) + 4, cap))
+    # bound(M) = Σ_k A_k x_k^{M+1}/(M+1)!, x_k = πk·spread/q, A_k = q/(πk)·γ_k; with
+    # P_M = Σ_k A_k k^{M+1}, bound(M) = (π·spread/q)^{M+1}/(M+1)! · P_M, both updated per M
+    x = math.pi * spread / step
+    scale = x * x * x * x / 24.0  # x^{M+1}/(M+1)! at M = 3
     for M in range(3, cap + 1):
-        bound = 0.0
+        total = 0.0
         for k in range(1, kmax + 1):
-            x = math.pi * k * spread / step
-            term = abs(coefficients[row, 0, k - 1])  # A_k = q/(πk)·γ_k
-            for j in range(1, M + 2):
-                term *= x / j
-            bound += term
-        if bound <= tolerance:
+            total += abs(coefficients[row, 0, k - 1]) * float(k) ** (M + 1)
+        if scale * total <= tolerance:
             return min(3 * (M // 3 + 1), cap) if M > 3 else 3
+        scale *= x / (M + 2)
     return cap
 
 
 @jit
-def deterministic_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
-                        sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
-    """Exact noise-free segment means (S, 6) of one trial's draws: the average over the samples."""
+def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
+                     smoothness, gravity, earth_enu, nodes_out, rates_out, jitter_out):
+    """The deterministic part of one trial, segment by segment, from its systematic *draws*.
+
+    Writes, for every segment s,
+
+    - ``nodes_out[s]`` (7, 6): the noise-free outputs at the table angles θ0 + 2πj/7 (j < 7) at the
+      actual rate. They determine the output at every angle of the segment: a trigonometric
+      polynomial of degree ≤ 3 in θ is fixed by 7 equispaced values. At rest every row holds the
+      one (θ-independent) output;
+    - ``rates_out[s]``: the actual table rate, rad/s (0 at rest);
+    - ``jitter_out[s]`` (6): the output's response to the rate smoothness, σ_rate·∂y/∂ω at θ0 per
+      unit normal rate jitter (central difference, step 1e-6 of the rate); 0 at rest.
+    """
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
-    rates = np.empty(DETERMINISTIC_NODES)
+    rates = np.empty(DETERMINISTIC_NODES + _JITTER_NODES)
+    outputs = np.empty((DETERMINISTIC_NODES + _JITTER_NODES, 6))
     scratch = np.empty((3, 6))
-    nodes = np.empty((DETERMINISTIC_NODES, 6))
-    weights = np.empty(DETERMINISTIC_NODES)
-    for s in range(seg_n.shape[0]):
+    for s in range(seg_C0.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, frames)
         dT = seg_temp[s] - t_ref
         if seg_rate[s] == 0.0:
             rates[0] = 0.0
-            evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
+            evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
+                             sensor, S2, outputs, scratch)
+            rates_out[s] = 0.0
             for c in range(6):
-                means_out[s, c] = nodes[0, c]
+                for j in range(DETERMINISTIC_NODES):
+                    nodes_out[s, j, c] = outputs[0, c]
+                jitter_out[s, c] = 0.0
             continue
-        arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
+        # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
+        h = 1e-6 * abs(rate_act)
         for j in range(DETERMINISTIC_NODES):
             rates[j] = rate_act
-        evaluate_outputs(DETERMINISTIC_NODES, _NO_EXTRA, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg,
-                         G, Ka, Ba, P, sensor, S2, nodes, scratch)
+        rates[DETERMINISTIC_NODES] = rate_act + h
+        rates[DETERMINISTIC_NODES + 1] = rate_act - h
+        evaluate_outputs(DETERMINISTIC_NODES, _JITTER_NODES, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka,
+                         Ba, P, sensor, S2, outputs, scratch)
+        rates_out[s] = rate_act
         for c in range(6):
-            means_out[s, c] = 0.0
             for j in range(DETERMINISTIC_NODES):
-                means_out[s, c] += weights[j] * nodes[j, c]
+                nodes_out[s, j, c] = outputs[j, c]
+            # the sample path jitters the gyro input w (so also P·w²), not the centripetal term
+            jitter_out[s, c] = (smoothness * rate_act
+                                * (outputs[DETERMINISTIC_NODES, c] - outputs[DETERMINISTIC_NODES + 1, c]) / (2.0 * h))
+
+
+@jit
+def segment_mean_and_spread(nodes, s, rate, dt, n, weights, mean_out, spread_out):
+    """Exact noise-free mean over the segment's *n* samples (``mean_out``, 6) and the spread
+    max − min of the node values (``spread_out``, 6), from :func:`noise_free_nodes`'s ``nodes``.
+
+    *weights* (7) is work space; at rest (*rate* 0) the mean is the output itself and the spread 0.
+    """
+    if rate == 0.0:
+        for c in range(6):
+            mean_out[c] = nodes[s, 0, c]
+            spread_out[c] = 0.0
+        return
+    arc_weights(DETERMINISTIC_NODES, rate * dt, n, weights)
+    for c in range(6):
+        total = 0.0
+        low = nodes[s, 0, c]
+        high = low
+        for j in range(DETERMINISTIC_NODES):
+            y = nodes[s, j, c]
+            total += weights[j] * y
+            low = min(low, y)
+            high = max(high, y)
+        mean_out[c] = total
+        spread_out[c] = high - low
 
 
 @jit
 def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
                      sensor, S2, lever, t_ref, gravity, earth_enu, means_out):
-    """:func:`deterministic_means` for many draws vectors (n, D) -> (n, S, 6).
+    """Exact noise-free segment means (n, S, 6) of many draws vectors (n, D): the average over the samples.
 
-    Serial on purpose: it serves the path check and the GUM sensitivities (few vectors), and a
-    parallel kernel would add seconds of compilation to every cold start.
+    Serial on purpose: it serves the GUM sensitivities (few vectors), and a parallel kernel would
+    add seconds of compilation to every cold start.
     """
+    n_seg = seg_n.shape[0]
+    nodes = np.empty((n_seg, DETERMINISTIC_NODES, 6))
+    rates = np.empty(n_seg)
+    jitter = np.empty((n_seg, 6))
+    weights = np.empty(DETERMINISTIC_NODES)
+    spread = np.empty(6)
     for t in range(draws.shape[0]):
-        deterministic_means(draws[t], seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
-                            sensor, S2, lever, t_ref, gravity, earth_enu, means_out[t])
+        noise_free_nodes(draws[t], seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
+                         0.0, gravity, earth_enu, nodes, rates, jitter)
+        for s in range(n_seg):
+            segment_mean_and_spread(nodes, s, rates[s], seg_dt[s], seg_n[s], weights, means_out[t, s], spread)
+
+
+@jit
+def simulate_chunk_nodes(first_trial, key, truth_nominal, truth_spread, error_kind, error_scale,
+                         seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref, smoothness,
+                         gravity, earth_enu, truth_out, nodes_out, rates_out, jitter_out):
+    """The deterministic half of trials ``first_trial …`` on the segment-statistics path.
+
+    Each trial's systematic draws (the same as on the sample-level path), its truth into
+    ``truth_out`` (T, 39) and :func:`noise_free_nodes` into ``nodes_out`` (T, S, 7, 6),
+    ``rates_out`` (T, S), ``jitter_out`` (T, S, 6), for :func:`simulate_chunk_statistics`.
+    Serial and ``nogil``: the engine runs slices of a chunk on a thread pool.
+    """
+    n_seg = seg_C0.shape[0]
+    draws = np.empty(_draws_length(n_seg))
+    for t in range(truth_out.shape[0]):
+        draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind, error_scale, n_seg, draws)
+        for k in range(N_TRUTH):
+            truth_out[t, k] = draws[k]
+        noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
+                         smoothness, gravity, earth_enu, nodes_out[t], rates_out[t], jitter_out[t])
 
 
 @inline_jit
@@ -300,27 +423,27 @@ def _segment_drift(drift, drift_coeffs, s, noise, stream, mean_out):
 
 
 @jit
-def simulate_trial_statistics(trial, key, draws,
-                              seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
-                              sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness, gravity,
-                              earth_enu, drift_coeffs, settling, needed, means_out):
-    """One calibration on the segment-statistics path; segment means into ``means_out`` (S, 6).
+def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg_dt, seg_gap, seg_rate,
+                              acquisition, noise, noise_times, smoothness, drift_coeffs, needed, means_out):
+    """The stochastic half of trials ``first_trial …``: noise, drift and quantisation of the segment means.
 
-    ``settling`` (S, 2, 3, 6): the drift transition over each segment's settling gap
-    (:func:`plansim.simulate.sample_path.drift_transition`), the same for every trial."""
-    stream, drift = noise_stream(key, trial, noise)
-    Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-    u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
-    y = np.empty(6)
+    ``nodes`` (T, S, 7, 6), ``rates`` (T, S), ``jitter`` (T, S, 6) come from
+    :func:`simulate_chunk_nodes`; the segment means go to ``means_out`` (T, S, 6). Each trial's
+    numbers come from its own noise stream (stream 1), so they do not depend on the chunking.
+    Where a quantiser's moments are averaged over more nodes than the 7, the output at the extra
+    angles is the trigonometric interpolation of the 7 node values (exact: degree ≤ 3 in θ).
+    Serial and ``nogil``: the engine runs slices of a chunk on a thread pool.
+    """
+    n_seg = seg_n.shape[0]
+    settling = np.empty((n_seg, 2, 3, 6))  # the drift transition over each settling gap, for every trial
+    for s in range(n_seg):
+        drift_transition(seg_gap[s], noise, noise_times, settling, s)
     det = np.empty(6)
     spread = np.empty(6)
-    jitter = np.empty(6)
     dbar = np.empty(6)
     w7 = np.empty(DETERMINISTIC_NODES)
-    nodes = np.empty((MAX_NODES + 2, 6))
-    rates = np.empty(MAX_NODES + 2)
-    scratch = np.empty((3, 6))
     wj = np.empty(MAX_NODES)
+    coefficients = np.empty((6, DETERMINISTIC_NODES))  # a0, a1, b1, a2, b2, a3, b3 per channel
     z_all = np.empty(6)
     white_all = np.empty(6)
     sigma_all = np.empty(6)
@@ -329,138 +452,91 @@ def simulate_trial_statistics(trial, key, draws,
     mode = np.empty(6, np.int64)
     gammas_all = np.empty((6, 3, 8))
     kmax_all = np.zeros(6, np.int64)
-    for s in range(seg_n.shape[0]):
-        rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                           earth_enu, lever, g_b0, om_b0, u, perp, frames)
-        rotating = seg_rate[s] != 0.0
-        stream = advance_drift(settling, s, drift, stream)
-        stream = _segment_drift(drift, drift_coeffs, s, noise, stream, dbar)
-        n = seg_n[s]
-        dt = seg_dt[s]
-        dT = seg_temp[s] - t_ref
-        # deterministic segment mean (exact) and the output's variation over θ
-        if rotating:
-            arc_weights(DETERMINISTIC_NODES, rate_act * dt, n, w7)
-            # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
-            h = 1e-6 * abs(rate_act)
-            for j in range(DETERMINISTIC_NODES):
-                rates[j] = rate_act
-            rates[DETERMINISTIC_NODES] = rate_act + h
-            rates[DETERMINISTIC_NODES + 1] = rate_act - h
-            evaluate_outputs(DETERMINISTIC_NODES, _JITTER_NODES, phase, rates, u, g_b0, om_b0, perp, dT, Kg,
-                             Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
-            for c in range(6):
-                det[c] = 0.0
-                for j in range(DETERMINISTIC_NODES):
-                    det[c] += w7[j] * nodes[j, c]
-            for c in range(6):
-                lo = nodes[0, c]
-                hi = nodes[0, c]
-                for j in range(1, DETERMINISTIC_NODES):
-                    lo = min(lo, nodes[j, c])
-                    hi = max(hi, nodes[j, c])
-                spread[c] = hi - lo
-            # rate jitter: linear response of each output to the table rate (central difference);
-            # the sample path jitters the gyro input w (so also P·w²), not the centripetal term
-            for c in range(6):
-                jitter[c] = (smoothness * rate_act * (nodes[DETERMINISTIC_NODES, c] - nodes[DETERMINISTIC_NODES + 1, c])
-                             / (2.0 * h))
-        else:
-            rates[0] = 0.0
-            evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
-            for c in range(6):
-                det[c] = nodes[0, c]
-                spread[c] = 0.0
-                jitter[c] = 0.0
-        zbar = 0.0
-        if rotating and smoothness > 0.0:
-            zbar, stream = normal(stream)
-            zbar /= math.sqrt(n)
-        # per channel: 0 linear (no quantiser, or no estimator uses it), 1 dithered, 2 quantised
-        # with a constant mean, 3 quantised while the output sweeps across it (average over θ)
-        J = np.int64(0)  # not a literal 0 (see DETERMINISTIC_NODES)
-        for c in range(6):
-            z_all[c], stream = normal(stream)
-            white_all[c] = noise[c, 0] / math.sqrt(dt)
-            step = acquisition[2] if c < 3 else acquisition[3]
-            sigma_all[c] = math.sqrt(white_all[c] * white_all[c] + jitter[c] * jitter[c])
-            if step <= 0.0 or needed[s, c] == 0:
-                mode[c] = 0
-                continue
-            tolerance = RELATIVE_TOLERANCE * sigma_all[c] / math.sqrt(n)
-            kmax_all[c] = fourier_damping(sigma_all[c], step, gammas_all, c)
-            # bias of the quantised mean: Σ_k q/(πk) γ_k (the first term when γ_1 is small)
-            bias_amplitude = 0.0
-            for k in range(kmax_all[c]):
-                bias_amplitude += abs(gammas_all[c, 0, k])  # q/(πk)·γ_k
-            if kmax_all[c] > 0 and bias_amplitude <= tolerance:
-                mode[c] = 1
-            elif spread[c] == 0.0:
-                mode[c] = 2
-            else:
-                mode[c] = 3
-                half = _harmonics_needed(spread[c], sigma_all[c], step, gammas_all, c, kmax_all[c], tolerance)
-                J = max(J, 2 * half + 1)
-        if J > 0:
-            if J == DETERMINISTIC_NODES:
-                for j in range(J):
-                    wj[j] = w7[j]
-            else:
-                arc_weights(J, rate_act * dt, n, wj)
-            for c in range(6):
-                mbar[c] = 0.0
-                vbar[c] = 0.0
-            if J != DETERMINISTIC_NODES:  # else the nodes of the deterministic mean serve
-                for j in range(J):
-                    rates[j] = rate_act
-                evaluate_outputs(J, _NO_EXTRA, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, nodes, scratch)
-            for j in range(J):
-                for c in range(6):
-                    y[c] = nodes[j, c]
-                for c in range(6):
-                    if mode[c] == 3:
-                        step = acquisition[2] if c < 3 else acquisition[3]
-                        m, v = _channel_moments(y[c] + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
-                        mbar[c] += wj[j] * m
-                        vbar[c] += wj[j] * v
-        for c in range(6):
-            base = det[c] + dbar[c]
-            step = acquisition[2] if c < 3 else acquisition[3]
-            if mode[c] == 0:
-                means_out[s, c] = base + white_all[c] / math.sqrt(n) * z_all[c] + jitter[c] * zbar
-            elif mode[c] == 1:  # dithered: unbiased, each sample adds q²/12 of independent variance
-                means_out[s, c] = (base + math.sqrt((white_all[c] * white_all[c] + step * step / 12.0) / n) * z_all[c]
-                                   + jitter[c] * zbar)
-            elif mode[c] == 2:
-                m, v = _channel_moments(base, sigma_all[c], step, gammas_all, c, kmax_all[c])
-                means_out[s, c] = m + math.sqrt(v / n) * z_all[c]
-            else:
-                means_out[s, c] = mbar[c] + math.sqrt(max(vbar[c], 0.0) / n) * z_all[c]
-
-
-@jit
-def simulate_chunk_statistics(first_trial, key, truth_nominal, truth_spread, error_kind,
-                              error_scale, seg_n, seg_dt, seg_gap, seg_C0, seg_rate, seg_axis, seg_axis_index,
-                              seg_temp, sensor, S2, lever, t_ref, acquisition, noise, noise_times, smoothness,
-                              gravity, earth_enu, drift_coeffs, needed, means_out, truth_out):
-    """Trials ``first_trial …`` on the segment-statistics path (same systematic draws as the sample path).
-
-    Serial and ``nogil``: the engine runs slices of a chunk on a thread pool.
-    """
-    n_seg = seg_n.shape[0]
-    settling = np.empty((n_seg, 2, 3, 6))
-    for s in range(n_seg):
-        drift_transition(seg_gap[s], noise, noise_times, settling, s)
     for t in range(means_out.shape[0]):
-        draws = np.empty(_draws_length(n_seg))
-        draw_systematic(first_trial + t, key, truth_nominal, truth_spread, error_kind,
-                        error_scale, n_seg, draws)
-        for k in range(N_TRUTH):
-            truth_out[t, k] = draws[k]
-        simulate_trial_statistics(first_trial + t, key, draws, seg_n, seg_dt, seg_gap, seg_C0,
-                                  seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
-                                  acquisition, noise, noise_times, smoothness, gravity, earth_enu, drift_coeffs,
-                                  settling, needed, means_out[t])
+        stream, drift = noise_stream(key, first_trial + t, noise)
+        trial_nodes = nodes[t]
+        for s in range(n_seg):
+            rotating = seg_rate[s] != 0.0
+            stream = advance_drift(settling, s, drift, stream)
+            stream = _segment_drift(drift, drift_coeffs, s, noise, stream, dbar)
+            n = seg_n[s]
+            dt = seg_dt[s]
+            rate_act = rates[t, s]
+            segment_mean_and_spread(trial_nodes, s, rate_act, dt, n, w7, det, spread)
+            zbar = 0.0
+            if rotating and smoothness > 0.0:
+                zbar, stream = normal(stream)
+                zbar /= math.sqrt(n)
+            # per channel: 0 linear (no quantiser, or no estimator uses it), 1 dithered, 2 quantised
+            # with a constant mean, 3 quantised while the output sweeps across it (average over θ)
+            J = np.int64(0)  # not a literal 0 (see DETERMINISTIC_NODES)
+            for c in range(6):
+                z_all[c], stream = normal(stream)
+                white_all[c] = noise[c, 0] / math.sqrt(dt)
+                step = acquisition[2] if c < 3 else acquisition[3]
+                sigma_all[c] = math.sqrt(white_all[c] * white_all[c] + jitter[t, s, c] * jitter[t, s, c])
+                if step <= 0.0 or needed[s, c] == 0:
+                    mode[c] = 0
+                    continue
+                tolerance = RELATIVE_TOLERANCE * sigma_all[c] / math.sqrt(n)
+                kmax_all[c] = fourier_damping(sigma_all[c], step, gammas_all, c)
+                # bias of the quantised mean: Σ_k q/(πk) γ_k (the first term when γ_1 is small)
+                bias_amplitude = 0.0
+                for k in range(kmax_all[c]):
+                    bias_amplitude += abs(gammas_all[c, 0, k])  # q/(πk)·γ_k
+                if kmax_all[c] > 0 and bias_amplitude <= tolerance:
+                    mode[c] = 1
+                elif spread[c] == 0.0:
+                    mode[c] = 2
+                else:
+                    mode[c] = 3
+                    half = _harmonics_needed(spread[c], sigma_all[c], step, gammas_all, c, kmax_all[c], tolerance)
+                    J = max(J, 2 * half + 1)
+            if J > 0:
+                if J == DETERMINISTIC_NODES:
+                    for j in range(J):
+                        wj[j] = w7[j]
+                else:
+                    arc_weights(J, rate_act * dt, n, wj)
+                    trigonometric_coefficients(trial_nodes, s, coefficients)
+                for c in range(6):
+                    mbar[c] = 0.0
+                    vbar[c] = 0.0
+                # cos/sin of m·2πj/J (m = 1, 2, 3) at node j, by angle addition
+                cd = math.cos(2.0 * math.pi / J)
+                sd = math.sin(2.0 * math.pi / J)
+                c1, s1 = 1.0, 0.0
+                for j in range(J):
+                    c2 = c1 * c1 - s1 * s1
+                    s2 = 2.0 * c1 * s1
+                    c3 = c2 * c1 - s2 * s1
+                    s3 = s2 * c1 + c2 * s1
+                    for c in range(6):
+                        if mode[c] == 3:
+                            if J == DETERMINISTIC_NODES:
+                                y = trial_nodes[s, j, c]
+                            else:
+                                y = (coefficients[c, 0] + coefficients[c, 1] * c1 + coefficients[c, 2] * s1
+                                     + coefficients[c, 3] * c2 + coefficients[c, 4] * s2
+                                     + coefficients[c, 5] * c3 + coefficients[c, 6] * s3)
+                            step = acquisition[2] if c < 3 else acquisition[3]
+                            m, v = _channel_moments(y + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
+                            mbar[c] += wj[j] * m
+                            vbar[c] += wj[j] * v
+                    c1, s1 = c1 * cd - s1 * sd, s1 * cd + c1 * sd
+            for c in range(6):
+                base = det[c] + dbar[c]
+                step = acquisition[2] if c < 3 else acquisition[3]
+                if mode[c] == 0:
+                    means_out[t, s, c] = base + white_all[c] / math.sqrt(n) * z_all[c] + jitter[t, s, c] * zbar
+                elif mode[c] == 1:  # dithered: unbiased, each sample adds q²/12 of independent variance
+                    means_out[t, s, c] = (base + math.sqrt((white_all[c] * white_all[c] + step * step / 12.0) / n)
+                                          * z_all[c] + jitter[t, s, c] * zbar)
+                elif mode[c] == 2:
+                    m, v = _channel_moments(base, sigma_all[c], step, gammas_all, c, kmax_all[c])
+                    means_out[t, s, c] = m + math.sqrt(v / n) * z_all[c]
+                else:
+                    means_out[t, s, c] = mbar[c] + math.sqrt(max(vbar[c], 0.0) / n) * z_all[c]
 
 
 _draws_length = jit(draws_length)

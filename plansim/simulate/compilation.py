@@ -1,0 +1,129 @@
+"""Compiling the kernels of a run before it starts, on every core.
+
+The first run after an install compiles the kernels of its simulation path; numba keeps them in
+its on-disk cache (:mod:`plansim._jit`) and every later run loads them in a fraction of a second.
+Compiling is slow — numba's compiler is Python code, and the segment path's kernels take several
+seconds each — so :func:`compile_kernels` shortens the cold start in two ways:
+
+- **Two processes.** The segment-statistics path has two entry kernels that share no compiled
+  code (:mod:`plansim.simulate.segment_path`). When neither is cached and the machine has a
+  second core, a second Python process compiles the first into the cache while this process
+  compiles the second; this process then loads the first from the cache. Which process compiled
+  a kernel changes nothing in it: numba builds the same code from the same source and types.
+- **No garbage collection while compiling.** numba's compiler allocates millions of short-lived
+  objects, and the cyclic collector's passes over them cost about a sixth of the compile time;
+  the collector is paused while compiling and restored after.
+
+If the second process fails, or the cache cannot be written, this process compiles the kernel
+itself (with a :class:`RuntimeWarning` if the process failed): the run goes on either way.
+
+Whether a kernel is already cached is asked of numba's cache with the lookup
+``Dispatcher.compile`` itself makes first (``dispatcher._cache.load_overload``). It is not a
+public API; should it change, every kernel counts as not cached, which costs time, never
+correctness.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import importlib
+import inspect
+import os
+import pickle
+import subprocess
+import sys
+import warnings
+
+import numba
+
+
+def bound_call(dispatcher, *args, **kwargs) -> tuple[object, tuple]:
+    """``(dispatcher, positional arguments)`` of the call ``dispatcher(*args, **kwargs)``."""
+    bound = inspect.signature(dispatcher.py_func).bind(*args, **kwargs)
+    return dispatcher, tuple(bound.args)
+
+
+def argument_types(arguments: tuple) -> tuple:
+    """The numba types a call with *arguments* from Python compiles for."""
+    return tuple(numba.typeof(value) for value in arguments)
+
+
+def is_compiled_or_cached(dispatcher, types: tuple) -> bool:
+    """True if *dispatcher* needs no compiling for *types*: compiled in this process or in numba's cache."""
+    if types in dispatcher.overloads:
+        return True
+    try:
+        return dispatcher._cache.load_overload(types, dispatcher.targetctx) is not None
+    except Exception:  # see the module docstring: assume not cached
+        return False
+
+
+@contextlib.contextmanager
+def collector_paused():
+    """Pause Python's cyclic garbage collector (numba's compiler makes it busy for nothing)."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = True) -> None:
+    """Compile (or load from the cache) each kernel of *calls* for the types of its arguments.
+
+    Parameters
+    ----------
+    calls : list of (dispatcher, arguments)
+        Entry kernels with arguments of the types the run will pass (values do not matter); see
+        :func:`bound_call`. Kernels must not call one another.
+    parallel : bool
+        Let a second process compile the first kernel when two or more need compiling and the
+        machine has two or more cores.
+    """
+    pending = [(dispatcher, argument_types(arguments)) for dispatcher, arguments in calls]
+    pending = [(dispatcher, types) for dispatcher, types in pending if not is_compiled_or_cached(dispatcher, types)]
+    if not pending:
+        return
+    offloaded, child = [], None
+    if parallel and len(pending) >= 2 and (os.cpu_count() or 1) >= 2:
+        offloaded, pending = pending[:1], pending[1:]
+        child = _start_compiling_elsewhere(offloaded)
+    with collector_paused():
+        for dispatcher, types in pending:
+            dispatcher.compile(types)
+    if child is None:
+        return
+    errors = child.stderr.read()  # to the end: the child has exited or is about to
+    child.stderr.close()
+    if child.wait() != 0:
+        warnings.warn(f"the second process compiling {offloaded[0][0].__name__} failed (exit {child.returncode}); "
+                      f"compiling it here instead:\n{errors.decode(errors='replace')[-2000:]}", RuntimeWarning,
+                      stacklevel=2)
+    with collector_paused():
+        for dispatcher, types in offloaded:
+            dispatcher.compile(types)  # from the cache the other process filled (or compiled here if it failed)
+
+
+def _start_compiling_elsewhere(requests: list[tuple[object, tuple]]) -> subprocess.Popen:
+    """Start ``python -m plansim.simulate.compilation`` compiling *requests* into numba's cache."""
+    payload = pickle.dumps([(d.py_func.__module__, d.py_func.__name__, types) for d, types in requests])
+    child = subprocess.Popen([sys.executable, "-m", "plansim.simulate.compilation"], stdin=subprocess.PIPE,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    child.stdin.write(payload)  # a few kB: fits the pipe, so this does not wait for the child
+    child.stdin.close()
+    return child
+
+
+def _compile_requests(stream) -> None:
+    """The second process: compile each ``(module, function, types)`` read from *stream* (pickled by the parent)."""
+    requests = pickle.load(stream)
+    gc.disable()  # this process only compiles
+    for module, name, types in requests:
+        getattr(importlib.import_module(module), name).compile(types)
+
+
+if __name__ == "__main__":
+    _compile_requests(sys.stdin.buffer)
