@@ -314,11 +314,13 @@ class _PathKernels:
 
 def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int = 4096, path: str = "sample",
                    progress: ProgressCallback | None = None):
-    """Yield ``(start, stop, means, truth)`` chunk by chunk; the buffers are reused (copy what you keep).
+    """Yield ``(start, stop, means, truth)`` chunk by chunk; a chunk's buffers are valid until the next
+    one is asked for (copy what you keep).
 
-    Working memory is bounded by *chunk_size* whatever the number of trials; trial *i* gives the
-    same numbers in any chunk (its random streams depend on the seed and *i* only). The path's
-    kernels are compiled (or loaded from numba's cache) first, on every core
+    Working memory is bounded by *chunk_size* whatever the number of trials (two chunks' buffers:
+    the threads simulate the next chunk while the caller uses this one); trial *i* gives the same
+    numbers in any chunk (its random streams depend on the seed and *i* only). The path's kernels
+    are compiled (or loaded from numba's cache) first, on every core
     (:func:`plansim.simulate.compilation.compile_kernels`).
     """
     _check_run_arguments(trials, chunk_size, path)
@@ -326,20 +328,29 @@ def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int =
     kernels = _PathKernels(scenario, path)
     compile_kernels(kernels.calls(key))
     size = min(chunk_size, trials)
-    means = np.empty((size, len(scenario.schedule), 6))
-    truth = np.empty((size, N_PARAMETERS))
+    buffers = [(np.empty((size, len(scenario.schedule), 6)), np.empty((size, N_PARAMETERS))) for _ in range(2)]
+    starts = list(range(0, trials, chunk_size))
     workers = numba.get_num_threads()  # honours numba.set_num_threads / NUMBA_NUM_THREADS
+
+    def submit(pool, index):
+        start = starts[index]
+        count = min(trials, start + chunk_size) - start
+        means, truth = buffers[index % 2]
+        # contiguous slices, one per thread; each trial's numbers depend on its index only
+        edges = np.linspace(0, count, min(workers, count) + 1).astype(int)
+        return [pool.submit(kernels.run_slice, start + int(a), key, means[a:b], truth[a:b])
+                for a, b in zip(edges[:-1], edges[1:])]
+
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        for start in range(0, trials, chunk_size):
-            stop = min(trials, start + chunk_size)
-            m, t = means[: stop - start], truth[: stop - start]
-            # contiguous slices, one per thread; each trial's numbers depend on its index only
-            edges = np.linspace(0, stop - start, min(workers, stop - start) + 1).astype(int)
-            jobs = [pool.submit(kernels.run_slice, start + int(a), key, m[a:b], t[a:b])
-                    for a, b in zip(edges[:-1], edges[1:])]
+        jobs = submit(pool, 0)
+        for index, start in enumerate(starts):
             for job in jobs:
                 job.result()
-            yield start, stop, m, t
+            if index + 1 < len(starts):
+                jobs = submit(pool, index + 1)  # into the other buffers, while the caller uses these
+            stop = min(trials, start + chunk_size)
+            means, truth = buffers[index % 2]
+            yield start, stop, means[: stop - start], truth[: stop - start]
             if progress is not None:
                 progress(stop, trials)
 
