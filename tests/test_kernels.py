@@ -38,17 +38,34 @@ _EXERCISE_EVERY_KERNEL = textwrap.dedent("""
         for name, value in vars(module).items():
             if isinstance(value, numba.core.registry.CPUDispatcher) and value.__module__ == module.__name__:
                 copies[module.__name__ + "." + name] = [str(s) for s in value.signatures]
-    print(json.dumps(copies))
+    from plansim.simulate import segment_path
+    loaded = {name: getattr(segment_path, name).stats.cache_hits for name in
+              ("simulate_chunk_nodes", "simulate_chunk_statistics")}
+    print(json.dumps({"copies": copies, "loaded_from_cache": {k: sum(v.values()) for k, v in loaded.items()}}))
 """)
 
 
-@pytest.mark.slow
-def test_every_kernel_is_compiled_once(tmp_path):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))  # empty cache: everything compiles here
+@pytest.fixture(scope="module")
+def cold_start_report(tmp_path_factory) -> dict:
+    """Run every kernel once in a fresh process with an empty cache (everything compiles there)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba-cache")))
     done = subprocess.run([sys.executable, "-c", _EXERCISE_EVERY_KERNEL], env=env, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-3000:]
-    copies = json.loads(done.stdout.strip().splitlines()[-1])
-    compiled = {name: signatures for name, signatures in copies.items() if signatures}
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.slow
+def test_every_kernel_is_compiled_once(cold_start_report):
+    compiled = {name: signatures for name, signatures in cold_start_report["copies"].items() if signatures}
     assert len(compiled) >= 10, f"too few kernels compiled to mean anything: {sorted(compiled)}"
     duplicated = {name: signatures for name, signatures in compiled.items() if len(signatures) > 1}
     assert not duplicated, "kernels compiled more than once (literal arguments?):\n" + json.dumps(duplicated, indent=1)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="one core: the kernels are compiled one after the other")
+def test_a_cold_start_compiles_the_two_segment_kernels_in_two_processes(cold_start_report):
+    """From an empty cache, one segment kernel is compiled here and the other by a second process:
+    this process then finds that one in the cache (one cache hit) and compiles the other (none)."""
+    loaded = cold_start_report["loaded_from_cache"]
+    assert sorted(loaded.values()) == [0, 1], loaded
