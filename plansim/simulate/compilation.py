@@ -14,8 +14,9 @@ seconds each — so :func:`compile_kernels` shortens the cold start in two ways:
   objects, and the cyclic collector's passes over them cost about a sixth of the compile time;
   the collector is paused while compiling and restored after.
 
-If the second process fails, or the cache cannot be written, this process compiles the kernel
-itself (with a :class:`RuntimeWarning` if the process failed): the run goes on either way.
+If the second process cannot start, fails or hangs (:data:`SECOND_PROCESS_TIMEOUT`), or the
+cache cannot be written, this process compiles the kernel itself (with a :class:`RuntimeWarning`
+in the first three cases): the run goes on either way.
 
 Whether a kernel is already cached is asked of numba's cache with the lookup
 ``Dispatcher.compile`` itself makes first (``dispatcher._cache.load_overload``). It is not a
@@ -25,6 +26,7 @@ correctness.
 
 from __future__ import annotations
 
+import base64
 import contextlib
 import gc
 import importlib
@@ -36,6 +38,9 @@ import sys
 import warnings
 
 import numba
+
+#: seconds to wait for the second process (a compile takes seconds; this only guards against a hang)
+SECOND_PROCESS_TIMEOUT = 600
 
 
 def bound_call(dispatcher, *args, **kwargs) -> tuple[object, tuple]:
@@ -90,15 +95,24 @@ def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = True) ->
     offloaded, child = [], None
     if parallel and len(pending) >= 2 and (os.cpu_count() or 1) >= 2:
         offloaded, pending = pending[:1], pending[1:]
-        child = _start_compiling_elsewhere(offloaded)
+        try:
+            child = _start_compiling_elsewhere(offloaded)
+        except OSError as error:  # no usable interpreter to start (an embedded Python, say)
+            warnings.warn(f"could not start a second process to compile ({error}); compiling here",
+                          RuntimeWarning, stacklevel=2)
+            offloaded, pending = [], offloaded + pending
     with collector_paused():
         for dispatcher, types in pending:
             dispatcher.compile(types)
     if child is None:
         return
-    errors = child.stderr.read()  # to the end: the child has exited or is about to
-    child.stderr.close()
-    if child.wait() != 0:
+    try:
+        _, errors = child.communicate(timeout=SECOND_PROCESS_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        _, errors = child.communicate()
+        errors += f"(no answer after {SECOND_PROCESS_TIMEOUT} s)".encode()
+    if child.returncode != 0:
         warnings.warn(f"the second process compiling {offloaded[0][0].__name__} failed (exit {child.returncode}); "
                       f"compiling it here instead:\n{errors.decode(errors='replace')[-2000:]}", RuntimeWarning,
                       stacklevel=2)
@@ -108,22 +122,21 @@ def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = True) ->
 
 
 def _start_compiling_elsewhere(requests: list[tuple[object, tuple]]) -> subprocess.Popen:
-    """Start ``python -m plansim.simulate.compilation`` compiling *requests* into numba's cache."""
+    """Start ``python -m plansim.simulate.compilation REQUESTS`` compiling *requests* into numba's cache
+    (REQUESTS: the pickled ``(module, function, types)`` list, base64, a few kB)."""
     payload = pickle.dumps([(d.py_func.__module__, d.py_func.__name__, types) for d, types in requests])
-    child = subprocess.Popen([sys.executable, "-m", "plansim.simulate.compilation"], stdin=subprocess.PIPE,
-                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    child.stdin.write(payload)  # a few kB: fits the pipe, so this does not wait for the child
-    child.stdin.close()
-    return child
+    return subprocess.Popen([sys.executable, "-m", "plansim.simulate.compilation",
+                             base64.b64encode(payload).decode("ascii")],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
-def _compile_requests(stream) -> None:
-    """The second process: compile each ``(module, function, types)`` read from *stream* (pickled by the parent)."""
-    requests = pickle.load(stream)
+def _compile_requests(encoded: str) -> None:
+    """The second process: compile each ``(module, function, types)`` of *encoded* (pickled by the parent)."""
+    requests = pickle.loads(base64.b64decode(encoded))
     gc.disable()  # this process only compiles
     for module, name, types in requests:
         getattr(importlib.import_module(module), name).compile(types)
 
 
 if __name__ == "__main__":
-    _compile_requests(sys.stdin.buffer)
+    _compile_requests(sys.argv[1])
