@@ -41,47 +41,38 @@ def test_bound_call_puts_keyword_arguments_in_place():
                                                       numba.typeof(np.empty(3)))
 
 
-def test_a_failed_second_process_warns_and_compiles_here(monkeypatch):
-    def failing_child(requests):
-        assert len(requests) == 1  # the first kernel was handed over
-        return subprocess.Popen([sys.executable, "-c", "import sys; sys.stderr.write('no compiler'); sys.exit(3)"],
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+def _child_that_exits_3(requests):
+    assert len(requests) == 1  # the first kernel was handed over
+    return subprocess.Popen([sys.executable, "-c", "import sys; sys.stderr.write('no compiler'); sys.exit(3)"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
-    monkeypatch.setattr(compilation, "_start_compiling_elsewhere", failing_child)
+
+def _child_that_cannot_start(requests):
+    raise FileNotFoundError("no such interpreter")
+
+
+def _child_that_hangs(requests):
+    return subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+@pytest.mark.parametrize("start_child, message", [
+    (_child_that_exits_3, r"(?s)failed \(exit 3\).*no compiler"),
+    (_child_that_cannot_start, "could not start a second process"),
+    (_child_that_hangs, "no answer after 1 s"),
+])
+def test_a_failed_second_process_costs_time_not_the_run(monkeypatch, start_child, message):
+    """Whatever goes wrong in the second process, a warning says so and the kernel is compiled here."""
+    monkeypatch.setattr(compilation, "_start_compiling_elsewhere", start_child)
+    monkeypatch.setattr(compilation, "SECOND_PROCESS_TIMEOUT", 1)
     monkeypatch.setattr(compilation.os, "cpu_count", lambda: 2)
     calls = _kernels()
-    with pytest.warns(RuntimeWarning, match=r"(?s)failed \(exit 3\).*no compiler"):
+    with pytest.warns(RuntimeWarning, match=message):
         compilation.compile_kernels(calls)
     for dispatcher, arguments in calls:
         assert len(dispatcher.signatures) == 1  # compiled here after all
         dispatcher(*arguments)
     assert np.array_equal(calls[1][1][2], [1.0, 2.0, 3.0])
-
-
-def test_a_second_process_that_cannot_start_costs_time_not_the_run(monkeypatch):
-    def no_interpreter(requests):
-        raise FileNotFoundError("no such interpreter")
-
-    monkeypatch.setattr(compilation, "_start_compiling_elsewhere", no_interpreter)
-    monkeypatch.setattr(compilation.os, "cpu_count", lambda: 2)
-    calls = _kernels()
-    with pytest.warns(RuntimeWarning, match="could not start a second process"):
-        compilation.compile_kernels(calls)
-    assert all(len(dispatcher.signatures) == 1 for dispatcher, _ in calls)
-
-
-def test_a_hung_second_process_is_stopped(monkeypatch):
-    def hanging_child(requests):
-        return subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"],
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-
-    monkeypatch.setattr(compilation, "_start_compiling_elsewhere", hanging_child)
-    monkeypatch.setattr(compilation, "SECOND_PROCESS_TIMEOUT", 1)
-    monkeypatch.setattr(compilation.os, "cpu_count", lambda: 2)
-    calls = _kernels()
-    with pytest.warns(RuntimeWarning, match="no answer after 1 s"):
-        compilation.compile_kernels(calls)
-    assert all(len(dispatcher.signatures) == 1 for dispatcher, _ in calls)
 
 
 def test_nothing_starts_when_everything_is_compiled(monkeypatch):
