@@ -29,7 +29,8 @@ import plansim
 from plansim.model.parameters import PARAMETER_NAMES
 from plansim.scenario import builtin_scenarios, parse_scenario
 from plansim.simulate.engine import choose_path, simulate_segment_means
-from plansim.simulate.segment_path import arc_weights, drift_coefficients, quantised_gaussian_moments, sin_cos_turns
+from plansim.simulate.segment_path import (arc_weights, drift_coefficients, fourier_damping, fourier_terms_needed,
+                                          moments_from_damping, quantised_gaussian_moments, sin_cos_turns)
 
 Z = 5.0  # standard errors allowed; two-sided p ≈ 6e-7 per comparison (39 parameters × 3 scenarios)
 
@@ -165,6 +166,32 @@ def test_quantised_gaussian_moments_match_the_level_sums(sigma, mu):
     exact_mean = np.sum(levels * q * p)
     exact_var = np.sum((levels * q - exact_mean) ** 2 * p)
     assert abs(mean - exact_mean) < 1e-11 and abs(var - exact_var) < 1e-11
+
+
+@pytest.mark.parametrize("sigma", [0.2, 0.25, 0.41, 0.58, 1.0])
+@pytest.mark.parametrize("bias_tolerance, variance_tolerance", [(1e-4, 1e-4), (1e-6, 1e-7), (1e-9, 1e-10)])
+def test_a_cut_fourier_series_moves_the_moments_within_its_tolerances(sigma, bias_tolerance, variance_tolerance):
+    """fourier_terms_needed keeps the fewest terms whose dropped tail moves the quantised mean and
+    variance by at most the given amounts: checked against the full series over a period of μ."""
+    q = 1.0
+    coefficients = np.empty((1, 3, 8))
+    row = np.int64(0)
+    full = fourier_damping(sigma, q, coefficients, row)
+    kept = fourier_terms_needed(coefficients, row, full, sigma, bias_tolerance, variance_tolerance)
+    assert 0 <= kept <= full  # 0: even the first term is below tolerance (the noise dithers)
+    worst_mean = worst_var = 0.0
+    for mu in np.linspace(-0.5, 0.5, 201):
+        m_full, v_full = moments_from_damping(mu, sigma, q, coefficients, row, full)
+        m_cut, v_cut = moments_from_damping(mu, sigma, q, coefficients, row, kept)
+        worst_mean, worst_var = max(worst_mean, abs(m_cut - m_full)), max(worst_var, abs(v_cut - v_full))
+    assert worst_mean <= bias_tolerance and worst_var <= variance_tolerance
+    if kept > 1:  # and one term fewer would not do: the cut is the fewest terms
+        fewer = np.int64(kept - 1)
+        moved = max(max(abs(moments_from_damping(mu, sigma, q, coefficients, row, fewer)[i]
+                            - moments_from_damping(mu, sigma, q, coefficients, row, full)[i]) / tolerance
+                        for i, tolerance in ((0, bias_tolerance), (1, variance_tolerance)))
+                    for mu in np.linspace(-0.5, 0.5, 201))
+        assert moved > 0.5  # within a factor 2 of the bound: the bound is not loose by orders
 
 
 def test_sin_cos_in_turns_matches_numpy_to_a_few_ulp():
