@@ -35,7 +35,7 @@ import numpy as np
 SCENARIO = "jjf2003"
 
 
-ROUNDS = 5  # rounds per throughput figure (best round kept)
+ROUNDS = 7  # rounds per throughput figure (best round kept)
 
 
 def _best_of(function, repeats: int = ROUNDS) -> float:

@@ -553,31 +553,33 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
                 else:
                     arc_weights(J, rate_act * dt, n, wj)
                     trigonometric_coefficients(trial_nodes, s, coefficients)
+                if J != DETERMINISTIC_NODES:  # node j at θ0 + 2πj/J: cos/sin of m·2πj/J by angle addition
+                    cd = math.cos(2.0 * math.pi / J)
+                    sd = math.sin(2.0 * math.pi / J)
                 for c in range(6):
-                    mbar[c] = 0.0
-                    vbar[c] = 0.0
-                # cos/sin of m·2πj/J (m = 1, 2, 3) at node j, by angle addition
-                cd = math.cos(2.0 * math.pi / J)
-                sd = math.sin(2.0 * math.pi / J)
-                c1, s1 = 1.0, 0.0
-                for j in range(J):
-                    c2 = c1 * c1 - s1 * s1
-                    s2 = 2.0 * c1 * s1
-                    c3 = c2 * c1 - s2 * s1
-                    s3 = s2 * c1 + c2 * s1
-                    for c in range(6):
-                        if mode[c] == 3:
-                            if J == DETERMINISTIC_NODES:
-                                y = trial_nodes[s, j, c]
-                            else:
-                                y = (coefficients[c, 0] + coefficients[c, 1] * c1 + coefficients[c, 2] * s1
-                                     + coefficients[c, 3] * c2 + coefficients[c, 4] * s2
-                                     + coefficients[c, 5] * c3 + coefficients[c, 6] * s3)
-                            step = acquisition[2] if c < 3 else acquisition[3]
-                            m, v = _channel_moments(y + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
-                            mbar[c] += wj[j] * m
-                            vbar[c] += wj[j] * v
-                    c1, s1 = c1 * cd - s1 * sd, s1 * cd + c1 * sd
+                    if mode[c] != 3:
+                        continue
+                    step = acquisition[2] if c < 3 else acquisition[3]
+                    mean_sum = 0.0
+                    variance_sum = 0.0
+                    c1, s1 = 1.0, 0.0
+                    for j in range(J):
+                        if J == DETERMINISTIC_NODES:
+                            y = trial_nodes[s, j, c]
+                        else:
+                            c2 = c1 * c1 - s1 * s1
+                            s2 = 2.0 * c1 * s1
+                            c3 = c2 * c1 - s2 * s1
+                            s3 = s2 * c1 + c2 * s1
+                            y = (coefficients[c, 0] + coefficients[c, 1] * c1 + coefficients[c, 2] * s1
+                                 + coefficients[c, 3] * c2 + coefficients[c, 4] * s2
+                                 + coefficients[c, 5] * c3 + coefficients[c, 6] * s3)
+                            c1, s1 = c1 * cd - s1 * sd, s1 * cd + c1 * sd
+                        m, v = _channel_moments(y + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
+                        mean_sum += wj[j] * m
+                        variance_sum += wj[j] * v
+                    mbar[c] = mean_sum
+                    vbar[c] = variance_sum
             for c in range(6):
                 base = det[c] + dbar[c]
                 step = acquisition[2] if c < 3 else acquisition[3]
