@@ -14,9 +14,10 @@ import math
 import numpy as np
 import tomli_w
 import xarray as xr
+from threadpoolctl import threadpool_limits
 
 import plansim
-from plansim.estimate import reduce
+from plansim.estimate import reduce, reduction_matrix
 from plansim.model.parameters import PARAMETERS, PARAMETER_NAMES
 from plansim.scenario import Scenario, load_scenario
 from plansim.model.parameters import N_PARAMETERS
@@ -70,11 +71,20 @@ def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: i
     truth = np.empty((trials, N_PARAMETERS))
     estimate = np.empty((trials, N_PARAMETERS))
     means = np.empty((trials, len(sc.schedule), 6)) if keep_segment_means else None
-    for start, stop, m, t in iterate_chunks(sc, trials, seed, chunk_size, chosen, progress):
-        truth[start:stop] = t
-        estimate[start:stop] = reduce(m, sc.schedule, sc.reduction.reference_gravity, sc.reduction.omega_squared_sign)
-        if means is not None:
-            means[start:stop] = m
+    # the JJF 2003 formulas are linear in the segment means: one matrix product per chunk
+    matrix = reduction_matrix(sc.schedule, sc.reduction.reference_gravity, sc.reduction.omega_squared_sign)
+    # the simulation threads use every core: a multithreaded BLAS would only compete with them (its
+    # idle threads spin between chunks; measured: 10-30 % more CPU for the same run)
+    with threadpool_limits(limits=1, user_api="blas"):
+        for start, stop, m, t in iterate_chunks(sc, trials, seed, chunk_size, chosen, progress):
+            truth[start:stop] = t
+            if matrix is not None:
+                np.matmul(m.reshape(stop - start, -1), matrix, out=estimate[start:stop])
+            else:
+                estimate[start:stop] = reduce(m, sc.schedule, sc.reduction.reference_gravity,
+                                              sc.reduction.omega_squared_sign)
+            if means is not None:
+                means[start:stop] = m
     results = results_dataset(sc, truth, estimate, seed, means)
     results.attrs["simulation_path"] = PATH_NAMES[chosen]
     results.attrs["simulation_path_requested"] = path

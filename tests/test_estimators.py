@@ -15,7 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from plansim.estimate.jjf2003 import (DESIGN_MATRIX_A, check_design, line_fit, multi_position_design,
-                                      multi_position_fit, rate_sensitivity, reduce, segment_mean)
+                                      multi_position_fit, rate_sensitivity, reduce, reduction_matrix,
+                                      segment_mean)
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, pack, unpack
 from plansim.scenario import parse_scenario
 from plansim.schedule import axis_vector, jjf2003
@@ -373,3 +374,43 @@ def test_reduce_white_noise_on_rate_points_only_gives_closed_form_Kg_variance(id
     noise_free = reduce(clean, schedule, g)
     np.testing.assert_allclose(estimate[:, ~is_Kg], np.broadcast_to(noise_free[~is_Kg], (reps, (~is_Kg).sum())),
                                rtol=1e-12, atol=0)
+
+
+# ----------------------------------------------------------------------------- the reduction as one matrix
+
+
+@pytest.mark.parametrize("positions, rate_points", [(12, RATE_POINTS), (6, [-3.0, 0.5, 2.0])])
+@pytest.mark.parametrize("sign", ["model", "as_printed"])
+def test_reduction_matrix_is_reduce_to_rounding(positions, rate_points, sign):
+    """The estimators are linear in the segment means, so reduce is one matrix (runner.run uses it)."""
+    schedule = jjf2003(rate_points=rate_points, omega_squared_rate=OMEGA_SQUARED_RATE, positions=positions)
+    matrix = reduction_matrix(schedule, STANDARD_GRAVITY, sign)
+    assert matrix.shape == (6 * len(schedule), N_PARAMETERS)
+    means = np.random.default_rng(positions).normal(0.0, 5.0, size=(50, len(schedule), 6))
+    direct = reduce(means, schedule, STANDARD_GRAVITY, sign)
+    scale = np.abs(means.reshape(50, -1)) @ np.abs(matrix)  # what rounding can reach, per estimate
+    assert np.all(np.abs(means.reshape(50, -1) @ matrix - direct) <= 1e-13 * scale)
+
+
+def test_a_reduction_that_is_not_linear_is_not_made_a_matrix(monkeypatch):
+    """If reduce were not linear, reduction_matrix refuses (None) and runner.run falls back to reduce."""
+    import plansim
+    import plansim.estimate.jjf2003 as module
+    import plansim.runner as runner
+
+    linear = module.reduce
+
+    def squared(means, *args):
+        estimate = linear(means, *args)
+        return estimate + 1e-3 * estimate**2
+
+    monkeypatch.setattr(module, "reduce", squared)
+    schedule = jjf2003(rate_points=RATE_POINTS, omega_squared_rate=OMEGA_SQUARED_RATE)
+    assert reduction_matrix(schedule, STANDARD_GRAVITY) is None
+    monkeypatch.setattr(runner, "reduce", squared)
+    monkeypatch.setattr(runner, "reduction_matrix", module.reduction_matrix)
+    results = plansim.run("jjf2003", trials=3, seed=4, keep_segment_means=True)
+    sc = plansim.load_scenario("jjf2003")
+    expected = squared(results["segment_mean"].values, sc.schedule, sc.reduction.reference_gravity,
+                       sc.reduction.omega_squared_sign)
+    np.testing.assert_array_equal(results["estimate"].values, expected)
