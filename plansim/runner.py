@@ -14,7 +14,6 @@ import math
 import numpy as np
 import tomli_w
 import xarray as xr
-from threadpoolctl import threadpool_limits
 
 import plansim
 from plansim.estimate import reduce, reduction_matrix
@@ -73,18 +72,15 @@ def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: i
     means = np.empty((trials, len(sc.schedule), 6)) if keep_segment_means else None
     # the JJF 2003 formulas are linear in the segment means: one matrix product per chunk
     matrix = reduction_matrix(sc.schedule, sc.reduction.reference_gravity, sc.reduction.omega_squared_sign)
-    # the simulation threads use every core: a multithreaded BLAS would only compete with them (its
-    # idle threads spin between chunks; measured: 10-30 % more CPU for the same run)
-    with threadpool_limits(limits=1, user_api="blas"):
-        for start, stop, m, t in iterate_chunks(sc, trials, seed, chunk_size, chosen, progress):
-            truth[start:stop] = t
-            if matrix is not None:
-                np.matmul(m.reshape(stop - start, -1), matrix, out=estimate[start:stop])
-            else:
-                estimate[start:stop] = reduce(m, sc.schedule, sc.reduction.reference_gravity,
-                                              sc.reduction.omega_squared_sign)
-            if means is not None:
-                means[start:stop] = m
+    for start, stop, m, t in iterate_chunks(sc, trials, seed, chunk_size, chosen, progress):
+        truth[start:stop] = t
+        if matrix is not None:
+            np.matmul(m.reshape(stop - start, -1), matrix, out=estimate[start:stop])
+        else:
+            estimate[start:stop] = reduce(m, sc.schedule, sc.reduction.reference_gravity,
+                                          sc.reduction.omega_squared_sign)
+        if means is not None:
+            means[start:stop] = m
     results = results_dataset(sc, truth, estimate, seed, means)
     results.attrs["simulation_path"] = PATH_NAMES[chosen]
     results.attrs["simulation_path_requested"] = path

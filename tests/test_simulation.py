@@ -162,3 +162,22 @@ def test_non_whole_turn_windows_leak_the_horizontal_earth_rate_into_cross_coupli
     horizontal = EARTH_RATE * math.cos(math.radians(39.9))
     assert errs["whole"] < 1e-9 * horizontal / math.radians(36)
     assert errs["partial"] > 1e-4 * horizontal / math.radians(37)
+
+
+def test_blas_runs_on_one_thread_while_the_kernels_run_and_is_restored_after():
+    """The engine's threads use every core; numpy's BLAS is held to one thread meanwhile (see
+    plansim.simulate.engine.iterate_chunks) and given its threads back when the last chunk is used."""
+    from threadpoolctl import threadpool_info
+
+    from plansim.simulate.engine import iterate_chunks
+
+    def blas_threads():
+        return [info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"]
+
+    before = blas_threads()
+    if not before:
+        pytest.skip("numpy reports no BLAS library to limit")
+    during = [blas_threads() for _ in iterate_chunks(plansim.load_scenario("jjf2003"), 4, 1, chunk_size=2,
+                                                     path="segment")]
+    assert len(during) == 2 and all(threads == [1] * len(before) for threads in during)
+    assert blas_threads() == before
