@@ -292,3 +292,12 @@ def test_earth_rate_enu_at_30_degrees_by_hand():
     assert w[0] == 0.0
     assert w[1] == pytest.approx(13.025946, abs=1e-6)
     assert w[2] == pytest.approx(7.520533, abs=1e-6)
+
+
+def test_the_stored_gauss_markov_allan_peak_is_the_computed_one():
+    """GM_ALLAN_PEAK (the σ of the bias-instability stand-in depends on it) is written down to spare
+    every run the import of scipy.optimize; recomputed here, it must agree to the last digits."""
+    from plansim.simulate.engine import GM_ALLAN_PEAK, gauss_markov_allan_peak
+
+    assert GM_ALLAN_PEAK == pytest.approx(gauss_markov_allan_peak(), rel=1e-12)
+    assert GM_ALLAN_PEAK == pytest.approx(0.6174, abs=5e-5)  # the value docs/model.md quotes
