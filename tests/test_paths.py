@@ -128,6 +128,20 @@ def test_runner_takes_the_segment_path_only_where_it_is_exact():
         choose_path(parse_scenario(doc), "fast")
 
 
+def test_a_noiseless_quantiser_on_a_turning_table_takes_the_sample_path():
+    """Quantised without noise, a turning channel's output is a staircase in the table angle: the
+    segment path's average over θ at nodes is not exact for it, so the runner refuses that path.
+    At rest the same quantiser is plain rounding, which the segment path reproduces exactly."""
+    doc = _document("ideal")
+    doc["acquisition"] = {"bits": 12, "gyro_full_scale": "125 deg/s", "accel_full_scale": "8 g"}
+    path, reasons = choose_path(parse_scenario(doc))
+    assert path == "sample"
+    assert any("gx is quantised without white noise" in r for r in reasons), reasons
+    assert any("ax is quantised without white noise" in r for r in reasons), reasons  # the ω² test turns too
+    doc["mimu"]["noise"] = {"gyro_angle_random_walk": "0.15 deg/sqrt(h)", "accel_velocity_random_walk": "0.012 m/s/sqrt(h)"}
+    assert choose_path(parse_scenario(doc)) == ("segment", [])
+
+
 def test_results_do_not_depend_on_the_chunk_size_on_the_segment_path():
     sc = plansim.load_scenario("jjf2003")
     a, _ = simulate_segment_means(sc, 37, seed=3, chunk_size=37, path="segment")

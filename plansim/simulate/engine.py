@@ -192,7 +192,8 @@ def segment_path_exactness(scenario: Scenario) -> list[str]:
     Checks, each stated in :mod:`plansim.simulate.segment_path`: no gyro asymmetry; no
     saturation (:func:`output_bound` plus 6σ of white noise and drift inside the output range and
     the acquisition full scale); for quantised channels that the noise does not dither, drift small
-    against the noise (≤ 0.1σ) so that its variation within a segment does not move the quantiser.
+    against the noise (≤ 0.1σ) so that its variation within a segment does not move the quantiser;
+    and some white noise on every quantised channel an estimator reads while the table turns.
     """
     reasons = []
     e, a = scenario.effects, scenario.acquisition
@@ -216,6 +217,13 @@ def segment_path_exactness(scenario: Scenario) -> list[str]:
         for c in np.flatnonzero(~dithered & (drift_sigma > 0.1 * np.maximum(white, 1e-300))):
             reasons.append(f"channel {CHANNELS[c]}: drift σ {drift_sigma[c]:.3g} > 0.1 × white σ {white[c]:.3g} "
                            "in a quantiser the noise does not dither")
+        # without noise a quantiser's output is a staircase in the table angle while the table turns,
+        # which an average over θ at nodes cannot catch (at rest it is plain rounding, which is exact)
+        rotating = np.array([seg.rate != 0.0 for seg in scenario.schedule.segments])
+        needed_turning = needed_channels(scenario.schedule)[rotating].any(axis=0)
+        for c in np.flatnonzero((white == 0.0) & needed_turning):
+            reasons.append(f"channel {CHANNELS[c]} is quantised without white noise while the table turns: its "
+                           "output is a staircase in the table angle, not a smooth function to average")
     return reasons
 
 
