@@ -553,7 +553,7 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
                 else:
                     arc_weights(J, rate_act * dt, n, wj)
                     trigonometric_coefficients(trial_nodes, s, coefficients)
-                if J != DETERMINISTIC_NODES:  # node j at θ0 + 2πj/J: cos/sin of m·2πj/J by angle addition
+                    # node j at θ0 + 2πj/J: cos/sin of m·2πj/J by angle addition
                     cd = math.cos(2.0 * math.pi / J)
                     sd = math.sin(2.0 * math.pi / J)
                 for c in range(6):
