@@ -23,10 +23,6 @@ from plansim.model.parameters import N_PARAMETERS
 from plansim.simulate.engine import PATH_NAMES, ProgressCallback, choose_path, iterate_chunks
 
 
-def package_version() -> str:
-    return plansim.__version__
-
-
 def _scenario_of(scenario: Scenario | str) -> Scenario:
     if isinstance(scenario, Scenario):
         return scenario
@@ -123,7 +119,7 @@ def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed:
         "seed": int(seed) if int(seed) <= 2**31 - 1 else str(int(seed)),
         "trials": int(n),
         "simulation_path": "sample-level",
-        "plansim_version": package_version(),
+        "plansim_version": plansim.__version__,
         "reference_gravity_m_s2": float(sc.reduction.reference_gravity),
         "reference_gravity_choice": sc.reduction.reference_gravity_label,
         "local_gravity_m_s2": float(sc.environment.gravity),
