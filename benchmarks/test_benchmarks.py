@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import plansim
-from plansim.scenario import load_scenario
-from plansim.simulate.engine import simulate_segment_means
+from plansim.io.scenario_file import load_scenario
+from plansim.simulate.chunks import simulate_segment_means
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,7 @@
 >>> results = plansim.run("ideal", trials=10, seed=1)        # doctest: +SKIP
 >>> float(abs(results.error).max())                          # doctest: +SKIP
 
-The public names are imported on first use (PEP 562): ``import plansim.simulate…`` alone, as the
+The public names are imported on first use (PEP 562): ``import plansim.kernels…`` alone, as the
 process that compiles kernels in parallel does (:mod:`plansim.simulate.compilation`), does not
 pay for xarray and the rest of the orchestrator.
 """
@@ -17,10 +17,12 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "unknown"
 
-_PUBLIC = {"run": "plansim.runner", "Scenario": "plansim.scenario", "builtin_scenarios": "plansim.scenario",
-           "load_scenario": "plansim.scenario", "save_scenario": "plansim.scenario"}
+_PUBLIC = {"run": "plansim.runner", "Scenario": "plansim.config", "parse_scenario": "plansim.config",
+           "builtin_scenarios": "plansim.io.scenario_file", "load_scenario": "plansim.io.scenario_file",
+           "save_scenario": "plansim.io.scenario_file", "simulate_and_record": "plansim.runner"}
 
-__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "run", "save_scenario", "__version__"]
+__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "parse_scenario", "run", "save_scenario",
+           "simulate_and_record", "__version__"]
 
 
 def __getattr__(name: str):

@@ -63,8 +63,8 @@ def _numpy_draws(count: int):
 
 def _sample_path_run(trials: int):
     """One run of the sample-level path on the default scenario. Returns (run, IMU samples simulated)."""
-    from plansim.scenario import load_scenario
-    from plansim.simulate.engine import simulate_segment_means
+    from plansim.io.scenario_file import load_scenario
+    from plansim.simulate.chunks import simulate_segment_means
 
     sc = load_scenario(SCENARIO)
     simulate_segment_means(sc, 2, seed=1, path="sample")  # compile / load from cache

@@ -31,11 +31,11 @@ def _check_output(path: str | None, suffixes: tuple[str, ...], option: str) -> N
 
 
 def _cmd_run(args) -> int:
-    from plansim.report.files import atomic_write
-    from plansim.report.table import appendix_a_table, header, parameter_table
-    from plansim.runner import parameter_summary, run
-    from plansim.scenario import load_scenario
-    from plansim.simulate.engine import stderr_progress
+    from plansim.io.files import atomic_write
+    from plansim.io.scenario_file import load_scenario
+    from plansim.report.progress import stderr_progress
+    from plansim.report.table import appendix_a_table, header, parameter_summary, parameter_table
+    from plansim.runner import run
     from plansim.uncertainty import compare_with_appendix_a
 
     _check_output(args.out, (".nc",), "--out")
@@ -85,7 +85,7 @@ def _cmd_run(args) -> int:
 def _cmd_scenarios(args) -> int:
     import tomllib
 
-    from plansim.scenario import builtin_scenarios
+    from plansim.io.scenario_file import builtin_scenarios
 
     for name, path in builtin_scenarios().items():
         with open(path, "rb") as fh:
@@ -95,8 +95,9 @@ def _cmd_scenarios(args) -> int:
 
 
 def _cmd_record(args) -> int:
-    from plansim.recording import simulate_and_record, write_recording
-    from plansim.scenario import load_scenario
+    from plansim.io.recording import write_recording
+    from plansim.io.scenario_file import load_scenario
+    from plansim.runner import simulate_and_record
 
     _check_output(args.out, (".nc", ".csv"), "--out")
     scenario = load_scenario(args.scenario)

@@ -1,4 +1,4 @@
-"""The orchestrator: scenario -> Monte Carlo calibrations -> self-describing results.
+"""The orchestrator: scenario -> Monte Carlo calibrations -> self-describing results; one trial -> a recording.
 
 ``run`` simulates *trials* calibrations of the scenario, reduces each with the JJF 2003 formulas
 and returns an :class:`xarray.Dataset` with ``truth``, ``estimate`` and ``error`` over
@@ -16,11 +16,14 @@ import tomli_w
 import xarray as xr
 
 import plansim
+from plansim.config import Scenario
 from plansim.estimate import reduce, reduction_matrix
-from plansim.model.parameters import PARAMETERS, PARAMETER_NAMES
-from plansim.scenario import Scenario, load_scenario
-from plansim.model.parameters import N_PARAMETERS
-from plansim.simulate.engine import PATH_NAMES, ProgressCallback, choose_path, iterate_chunks
+from plansim.io.recording import UNITS_DESCRIPTION, Recording, plansim_version
+from plansim.io.scenario_file import load_scenario
+from plansim.kernels.layout import CHANNELS
+from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, PARAMETERS
+from plansim.simulate.chunks import ProgressCallback, iterate_chunks, simulate_recording
+from plansim.simulate.paths import PATH_NAMES, choose_path
 
 
 def _scenario_of(scenario: Scenario | str) -> Scenario:
@@ -50,7 +53,7 @@ def run(scenario: Scenario | str = "jjf2003", trials: int | None = None, seed: i
         Also return the mean output of every segment (trial × segment × channel).
     path : {"auto", "sample", "segment"}
         Simulation path. ``auto`` takes the segment-statistics path only where it is exact
-        (:func:`plansim.simulate.engine.segment_path_exactness`); the path used and, if the
+        (:func:`plansim.simulate.paths.segment_path_exactness`); the path used and, if the
         segment path was not exact, why, are in ``attrs``.
 
     Returns
@@ -107,7 +110,7 @@ def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed:
     }
     if segment_means is not None:
         coords["segment"] = ("segment", [s.label for s in sc.schedule.segments])
-        coords["channel"] = ("channel", ["gx", "gy", "gz", "ax", "ay", "az"])
+        coords["channel"] = ("channel", list(CHANNELS))
         data["segment_mean"] = (("trial", "segment", "channel"), segment_means,
                                 {"units": "rad/s (gyro), m/s^2 (accelerometer)", "long_name": "mean output, eq. (3)"})
     attrs = {
@@ -129,17 +132,29 @@ def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed:
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def parameter_summary(results: xr.Dataset) -> list[dict]:
-    """Per parameter: name, SI unit, mean truth, mean error and standard deviation of the error."""
-    err = results["error"]
-    out = []
-    for name in results["parameter"].values:
-        e = err.sel(parameter=name).values
-        out.append({
-            "name": str(name),
-            "unit": str(results["units"].sel(parameter=name).values),
-            "truth": float(results["truth"].sel(parameter=name).mean()),
-            "mean_error": float(np.mean(e)),
-            "std_error": float(np.std(e, ddof=1)) if e.size > 1 else 0.0,
-        })
-    return out
+def simulate_and_record(scenario, seed: int, trial: int = 0) -> Recording:
+    """Simulate one trial of *scenario* and return every raw sample as a :class:`Recording`.
+
+    Parameters
+    ----------
+    scenario : plansim.config.Scenario
+        The simulated world and schedule.
+    seed : int
+        Root seed, >= 0 (the same as for :func:`run`).
+    trial : int
+        Trial number, >= 0; the recording holds the same numbers that trial gives in a Monte Carlo run.
+
+    Returns
+    -------
+    Recording
+        ``attrs`` holds ``plansim_version``, ``scenario``, ``seed``, ``trial``, ``source = "simulated"``
+        and ``units``. The true parameters of the simulated unit are not kept; call
+        :func:`plansim.simulate.chunks.simulate_recording` for them.
+    """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario: expected a plansim Scenario (see plansim.io.scenario_file.load_scenario), "
+                        f"got {type(scenario).__name__}")
+    samples, _segment_means, _truth = simulate_recording(scenario, seed, trial)
+    attrs = {"plansim_version": plansim_version(), "scenario": scenario.name, "seed": int(seed),
+             "trial": int(trial), "source": "simulated", "units": UNITS_DESCRIPTION}
+    return Recording(samples=samples, schedule=scenario.schedule, attrs=attrs)

@@ -11,7 +11,7 @@ import pytest
 from scipy.stats import norm
 
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
-from plansim.scenario import load_scenario
+from plansim.io.scenario_file import load_scenario
 from plansim.schedule.segments import Schedule
 from plansim.uncertainty import (
     APPENDIX_A,

@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 
 from plansim.cli import main
-from plansim.recording import read_recording
+from plansim.io.recording import read_recording
 
 
 def run_cli(capsys, *argv):
@@ -113,7 +113,8 @@ def test_a_seed_beyond_32_bits_is_written_to_netcdf(capsys, tmp_path):
 def test_a_custom_segment_without_up_is_an_error_naming_it(tmp_path):
     import tomllib
 
-    from plansim.scenario import builtin_scenarios, parse_scenario
+    from plansim.io.scenario_file import builtin_scenarios
+    from plansim.config import parse_scenario
 
     with open(builtin_scenarios()["ideal"], "rb") as fh:
         doc = tomllib.load(fh)

@@ -19,8 +19,8 @@ from GTC import reporting, tb, ureal
 from plansim.estimate import reduce
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS, unpack
 from plansim.runner import run
-from plansim.scenario import load_scenario
-from plansim.simulate.segment_path import quantised_gaussian_moments
+from plansim.io.scenario_file import load_scenario
+from plansim.kernels.quantiser import quantised_gaussian_moments
 from plansim.uncertainty import APPENDIX_A, appendix_a_budget
 from plansim.uncertainty.gum import (combine, coverage_factor, drift_covariance, estimator_matrix, evaluate_gum,
                                      quantisation_covariance, quantisation_variance, systematic_effects,

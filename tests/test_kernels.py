@@ -22,10 +22,10 @@ import pytest
 _EXERCISE_EVERY_KERNEL = textwrap.dedent("""
     import importlib, json, pkgutil
     import numba
-    import plansim.simulate
-    from plansim.scenario import load_scenario
-    from plansim.simulate.engine import (nominal_draws, noise_free_segment_means, simulate_recording,
-                                         simulate_segment_means)
+    import plansim.kernels
+    from plansim.io.scenario_file import load_scenario
+    from plansim.simulate.arguments import nominal_draws, noise_free_segment_means
+    from plansim.simulate.chunks import simulate_recording, simulate_segment_means
 
     scenario = load_scenario("jjf2003")
     simulate_segment_means(scenario, 3, 1, path="segment")
@@ -33,12 +33,12 @@ _EXERCISE_EVERY_KERNEL = textwrap.dedent("""
     simulate_recording(scenario, 1)
     noise_free_segment_means(scenario, nominal_draws(scenario)[None])
     copies = {}
-    for module_info in pkgutil.iter_modules(plansim.simulate.__path__):
-        module = importlib.import_module("plansim.simulate." + module_info.name)
+    for module_info in pkgutil.iter_modules(plansim.kernels.__path__):
+        module = importlib.import_module("plansim.kernels." + module_info.name)
         for name, value in vars(module).items():
             if isinstance(value, numba.core.registry.CPUDispatcher) and value.__module__ == module.__name__:
                 copies[module.__name__ + "." + name] = [str(s) for s in value.signatures]
-    from plansim.simulate import segment_path
+    from plansim.kernels import segment_path
     loaded = {name: getattr(segment_path, name).stats.cache_hits for name in
               ("simulate_chunk_nodes", "simulate_chunk_statistics")}
     print(json.dumps({"copies": copies, "loaded_from_cache": {k: sum(v.values()) for k, v in loaded.items()}}))

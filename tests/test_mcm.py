@@ -24,7 +24,7 @@ from scipy import stats
 from plansim.cli import main
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
 from plansim.runner import run
-from plansim.scenario import load_scenario
+from plansim.io.scenario_file import load_scenario
 from plansim.uncertainty.mcm import (adaptive_monte_carlo, block_seeds, correlation_matrix, coverage_intervals,
                                      coverage_tolerance, joint_region_check, minimum_block_size, numerical_tolerance,
                                      validate_gum)

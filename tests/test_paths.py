@@ -27,10 +27,14 @@ from scipy import stats
 
 import plansim
 from plansim.model.parameters import PARAMETER_NAMES
-from plansim.scenario import builtin_scenarios, parse_scenario
-from plansim.simulate.engine import choose_path, simulate_segment_means
-from plansim.simulate.segment_path import (arc_weights, drift_coefficients, fourier_damping, fourier_terms_needed,
-                                          moments_from_damping, quantised_gaussian_moments, sin_cos_turns)
+from plansim.io.scenario_file import builtin_scenarios
+from plansim.config import parse_scenario
+from plansim.simulate.paths import choose_path
+from plansim.simulate.chunks import simulate_segment_means
+from plansim.kernels.drift import drift_coefficients
+from plansim.kernels.quantiser import (fourier_damping, fourier_terms_needed, moments_from_damping,
+                                       quantised_gaussian_moments, sin_cos_turns)
+from plansim.kernels.segment_path import arc_weights
 
 Z = 5.0  # standard errors allowed; two-sided p ≈ 6e-7 per comparison (39 parameters × 3 scenarios)
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from plansim.recording import (
+from plansim.io.recording import (
     CHANNELS,
     CSV_SAMPLE_COLUMNS,
     Recording,
@@ -18,9 +18,9 @@ from plansim.recording import (
     read_recording,
     recording_to_dataset,
     segment_table_path,
-    simulate_and_record,
     write_recording,
 )
+from plansim.runner import simulate_and_record
 from plansim.schedule import Schedule, multi_position, rate_test
 
 
@@ -121,7 +121,7 @@ def test_failed_write_leaves_nothing(tmp_path, suffix):
 
 
 def test_csv_failure_in_the_second_file_leaves_neither(tmp_path, monkeypatch):
-    import plansim.recording as recording_module
+    import plansim.io.recording as recording_module
 
     def broken_writer(*args, **kwargs):
         raise OSError("disk full")
@@ -307,9 +307,9 @@ def test_recording_validation():
 
 
 def test_simulate_and_record_matches_the_engine():
-    from plansim.scenario import load_scenario
-    from plansim.simulate.engine import CHANNELS as ENGINE_CHANNELS
-    from plansim.simulate.engine import simulate_recording
+    from plansim.io.scenario_file import load_scenario
+    from plansim.kernels.layout import CHANNELS as ENGINE_CHANNELS
+    from plansim.simulate.chunks import simulate_recording
 
     assert CHANNELS == ENGINE_CHANNELS
     scenario = load_scenario("ideal")

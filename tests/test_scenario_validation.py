@@ -1,7 +1,7 @@
 """Strict scenario parsing: bad input raises a ValueError/TypeError that names the offending field.
 
 Documents are built by loading scenarios/ideal.toml with tomllib (fixture ``ideal_document``) and
-modifying one thing; :func:`plansim.scenario.parse_scenario` must then refuse it with a message
+modifying one thing; :func:`plansim.config.parse_scenario` must then refuse it with a message
 that names the field (checked with ``pytest.raises(..., match=...)``).
 """
 
@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from plansim.model.environment import normal_gravity
-from plansim.scenario import load_scenario, parse_scenario, save_scenario
+from plansim.io.scenario_file import load_scenario, save_scenario
+from plansim.config import parse_scenario
 from plansim.units import DEG, STANDARD_GRAVITY
 
 

@@ -13,8 +13,9 @@ import pytest
 import plansim
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_NAMES
-from plansim.scenario import builtin_scenarios, parse_scenario
-from plansim.simulate.engine import simulate_recording, simulate_segment_means
+from plansim.io.scenario_file import builtin_scenarios
+from plansim.config import parse_scenario
+from plansim.simulate.chunks import simulate_recording, simulate_segment_means
 
 
 def ideal_document() -> dict:
@@ -166,10 +167,10 @@ def test_non_whole_turn_windows_leak_the_horizontal_earth_rate_into_cross_coupli
 
 def test_blas_runs_on_one_thread_while_the_kernels_run_and_is_restored_after():
     """The engine's threads use every core; numpy's BLAS is held to one thread meanwhile (see
-    plansim.simulate.engine.iterate_chunks) and given its threads back when the last chunk is used."""
+    plansim.simulate.chunks.iterate_chunks) and given its threads back when the last chunk is used."""
     from threadpoolctl import threadpool_info
 
-    from plansim.simulate.engine import iterate_chunks
+    from plansim.simulate.chunks import iterate_chunks
 
     def blas_threads():
         return [info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"]

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from plansim.model.environment import EARTH_RATE, earth_rate_enu, normal_gravity
-from plansim.scenario import Environment
+from plansim.config import Environment
 from plansim.units import (KINDS, STANDARD_GRAVITY, allowed_units, format_quantity, parse_matrix, parse_quantity,
                            parse_vector, to_unit)
 
@@ -297,7 +297,7 @@ def test_earth_rate_enu_at_30_degrees_by_hand():
 def test_the_stored_gauss_markov_allan_peak_is_the_computed_one():
     """GM_ALLAN_PEAK (the σ of the bias-instability stand-in depends on it) is written down to spare
     every run the import of scipy.optimize; recomputed here, it must agree to the last digits."""
-    from plansim.simulate.engine import GM_ALLAN_PEAK, gauss_markov_allan_peak
+    from plansim.simulate.arguments import GM_ALLAN_PEAK, gauss_markov_allan_peak
 
     assert GM_ALLAN_PEAK == pytest.approx(gauss_markov_allan_peak(), rel=1e-12)
     assert GM_ALLAN_PEAK == pytest.approx(0.6174, abs=5e-5)  # the value docs/model.md quotes

@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from plansim.report.files import atomic_write
+from plansim.io.files import atomic_write
 from plansim.uncertainty.appendix_a import APPENDIX_A, errors_in_reading_units
 
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
 
 from plansim.model.parameters import parameter
-from plansim.runner import parameter_summary
 
 
 def _g(x: float, digits: int = 4) -> str:
@@ -43,3 +43,19 @@ def appendix_a_table(comparisons) -> str:
                      f"{c.mc_U95:>10.3g} {c.mc_bias:>10.3g} {c.coverage:>8.1%}  {c.verdict}")
     lines.append("readings: " + "; ".join(f"{c.item} {c.reading_unit}" for c in comparisons))
     return "\n".join(lines)
+
+
+def parameter_summary(results: xr.Dataset) -> list[dict]:
+    """Per parameter: name, SI unit, mean truth, mean error and standard deviation of the error."""
+    err = results["error"]
+    out = []
+    for name in results["parameter"].values:
+        e = err.sel(parameter=name).values
+        out.append({
+            "name": str(name),
+            "unit": str(results["units"].sel(parameter=name).values),
+            "truth": float(results["truth"].sel(parameter=name).mean()),
+            "mean_error": float(np.mean(e)),
+            "std_error": float(np.std(e, ddof=1)) if e.size > 1 else 0.0,
+        })
+    return out

@@ -1,12 +1,12 @@
 """Compiling the kernels of a run before it starts, on every core.
 
 The first run after an install compiles the kernels of its simulation path; numba keeps them in
-its on-disk cache (:mod:`plansim._jit`) and every later run loads them in a fraction of a second.
+its on-disk cache (:mod:`plansim.kernels.options`) and every later run loads them in a fraction of a second.
 Compiling is slow — numba's compiler is Python code, and the segment path's kernels take several
 seconds each — so :func:`compile_kernels` shortens the cold start in two ways:
 
 - **Two processes.** The segment-statistics path has two entry kernels that share no compiled
-  code (:mod:`plansim.simulate.segment_path`). When neither is cached and the machine has a
+  code (:mod:`plansim.kernels.segment_path`). When neither is cached and the machine has a
   second core, a second Python process compiles the first into the cache while this process
   compiles the second; this process then loads the first from the cache. Which process compiled
   a kernel changes nothing in it: numba builds the same code from the same source and types.
@@ -39,8 +39,7 @@ import warnings
 
 import numba
 
-#: seconds to wait for the second process (a compile takes seconds; this only guards against a hang)
-SECOND_PROCESS_TIMEOUT = 600
+from plansim.kernels.options import COMPILE_IN_SECOND_PROCESS, SECOND_PROCESS_TIMEOUT
 
 
 def bound_call(dispatcher, *args, **kwargs) -> tuple[object, tuple]:
@@ -76,7 +75,7 @@ def collector_paused():
             gc.enable()
 
 
-def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = True) -> None:
+def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = COMPILE_IN_SECOND_PROCESS) -> None:
     """Compile (or load from the cache) each kernel of *calls* for the types of its arguments.
 
     Parameters

@@ -22,9 +22,9 @@ Input quantities (one budget line per group of independent components):
   perpendicularity, systematic rate error, rate error per point. Drawn by the simulator from the
   scenario's distributions (``scenario.turntable.<error>``: a ± limit is rectangular, GUM 4.3.7;
   a stated uncertainty is normal, 4.3.3). Sensitivity coefficients by central finite differences
-  of :func:`plansim.simulate.engine.noise_free_segment_means` followed by the reduction, one
+  of :func:`plansim.simulate.arguments.noise_free_segment_means` followed by the reduction, one
   component of the draws vector at a time with a step of its standard uncertainty (GUM 5.1.3
-  note 2), around :func:`plansim.simulate.engine.nominal_draws`. A group's contribution is
+  note 2), around :func:`plansim.simulate.arguments.nominal_draws`. A group's contribution is
   ``sqrt(Σ (c_i u_i)²)`` over its independent components; its *group-equivalent* sensitivity is
   that contribution divided by the components' common ``u``.
 - **Table start angle** of the rotating segments (type B, uniform on [0, 2π)). A segment that is
@@ -83,10 +83,10 @@ from scipy import special  # the quantiles themselves: scipy.stats takes 1.4 s t
 
 from plansim.estimate import reduce
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
-from plansim.scenario import ErrorDistribution, Scenario
-from plansim.simulate.engine import (drift_coefficient_table, kernel_arguments, nominal_draws,
-                                     noise_free_segment_means)
-from plansim.simulate.physics import HEAD, PER_SEGMENT
+from plansim.config import ErrorDistribution, Scenario
+from plansim.simulate.arguments import (drift_coefficient_table, kernel_arguments, nominal_draws,
+                                        noise_free_segment_means)
+from plansim.kernels.layout import HEAD, PER_SEGMENT
 from plansim.uncertainty.appendix_a import APPENDIX_A, AppendixABudget, reading_unit_in_si
 
 __all__ = [
@@ -247,7 +247,7 @@ def drift_covariance(scenario: Scenario) -> np.ndarray:
     """Covariance of the drift part of every segment mean, ``(6, S, S)`` per channel gx … az.
 
     Derived from the model the simulator uses (:mod:`plansim.simulate.sample_path`): first-order
-    Gauss–Markov bias instability (σ from :func:`plansim.simulate.engine.bias_instability_sigma`,
+    Gauss–Markov bias instability (σ from :func:`plansim.simulate.arguments.bias_instability_sigma`,
     correlation time ``bias_instability_correlation_time``), Gauss–Markov drift
     (``*_markov_sigma``, ``markov_correlation_time``) and random walk, each advanced exactly every
     ``drift_update_interval`` and held in between; Gauss–Markov processes stationary at the start

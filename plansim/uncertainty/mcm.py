@@ -34,7 +34,7 @@ import numpy as np
 from scipy import special  # the quantiles themselves: scipy.stats takes 1.4 s to import
 
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES
-from plansim.scenario import Scenario
+from plansim.config import Scenario
 
 __all__ = [
     "DEFAULT_DIGITS",

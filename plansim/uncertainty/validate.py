@@ -49,7 +49,8 @@ import numpy as np
 from scipy import special  # the quantiles themselves: scipy.stats takes 1.4 s to import
 
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS, parameter
-from plansim.scenario import Scenario, load_scenario
+from plansim.config import Scenario
+from plansim.io.scenario_file import load_scenario
 from plansim.units import parse_quantity
 from plansim.uncertainty.appendix_a import (APPENDIX_A, AppendixABudget, appendix_a_budget,
                                             reading_unit_description, reading_unit_in_si)

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from plansim._jit import jit
+from plansim.kernels.options import jit
 
 _U64 = np.uint64
 _GOLDEN = _U64(0x9E3779B97F4A7C15)

@@ -35,7 +35,7 @@ Two kernels, run one after the other on each slice of trials:
 They are separate entry points so that, on a cold start, two processes compile them side by side
 (:mod:`plansim.simulate.compilation`).
 
-What is not exact, and the runner's checks (:func:`plansim.simulate.engine.segment_path_exactness`):
+What is not exact, and the runner's checks (:func:`plansim.simulate.paths.segment_path_exactness`):
 saturation (excluded), gyro asymmetry (|w| is not a polynomial; excluded), drift that moves a
 non-dithered quantised output within a segment (excluded above 0.1σ), the cross-channel
 correlation of the rate jitter inside non-dithered quantisers (dropped), and channels that no
@@ -48,20 +48,20 @@ import math
 
 import numpy as np
 
-from plansim._jit import inline_jit, jit
-from plansim.simulate.physics import (N_TRUTH, draw_systematic, draws_length, evaluate_outputs,
-                                      geometry_buffers, segment_geometry, unpack_truth)
-from plansim.simulate.random import normal
-from plansim.simulate.sample_path import advance_drift, drift_transition, noise_stream
+from plansim.kernels.drift import advance_drift, drift_transition, noise_stream, segment_drift
+from plansim.kernels.layout import ACQ_STEP, N_TRUTH, NOISE_WHITE, draws_length
+from plansim.kernels.options import inline_jit, jit
+from plansim.kernels.physics import (draw_systematic, evaluate_outputs, geometry_buffers, segment_geometry,
+                                     unpack_truth)
+from plansim.kernels.quantiser import channel_moments, fourier_damping, fourier_terms_needed
+from plansim.kernels.random import normal
 
 # int64 scalars, not Python ints: passed to kernels, a literal would compile a copy per value
 DETERMINISTIC_NODES = np.int64(7)  # degree ≤ 3 in θ -> 2·3 + 1 nodes
 _ONE_NODE = np.int64(1)  # at rest: the output does not depend on θ
 _NO_EXTRA = np.int64(0)
 _JITTER_NODES = np.int64(2)  # θ0 at the rate ± h, for the response to rate jitter
-_FIRST_ROW = np.int64(0)
 MAX_NODES = 401
-QUANTISER_WINDOW = 8.0  # thresholds within ±8σ (Φ(−8) ≈ 6e-16)
 #: every approximation of the quantiser stays below this fraction of the segment mean's noise σ/√N
 RELATIVE_TOLERANCE = 1e-3
 #: the share of that tolerance spent on cutting the quantiser's Fourier series (the rest goes to the
@@ -143,151 +143,6 @@ def trigonometric_coefficients(nodes, s, coefficients):
                 b += nodes[s, j, c] * _SIN7[k]
             coefficients[c, 2 * m - 1] = 2.0 * a / DETERMINISTIC_NODES
             coefficients[c, 2 * m] = 2.0 * b / DETERMINISTIC_NODES
-
-
-@jit
-def fourier_damping(sigma, step, coefficients, row):
-    """Series coefficients of :func:`quantised_gaussian_moments` for σ ≥ 0.2q into ``coefficients[row]`` (3, K):
-    row 0: (−1)^{k+1} q/(πk) γ_k, row 1: (−1)^k q²/(π²k²) γ_k, row 2: (−1)^{k+1} γ_k, with
-    γ_k = exp(−2π²k²σ²/q²) for k = 1… while γ_k ≥ 1e-16. Returns the count, 0 if σ < 0.2q.
-
-    One exponential per call: γ_k = γ_1^{k²} = γ_{k−1}·γ_1^{2k−1}.
-    """
-    if sigma < 0.2 * step:
-        return 0
-    r = sigma / step
-    kmax = min(int(math.ceil(1.366 / r)), coefficients.shape[2])
-    g1 = math.exp(-2.0 * math.pi * math.pi * r * r)
-    g1_squared = g1 * g1
-    g = 1.0
-    factor = g1  # γ_1^{2k−1}
-    sign = 1.0
-    for k in range(1, kmax + 1):
-        g *= factor
-        factor *= g1_squared
-        coefficients[row, 0, k - 1] = sign * step / (math.pi * k) * g
-        coefficients[row, 1, k - 1] = -sign * step * step / (math.pi * math.pi * k * k) * g
-        coefficients[row, 2, k - 1] = sign * g
-        sign = -sign
-    return kmax
-
-
-@inline_jit
-def sin_cos_turns(turns):
-    """``(sin 2πt, cos 2πt)`` for *t* in turns, to within 1e-15.
-
-    Reduced to the nearest quarter turn (exact in binary), then Taylor polynomials on
-    |x| ≤ π/4 (truncation below 2e-17). Twice as fast as libm's sincos, whose slow range
-    reduction above |x| ≈ 2.4 the quantiser phases hit half the time.
-    """
-    quarter = math.floor(4.0 * turns + 0.5)
-    x = 2.0 * math.pi * (turns - 0.25 * quarter)
-    x2 = x * x
-    s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 + x2 * (
-        -1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (-1.0 / 1307674368000.0))))))))
-    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
-        -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (1.0 / 20922789888000.0))))))))
-    k = int(quarter) & 3
-    if k == 0:
-        return s, c
-    if k == 1:
-        return c, -s
-    if k == 2:
-        return -s, -c
-    return -c, s
-
-
-@inline_jit
-def moments_from_damping(mu, sigma, step, coefficients, row, kmax):
-    """The Fourier branch of :func:`quantised_gaussian_moments` with the coefficients ``coefficients[row]``
-    of :func:`fourier_damping` (rows index, not views: a view is reference-counted per call)."""
-    s1, c1 = sin_cos_turns(mu / step)  # α_1 = 2πμ/q
-    ck, sk = c1, s1
-    e1 = 0.0
-    e2 = step * step / 12.0
-    cov = 0.0
-    for k in range(kmax):
-        e1 += coefficients[row, 0, k] * sk
-        e2 += coefficients[row, 1, k] * ck
-        cov += coefficients[row, 2, k] * ck
-        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
-    cov *= 2.0 * sigma * sigma
-    return mu - e1, max(sigma * sigma + e2 - e1 * e1 - 2.0 * cov, 0.0)
-
-
-@jit
-def quantised_gaussian_moments(mu, sigma, step):
-    """Mean and variance of ``Q(x) = step·floor(x/step + ½)`` for ``x = μ + σZ``, Z standard normal.
-
-    For σ ≥ 0.2·step by the Fourier series of the quantisation error ε = x − Q(x) (a sawtooth),
-    with γ_k = exp(−2π²k²σ²/q²) and α_k = 2πkμ/q (terms to γ_k < 1e-16):
-
-        E[ε]  = Σ_k (−1)^{k+1} q/(πk) γ_k sin α_k
-        E[ε²] = q²/12 + Σ_k (−1)^k q²/(π²k²) γ_k cos α_k
-        Cov(x, ε) = 2σ² Σ_k (−1)^{k+1} γ_k cos α_k          (Stein's lemma)
-        E[Q] = μ − E[ε],  Var Q = σ² + E[ε²] − E[ε]² − 2 Cov(x, ε);
-
-    below that, by summing the threshold-crossing probabilities within ±8σ.
-    """
-    if sigma >= 0.2 * step:
-        coefficients = np.empty((1, 3, 8))
-        kmax = fourier_damping(sigma, step, coefficients, _FIRST_ROW)
-        return moments_from_damping(mu, sigma, step, coefficients, 0, kmax)
-    if sigma <= 0.0:
-        return step * math.floor(mu / step + 0.5), 0.0
-    low = math.floor((mu - QUANTISER_WINDOW * sigma) / step + 0.5)
-    high = math.floor((mu + QUANTISER_WINDOW * sigma) / step + 0.5)
-    s1 = 0.0  # E[S], S = number of thresholds below x
-    s2 = 0.0  # E[S²] = Σ_j (2j + 1) P_j
-    j = 0
-    level = low
-    while level < high:
-        t = (level + 0.5) * step
-        p = 0.5 * math.erfc((t - mu) / (sigma * math.sqrt(2.0)))
-        s1 += p
-        s2 += (2.0 * j + 1.0) * p
-        level += 1.0
-        j += 1
-    return step * (low + s1), step * step * max(s2 - s1 * s1, 0.0)
-
-
-@jit
-def fourier_terms_needed(coefficients, row, kmax, sigma, bias_tolerance, variance_tolerance):
-    """The fewest leading terms of the series in ``coefficients[row]`` (:func:`fourier_damping`, *kmax*
-    of them) whose dropped tail moves the quantised mean by at most *bias_tolerance* and the variance
-    by at most *variance_tolerance*.
-
-    With A_k, B_k, C_k the three rows (|A_k| = q/(πk)γ_k, |B_k| = q²/(π²k²)γ_k, |C_k| = γ_k) and the
-    tails a, b, c of their absolute values beyond the kept terms, the mean moves by at most a and
-    the variance σ² + E[ε²] − E[ε]² − 2Cov by at most b + (2 Σ_k |A_k| + a)·a + 4σ²c
-    (:func:`quantised_gaussian_moments`). γ_k = γ_1^{k²} falls so fast that for the default's
-    gyros (σ = 0.41q) one term is enough where machine precision wanted four.
-    """
-    total = 0.0
-    for k in range(kmax):
-        total += abs(coefficients[row, 0, k])
-    tail_a = 0.0
-    tail_b = 0.0
-    tail_c = 0.0
-    kept = kmax
-    while kept > 0:
-        a = tail_a + abs(coefficients[row, 0, kept - 1])
-        b = tail_b + abs(coefficients[row, 1, kept - 1])
-        c = tail_c + abs(coefficients[row, 2, kept - 1])
-        if a > bias_tolerance or b + (2.0 * total + a) * a + 4.0 * sigma * sigma * c > variance_tolerance:
-            break
-        tail_a, tail_b, tail_c = a, b, c
-        kept -= 1
-    return kept
-
-
-@inline_jit
-def _channel_moments(mu, sigma, step, coefficients, row, kmax):
-    """:func:`quantised_gaussian_moments` of a channel whose Fourier coefficients are
-    ``coefficients[row]`` (*kmax* of them; 0: σ < 0.2q, threshold sums)."""
-    if kmax > 0:
-        return moments_from_damping(mu, sigma, step, coefficients, row, kmax)
-    return quantised_gaussian_moments(mu, sigma, step)
 
 
 @jit
@@ -437,28 +292,6 @@ def simulate_chunk_nodes(first_trial, key, truth_nominal, truth_spread, error_ki
                          smoothness, gravity, earth_enu, nodes_out[t], rates_out[t], jitter_out[t])
 
 
-@inline_jit
-def _segment_drift(drift, drift_coeffs, s, noise, stream, mean_out):
-    """Draw the segment-mean drift per channel and move the states to the end of the recording;
-    returns the stream.
-
-    ``drift_coeffs[s]`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
-    coefficients a, c, L11, L21, L22 of mean = a·x0 + σ L11 z1, end = c·x0 + σ(L21 z1 + L22 z2).
-    """
-    for c in range(6):
-        mean_out[c] = 0.0
-        for p in range(3):
-            sigma = noise[c, 1] if p == 0 else (noise[c, 3] if p == 1 else noise[c, 2])
-            if sigma <= 0.0:
-                continue
-            z1, stream = normal(stream)
-            z2, stream = normal(stream)
-            x0 = drift[p, c]
-            mean_out[c] += drift_coeffs[s, p, 0] * x0 + sigma * drift_coeffs[s, p, 2] * z1
-            drift[p, c] = drift_coeffs[s, p, 1] * x0 + sigma * (drift_coeffs[s, p, 3] * z1 + drift_coeffs[s, p, 4] * z2)
-    return stream
-
-
 @jit
 def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg_dt, seg_gap, seg_rate,
                               acquisition, noise, noise_times, smoothness, drift_coeffs, needed, means_out):
@@ -498,7 +331,7 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
         for s in range(n_seg):
             rotating = seg_rate[s] != 0.0
             stream = advance_drift(settling, s, drift, stream)
-            stream = _segment_drift(drift, drift_coeffs, s, noise, stream, dbar)
+            stream = segment_drift(drift, drift_coeffs, s, noise, stream, dbar)
             n = seg_n[s]
             dt = seg_dt[s]
             rate_act = rates[t, s]
@@ -512,8 +345,8 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
             J = np.int64(0)  # not a literal 0 (see DETERMINISTIC_NODES)
             for c in range(6):
                 z_all[c], stream = normal(stream)
-                white_all[c] = noise[c, 0] / math.sqrt(dt)
-                step = acquisition[2] if c < 3 else acquisition[3]
+                white_all[c] = noise[c, NOISE_WHITE] / math.sqrt(dt)
+                step = acquisition[ACQ_STEP] if c < 3 else acquisition[ACQ_STEP + 1]
                 sigma_all[c] = math.sqrt(white_all[c] * white_all[c] + jitter[t, s, c] * jitter[t, s, c])
                 if step <= 0.0 or needed[s, c] == 0:
                     mode[c] = 0
@@ -559,7 +392,7 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
                 for c in range(6):
                     if mode[c] != 3:
                         continue
-                    step = acquisition[2] if c < 3 else acquisition[3]
+                    step = acquisition[ACQ_STEP] if c < 3 else acquisition[ACQ_STEP + 1]
                     mean_sum = 0.0
                     variance_sum = 0.0
                     c1, s1 = 1.0, 0.0
@@ -575,21 +408,21 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
                                  + coefficients[c, 3] * c2 + coefficients[c, 4] * s2
                                  + coefficients[c, 5] * c3 + coefficients[c, 6] * s3)
                             c1, s1 = c1 * cd - s1 * sd, s1 * cd + c1 * sd
-                        m, v = _channel_moments(y + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
+                        m, v = channel_moments(y + dbar[c], sigma_all[c], step, gammas_all, c, kmax_all[c])
                         mean_sum += wj[j] * m
                         variance_sum += wj[j] * v
                     mbar[c] = mean_sum
                     vbar[c] = variance_sum
             for c in range(6):
                 base = det[c] + dbar[c]
-                step = acquisition[2] if c < 3 else acquisition[3]
+                step = acquisition[ACQ_STEP] if c < 3 else acquisition[ACQ_STEP + 1]
                 if mode[c] == 0:
                     means_out[t, s, c] = base + white_all[c] / math.sqrt(n) * z_all[c] + jitter[t, s, c] * zbar
                 elif mode[c] == 1:  # dithered: unbiased, each sample adds q²/12 of independent variance
                     means_out[t, s, c] = (base + math.sqrt((white_all[c] * white_all[c] + step * step / 12.0) / n)
                                           * z_all[c] + jitter[t, s, c] * zbar)
                 elif mode[c] == 2:
-                    m, v = _channel_moments(base, sigma_all[c], step, gammas_all, c, kmax_all[c])
+                    m, v = channel_moments(base, sigma_all[c], step, gammas_all, c, kmax_all[c])
                     means_out[t, s, c] = m + math.sqrt(v / n) * z_all[c]
                 else:
                     means_out[t, s, c] = mbar[c] + math.sqrt(max(vbar[c], 0.0) / n) * z_all[c]
@@ -598,38 +431,3 @@ def simulate_chunk_statistics(first_trial, key, nodes, rates, jitter, seg_n, seg
 _draws_length = jit(draws_length)
 
 
-def drift_coefficients(n: int, dt: float, hold_interval: float, tau: float | None) -> np.ndarray:
-    """Unit-σ coefficients (a, c, L11, L21, L22) of a held drift process over one recorded segment.
-
-    The process is advanced (exactly) at the end of each block of ``hold`` samples, as the
-    sample-level path does; ``tau=None`` means a random walk (φ = 1, increments √Δt). Returns the
-    coefficients of ``mean = a·x0 + L11 z1`` and ``end = c·x0 + L21 z1 + L22 z2`` (z independent
-    standard normals) for a process of unit σ (or unit random-walk coefficient).
-    """
-    hold = max(1, int(math.floor(hold_interval / dt + 0.5)))
-    blocks = -(-n // hold)
-    sizes = np.full(blocks, hold, dtype=float)
-    sizes[-1] = n - (blocks - 1) * hold
-    durations = sizes * dt
-    if tau is None:
-        phi = np.ones(blocks)
-        q = np.sqrt(durations)
-    else:
-        phi = np.exp(-durations / tau)
-        q = np.sqrt(1.0 - phi**2)
-    weight = sizes / n
-    A = np.concatenate([[1.0], np.cumprod(phi)])  # A_j = Π_{l<j} φ_l
-    a = float(np.sum(weight * A[:-1]))
-    c = float(A[-1])
-    T = np.zeros(blocks)  # T_i = Σ_{j>i} w_j Π_{i<l<j} φ_l
-    E = np.ones(blocks)  # E_i = Π_{i<l<B} φ_l
-    for i in range(blocks - 2, -1, -1):
-        T[i] = weight[i + 1] + phi[i + 1] * T[i + 1]
-        E[i] = phi[i + 1] * E[i + 1]
-    b = q * T
-    d = q * E
-    cov = np.array([[b @ b, b @ d], [b @ d, d @ d]])
-    L11 = math.sqrt(cov[0, 0])
-    L21 = cov[0, 1] / L11 if L11 > 0 else 0.0
-    L22 = math.sqrt(max(cov[1, 1] - L21**2, 0.0))
-    return np.array([a, c, L11, L21, L22])

@@ -5,10 +5,10 @@ trial is the exception, on request). Orientation within a rate point follows the
 sample by sample, noise and drift are drawn per sample, saturation and quantisation act on each
 raw sample exactly as a data acquisition would.
 
-Array arguments (SI), built by :func:`plansim.simulate.engine.kernel_arguments`:
+Array arguments (SI), built by :func:`plansim.simulate.arguments.kernel_arguments`:
 
 - ``seg_*``: the nominal schedule (see engine.schedule_arrays);
-- ``sensor`` (8, 3): effect coefficients, rows :data:`plansim.simulate.physics.EFFECT_ROWS`;
+- ``sensor`` (8, 3): effect coefficients, rows :data:`plansim.kernels.layout.EFFECT_ROWS`;
   ``S2`` (3, 3) g² sensitivity; ``lever`` (3, 3) accelerometer positions; ``t_ref`` (°C);
 - ``acquisition`` (6,): gyro output range, accel output range, gyro step, accel step, gyro full
   scale, accel full scale;
@@ -24,76 +24,22 @@ import math
 
 import numpy as np
 
-from plansim._jit import inline_jit, jit
-from plansim.simulate.random import normal, seed_stream
-from plansim.simulate.physics import N_TRUTH, STREAM_NOISE, draw_systematic, draws_length, segment_geometry
-from plansim.simulate.physics import quantise, rotated_inputs, sensor_outputs
-from plansim.simulate.physics import geometry_buffers, unpack_truth
+from plansim.kernels.drift import advance_drift, drift_transition, noise_stream
+from plansim.kernels.layout import (ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP, N_TRUTH, NOISE_WHITE,
+                                    TIME_DRIFT_UPDATE, draws_length)
+from plansim.kernels.options import jit
+from plansim.kernels.physics import (draw_systematic, geometry_buffers, rotated_inputs, segment_geometry,
+                                     sensor_outputs, unpack_truth)
+from plansim.kernels.quantiser import quantise
+from plansim.kernels.random import normal
 
 
 #: ``record`` argument of :func:`simulate_trial` from the chunk kernel: a numpy bool, not a Python
-#: literal, so that the kernel and :func:`plansim.simulate.engine.simulate_recording` share one
+#: literal, so that the kernel and :func:`plansim.simulate.chunks.simulate_recording` share one
 #: compiled copy
 _NO_RECORDING = np.bool_(False)
 #: index of the one-slot transition buffer of :func:`simulate_trial` (an int64 for the same reason)
 _ONLY_TRANSITION = np.int64(0)
-
-
-@jit
-def drift_transition(interval, noise, noise_times, transitions, k):
-    """Exact update of the drift processes over *interval* s, as ``x ← carry·x + kick·z``.
-
-    ``transitions[k]`` (2, 3, 6) receives ``carry`` and ``kick`` per process (GM bias instability,
-    GM drift, random walk) and channel: a first-order Gauss–Markov process with stationary σ and
-    correlation time τ has carry φ = exp(−Δt/τ) and kick σ√(1 − φ²); a random walk with
-    coefficient K has carry 1 and kick K√Δt. A process that is off has kick 0. Computed once per
-    interval length, so the per-sample loop pays no exp or sqrt.
-    """
-    phi_bi = math.exp(-interval / noise_times[0]) if interval > 0.0 else 1.0
-    phi_mk = math.exp(-interval / noise_times[1]) if interval > 0.0 else 1.0
-    root = math.sqrt(max(interval, 0.0))
-    for c in range(6):
-        transitions[k, 0, 0, c] = phi_bi
-        transitions[k, 1, 0, c] = noise[c, 1] * math.sqrt(1.0 - phi_bi * phi_bi) if noise[c, 1] > 0.0 else 0.0
-        transitions[k, 0, 1, c] = phi_mk
-        transitions[k, 1, 1, c] = noise[c, 3] * math.sqrt(1.0 - phi_mk * phi_mk) if noise[c, 3] > 0.0 else 0.0
-        transitions[k, 0, 2, c] = 1.0
-        transitions[k, 1, 2, c] = noise[c, 2] * root if noise[c, 2] > 0.0 else 0.0
-
-
-@inline_jit
-def advance_drift(transitions, k, drift, stream):
-    """Advance the drift states ``drift`` (3, 6) by the transition ``transitions[k]`` of
-    :func:`drift_transition`; returns the stream."""
-    for c in range(6):
-        for p in range(3):
-            if transitions[k, 1, p, c] > 0.0:
-                z, stream = normal(stream)
-                drift[p, c] = transitions[k, 0, p, c] * drift[p, c] + transitions[k, 1, p, c] * z
-    return stream
-
-
-@jit
-def initial_drift(noise, stream):
-    """Drift states at the start of the test, Gauss–Markov processes stationary and random walks
-    at 0: ``(drift (3, 6), stream)``."""
-    drift = np.zeros((3, 6))
-    for c in range(6):
-        if noise[c, 1] > 0.0:
-            z, stream = normal(stream)
-            drift[0, c] = noise[c, 1] * z
-        if noise[c, 3] > 0.0:
-            z, stream = normal(stream)
-            drift[1, c] = noise[c, 3] * z
-    return drift, stream
-
-
-@jit
-def noise_stream(key, trial, noise):
-    """The trial's noise stream (stream 1) and its drift states at the start of the test:
-    ``(stream, drift)``."""
-    drift, stream = initial_drift(noise, seed_stream(key, trial, STREAM_NOISE))
-    return stream, drift
 
 
 @jit
@@ -122,10 +68,10 @@ def simulate_trial(trial, key, draws,
     level = np.empty(6)  # total drift of each channel, held between drift updates
     for c in range(6):
         sensor_kind = 0 if c < 3 else 1
-        out_range[c] = acquisition[sensor_kind]
-        step[c] = acquisition[2 + sensor_kind]
+        out_range[c] = acquisition[ACQ_RANGE + sensor_kind]
+        step[c] = acquisition[ACQ_STEP + sensor_kind]
         inverse_step[c] = 1.0 / step[c] if step[c] > 0.0 else 0.0
-        full_scale[c] = acquisition[4 + sensor_kind]
+        full_scale[c] = acquisition[ACQ_FULL_SCALE + sensor_kind]
     offset = 0
     for s in range(seg_n.shape[0]):
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
@@ -136,10 +82,10 @@ def simulate_trial(trial, key, draws,
         dt = seg_dt[s]
         dT = seg_temp[s] - t_ref
         for c in range(6):
-            white[c] = noise[c, 0] / math.sqrt(dt)
+            white[c] = noise[c, NOISE_WHITE] / math.sqrt(dt)
             acc[c] = 0.0
         # drift processes are advanced every `hold` samples (exactly, over hold·dt) and held between
-        hold = max(1, int(math.floor(noise_times[2] / dt + 0.5)))
+        hold = max(1, int(math.floor(noise_times[TIME_DRIFT_UPDATE] / dt + 0.5)))
         drift_transition(hold * dt, noise, noise_times, transition, _ONLY_TRANSITION)
         n = seg_n[s]
         if not rotating:  # at rest the deterministic part of every sample is the same

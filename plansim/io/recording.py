@@ -3,7 +3,7 @@
 A :class:`Recording` is the segment table (a :class:`~plansim.schedule.segments.Schedule`) plus every
 raw sample of the six channels ``gx, gy, gz`` (rad/s) and ``ax, ay, az`` (m/s²), concatenated
 segment by segment in schedule order, plus provenance attributes. Simulated recordings come from
-:func:`simulate_and_record`; measured ones are read with :func:`read_recording`. Both go through the
+:func:`plansim.runner.simulate_and_record`; measured ones are read with :func:`read_recording`. Both go through the
 same validation, so a measured file that reads is one the rest of plansim can use.
 
 Files (docs/recording.md describes every field):
@@ -35,13 +35,11 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from plansim.report.files import atomic_write
+from plansim.io.files import atomic_write
+from plansim.kernels.layout import CHANNELS
 from plansim.schedule.segments import Schedule, Segment
 from plansim.units import DEG
 
-# The same order as plansim.simulate.engine.CHANNELS (a test checks it); defined here so that the file
-# format does not depend on the simulation engine.
-CHANNELS = ("gx", "gy", "gz", "ax", "ay", "az")
 CHANNEL_UNITS = {"gx": "rad/s", "gy": "rad/s", "gz": "rad/s", "ax": "m/s^2", "ay": "m/s^2", "az": "m/s^2"}
 CHANNEL_LONG_NAMES = {
     "gx": "angular rate output of the x gyro (body frame)",
@@ -271,41 +269,6 @@ def _check_time(time: np.ndarray, expected_rows: int, where: str) -> None:
         k = int(backwards[0]) + 1
         raise ValueError(f"{where}: time decreases at sample {k} ({float(time[k - 1])!r} s then "
                          f"{float(time[k])!r} s); expected a global time axis, never decreasing")
-
-
-# ----------------------------------------------------------------------------- simulation
-
-
-def simulate_and_record(scenario, seed: int, trial: int = 0) -> Recording:
-    """Simulate one trial of *scenario* and return every raw sample as a :class:`Recording`.
-
-    Parameters
-    ----------
-    scenario : plansim.scenario.Scenario
-        The simulated world and schedule.
-    seed : int
-        Root seed, >= 0 (the same as for :func:`plansim.simulate.engine.simulate_segment_means`).
-    trial : int
-        Trial number, >= 0; the recording holds the same numbers that trial gives in a Monte Carlo run.
-
-    Returns
-    -------
-    Recording
-        ``attrs`` holds ``plansim_version``, ``scenario``, ``seed``, ``trial``, ``source = "simulated"``
-        and ``units``. The true parameters of the simulated unit are not kept; call
-        :func:`plansim.simulate.engine.simulate_recording` for them.
-    """
-    # imported here: the file format stays independent of the engine and its numba kernels
-    from plansim.scenario import Scenario
-    from plansim.simulate.engine import simulate_recording
-
-    if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario: expected a plansim Scenario (see plansim.scenario.load_scenario), "
-                        f"got {type(scenario).__name__}")
-    samples, _segment_means, _truth = simulate_recording(scenario, seed, trial)
-    attrs = {"plansim_version": plansim_version(), "scenario": scenario.name, "seed": int(seed),
-             "trial": int(trial), "source": "simulated", "units": UNITS_DESCRIPTION}
-    return Recording(samples=samples, schedule=scenario.schedule, attrs=attrs)
 
 
 # ----------------------------------------------------------------------------- xarray

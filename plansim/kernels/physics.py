@@ -6,18 +6,7 @@ the MIMU in each segment and the noise-free sensor output at any table angle θ.
 the path (sample by sample, or as exact segment statistics). Keeping the draws explicit lets a
 caller fix any of them (e.g. the GUM sensitivities of :mod:`plansim.uncertainty`).
 
-Draws vector (length ``HEAD + PER_SEGMENT·S``):
-
-====================  ====================================================================
-``[0:39]``            the unit's parameters (order of :data:`plansim.model.parameters.PARAMETER_NAMES`)
-``[39:42]``           fixture misalignment, rotation vector of the MIMU case in the fixture, rad
-``[42:44]``           platform tilt about East and North, rad
-``[44]``              rate error, systematic (relative)
-``[45:51]``           axis perpendicularity: for rate axis x, y, z two components each, rad
-``[51+8s : 59+8s]``   segment s: position accuracy x, repeatability x, accuracy y, repeatability y,
-                      accuracy z, repeatability z (rad), rate error of the point (relative), start
-                      phase θ0 of the table (rad)
-====================  ====================================================================
+The draws vector's layout, and every other packed array's, is named in :mod:`plansim.kernels.layout`.
 
 Physics (docs/model.md): ``C_nb(θ) = Tilt · PosErr · C_nb,nominal · C_fb · R(u_b, θ)``; the gyro
 input is ``w = ω·u_b + R(u_b, −θ) Ω_b0`` and the specific force at the IMU centre
@@ -30,25 +19,16 @@ import math
 
 import numpy as np
 
-from plansim._jit import inline_jit, jit
-from plansim.simulate.random import draw_error, normal, seed_stream, uniform
-
-N_TRUTH = 39
-HEAD = 51
-PER_SEGMENT = 8
-# Integer constants that kernels pass to other kernels are numpy scalars, not Python ints: numba
-# types a Python int argument as a literal and compiles the callee once per distinct value.
-STREAM_SYSTEMATIC = np.int64(0)  # truth spread and table/fixture errors
-STREAM_NOISE = np.int64(1)  # sensor noise, drift and rate smoothness
-
-# rows of the `sensor` effects array (3 columns: x, y, z)
-EFFECT_ROWS = ("gyro_nonlinearity_quadratic", "gyro_nonlinearity_cubic", "gyro_asymmetry", "accel_second_order",
-               "gyro_bias_temperature_coefficient", "gyro_scale_temperature_coefficient",
-               "accel_bias_temperature_coefficient", "accel_scale_temperature_coefficient")
-
-
-def draws_length(n_segments: int) -> int:
-    return HEAD + PER_SEGMENT * n_segments
+from plansim.kernels.layout import (BA_FIRST, BG_FIRST, G_FIRST, KA_FIRST, KG_FIRST, P_ENTRIES, P_FIRST,
+                                    EFF_ACCEL_BIAS_TEMPERATURE, EFF_ACCEL_SCALE_TEMPERATURE, EFF_ACCEL_SECOND_ORDER,
+                                    EFF_GYRO_ASYMMETRY, EFF_GYRO_BIAS_TEMPERATURE, EFF_GYRO_CUBIC, EFF_GYRO_QUADRATIC,
+                                    EFF_GYRO_SCALE_TEMPERATURE, ERR_AXIS_PERPENDICULARITY, ERR_FIXTURE_PERPENDICULARITY, ERR_PLATFORM_TILT,
+                                    ERR_POSITION_ACCURACY, ERR_POSITION_REPEATABILITY, ERR_RATE_PER_POINT,
+                                    ERR_RATE_SYSTEMATIC, FIXTURE_FIRST, HEAD, N_TRUTH, PER_SEGMENT,
+                                    PERPENDICULARITY_FIRST, RATE_SYSTEMATIC, SEG_PHASE, SEG_POSITION_ACCURACY,
+                                    SEG_POSITION_REPEATABILITY, SEG_RATE_ERROR, STREAM_SYSTEMATIC, TILT_FIRST)
+from plansim.kernels.options import inline_jit, jit
+from plansim.kernels.random import draw_error, normal, seed_stream, uniform
 
 
 @jit
@@ -65,20 +45,26 @@ def draw_systematic(trial, key, truth_nominal, truth_spread, error_kind, error_s
         z, stream = normal(stream)
         draws[k] = truth_nominal[k] + truth_spread[k] * z
     for k in range(3):
-        draws[39 + k], stream = draw_error(stream, error_kind[4], error_scale[4])
-    draws[42], stream = draw_error(stream, error_kind[3], error_scale[3])
-    draws[43], stream = draw_error(stream, error_kind[3], error_scale[3])
-    draws[44], stream = draw_error(stream, error_kind[5], error_scale[5])
+        draws[FIXTURE_FIRST + k], stream = draw_error(stream, error_kind[ERR_FIXTURE_PERPENDICULARITY],
+                                                     error_scale[ERR_FIXTURE_PERPENDICULARITY])
+    draws[TILT_FIRST], stream = draw_error(stream, error_kind[ERR_PLATFORM_TILT], error_scale[ERR_PLATFORM_TILT])
+    draws[TILT_FIRST + 1], stream = draw_error(stream, error_kind[ERR_PLATFORM_TILT], error_scale[ERR_PLATFORM_TILT])
+    draws[RATE_SYSTEMATIC], stream = draw_error(stream, error_kind[ERR_RATE_SYSTEMATIC],
+                                                 error_scale[ERR_RATE_SYSTEMATIC])
     for k in range(6):
-        draws[45 + k], stream = draw_error(stream, error_kind[2], error_scale[2])
+        draws[PERPENDICULARITY_FIRST + k], stream = draw_error(stream, error_kind[ERR_AXIS_PERPENDICULARITY],
+                                                              error_scale[ERR_AXIS_PERPENDICULARITY])
     for s in range(n_segments):
         base = HEAD + PER_SEGMENT * s
         for axis in range(3):
-            draws[base + 2 * axis], stream = draw_error(stream, error_kind[0], error_scale[0])
-            draws[base + 2 * axis + 1], stream = draw_error(stream, error_kind[1], error_scale[1])
-        draws[base + 6], stream = draw_error(stream, error_kind[6], error_scale[6])
+            draws[base + SEG_POSITION_ACCURACY + 2 * axis], stream = draw_error(
+                stream, error_kind[ERR_POSITION_ACCURACY], error_scale[ERR_POSITION_ACCURACY])
+            draws[base + SEG_POSITION_REPEATABILITY + 2 * axis], stream = draw_error(
+                stream, error_kind[ERR_POSITION_REPEATABILITY], error_scale[ERR_POSITION_REPEATABILITY])
+        draws[base + SEG_RATE_ERROR], stream = draw_error(stream, error_kind[ERR_RATE_PER_POINT],
+                                                       error_scale[ERR_RATE_PER_POINT])
         phase, stream = uniform(stream)
-        draws[base + 7] = 2.0 * math.pi * phase
+        draws[base + SEG_PHASE] = 2.0 * math.pi * phase
 
 
 @inline_jit
@@ -119,18 +105,14 @@ def unpack_truth(p):
     Ba = np.empty(3)
     for i in range(3):
         for j in range(3):
-            Kg[i, j] = p[3 * i + j]
-            G[i, j] = p[12 + 3 * i + j]
-            Ka[i, j] = p[21 + 3 * i + j]
+            Kg[i, j] = p[KG_FIRST + 3 * i + j]
+            G[i, j] = p[G_FIRST + 3 * i + j]
+            Ka[i, j] = p[KA_FIRST + 3 * i + j]
             P[i, j] = 0.0
-        Bg[i] = p[9 + i]
-        Ba[i] = p[30 + i]
-    P[0, 1] = p[33]
-    P[0, 2] = p[34]
-    P[1, 0] = p[35]
-    P[1, 2] = p[36]
-    P[2, 0] = p[37]
-    P[2, 1] = p[38]
+        Bg[i] = p[BG_FIRST + i]
+        Ba[i] = p[BA_FIRST + i]
+    for k in range(6):
+        P[P_ENTRIES[k][0], P_ENTRIES[k][1]] = p[P_FIRST + k]
     return Kg, Bg, G, Ka, Ba, P
 
 
@@ -162,8 +144,8 @@ def geometry_buffers(draws):
 def trial_frames(draws, frames):
     """Per-trial rotations into ``frames[0]`` (fixture: MIMU case in the fixture, C_fb) and
     ``frames[1]`` (platform tilt about East and North); call once before :func:`segment_geometry`."""
-    small_rotation(draws[39], draws[40], draws[41], frames, _FIXTURE)
-    small_rotation(draws[42], draws[43], 0.0, frames, _TILT)
+    small_rotation(draws[FIXTURE_FIRST], draws[FIXTURE_FIRST + 1], draws[FIXTURE_FIRST + 2], frames, _FIXTURE)
+    small_rotation(draws[TILT_FIRST], draws[TILT_FIRST + 1], 0.0, frames, _TILT)
 
 
 @jit
@@ -178,8 +160,9 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     scratch space otherwise.
     """
     base = HEAD + PER_SEGMENT * s
-    small_rotation(draws[base] + draws[base + 1], draws[base + 2] + draws[base + 3],
-                   draws[base + 4] + draws[base + 5], frames, _POSITION_ERROR)
+    acc, rep = base + SEG_POSITION_ACCURACY, base + SEG_POSITION_REPEATABILITY  # + 2·axis
+    small_rotation(draws[acc] + draws[rep], draws[acc + 2] + draws[rep + 2],
+                   draws[acc + 4] + draws[rep + 4], frames, _POSITION_ERROR)
     for i in range(3):
         for j in range(3):
             frames[_NOMINAL, i, j] = seg_C0[s, i, j]
@@ -194,7 +177,7 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     # about the two other axes, expressed in the MIMU case frame (C_bf = C_fbᵀ)
     a = seg_axis_index[s]
     v0, v1, v2 = seg_axis[s, 0], seg_axis[s, 1], seg_axis[s, 2]
-    first, second = draws[45 + 2 * a], draws[46 + 2 * a]
+    first, second = draws[PERPENDICULARITY_FIRST + 2 * a], draws[PERPENDICULARITY_FIRST + 2 * a + 1]
     if abs(v0) > 0.5:
         v1 += first
         v2 += second
@@ -207,12 +190,12 @@ def segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravi
     norm = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
     for i in range(3):
         u[i] = (frames[_FIXTURE, 0, i] * v0 + frames[_FIXTURE, 1, i] * v1 + frames[_FIXTURE, 2, i] * v2) / norm
-    rate_act = seg_rate[s] * (1.0 + draws[44] + draws[base + 6])
+    rate_act = seg_rate[s] * (1.0 + draws[RATE_SYSTEMATIC] + draws[base + SEG_RATE_ERROR])
     for i in range(3):  # centripetal acceleration of accelerometer i: −ω²(r_i − (r_i·u)u)
         ru = lever[i, 0] * u[0] + lever[i, 1] * u[1] + lever[i, 2] * u[2]
         for j in range(3):
             perp[i, j] = -rate_act * rate_act * (lever[i, j] - ru * u[j])
-    return rate_act, draws[base + 7]
+    return rate_act, draws[base + SEG_PHASE]
 
 
 @inline_jit
@@ -237,42 +220,24 @@ def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
     (g² sensitivity, 3×3); ``dT`` = temperature − reference temperature.
     """
     for i in range(3):  # gyros, eq. (1) + effects
-        val = Bg[i] + sensor[4, i] * dT
+        val = Bg[i] + sensor[EFF_GYRO_BIAS_TEMPERATURE, i] * dT
         for j in range(3):
             val += Kg[i, j] * w[j] + G[i, j] * fc[j] + S2[i, j] * fc[j] * fc[j]
         wi = w[i]
-        val += Kg[i, i] * sensor[5, i] * dT * wi + sensor[0, i] * wi * wi + sensor[1, i] * wi * wi * wi
-        val += 0.5 * sensor[2, i] * Kg[i, i] * abs(wi)
+        val += (Kg[i, i] * sensor[EFF_GYRO_SCALE_TEMPERATURE, i] * dT * wi + sensor[EFF_GYRO_QUADRATIC, i] * wi * wi
+                + sensor[EFF_GYRO_CUBIC, i] * wi * wi * wi)
+        val += 0.5 * sensor[EFF_GYRO_ASYMMETRY, i] * Kg[i, i] * abs(wi)
         y[i] = val
     for i in range(3):  # accelerometers, eq. (2) + effects; accelerometer i sits at its lever arm
         f0 = fc[0] + perp[i, 0]
         f1 = fc[1] + perp[i, 1]
         f2 = fc[2] + perp[i, 2]
         fi = f0 if i == 0 else (f1 if i == 1 else f2)
-        val = Ba[i] + sensor[6, i] * dT
+        val = Ba[i] + sensor[EFF_ACCEL_BIAS_TEMPERATURE, i] * dT
         val += Ka[i, 0] * f0 + Ka[i, 1] * f1 + Ka[i, 2] * f2
         val += P[i, 0] * w[0] * w[0] + P[i, 1] * w[1] * w[1] + P[i, 2] * w[2] * w[2]
-        val += Ka[i, i] * sensor[7, i] * dT * fi + sensor[3, i] * fi * fi
+        val += Ka[i, i] * sensor[EFF_ACCEL_SCALE_TEMPERATURE, i] * dT * fi + sensor[EFF_ACCEL_SECOND_ORDER, i] * fi * fi
         y[3 + i] = val
-
-
-@inline_jit
-def quantise(y, output_range, step, inverse_step, full_scale):
-    """Saturate at ± output range, then quantise to *step* (round half up), clipped at ± full scale.
-
-    *inverse_step* = 1/step, precomputed: a multiplication per sample instead of a division.
-    """
-    if y > output_range:
-        y = output_range
-    elif y < -output_range:
-        y = -output_range
-    if step > 0.0:
-        y = step * math.floor(y * inverse_step + 0.5)
-        if y > full_scale:
-            y = full_scale
-        elif y < -full_scale:
-            y = -full_scale
-    return y
 
 
 @jit

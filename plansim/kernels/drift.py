@@ -1,0 +1,136 @@
+"""Drift processes of the sensor noise: Gauss–Markov bias instability and drift, rate random walk.
+
+Every process is held over the drift update interval and advanced exactly at its end, on both
+paths: sample by sample (:func:`drift_transition`, :func:`advance_drift`) and, on the
+segment-statistics path, as the exact joint distribution of a segment's mean drift and its end
+state (:func:`drift_coefficients`, :func:`segment_drift`). A first-order Gauss–Markov process with
+stationary σ and correlation time τ has carry φ = exp(−Δt/τ) and kick σ√(1 − φ²); a random walk
+with coefficient K has carry 1 and kick K√Δt (IEEE Std 952-1997, Annex C).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from plansim.kernels.layout import (NOISE_BIAS_INSTABILITY, NOISE_MARKOV, NOISE_RANDOM_WALK, STREAM_NOISE,
+                                    TIME_BIAS_INSTABILITY, TIME_MARKOV)
+from plansim.kernels.options import inline_jit, jit
+from plansim.kernels.random import normal, seed_stream
+
+
+@jit
+def drift_transition(interval, noise, noise_times, transitions, k):
+    """Exact update of the drift processes over *interval* s, as ``x ← carry·x + kick·z``.
+
+    ``transitions[k]`` (2, 3, 6) receives ``carry`` and ``kick`` per process (GM bias instability,
+    GM drift, random walk) and channel: a first-order Gauss–Markov process with stationary σ and
+    correlation time τ has carry φ = exp(−Δt/τ) and kick σ√(1 − φ²); a random walk with
+    coefficient K has carry 1 and kick K√Δt. A process that is off has kick 0. Computed once per
+    interval length, so the per-sample loop pays no exp or sqrt.
+    """
+    phi_bi = math.exp(-interval / noise_times[TIME_BIAS_INSTABILITY]) if interval > 0.0 else 1.0
+    phi_mk = math.exp(-interval / noise_times[TIME_MARKOV]) if interval > 0.0 else 1.0
+    root = math.sqrt(max(interval, 0.0))
+    for c in range(6):
+        transitions[k, 0, 0, c] = phi_bi
+        transitions[k, 1, 0, c] = noise[c, NOISE_BIAS_INSTABILITY] * math.sqrt(1.0 - phi_bi * phi_bi) if noise[c, NOISE_BIAS_INSTABILITY] > 0.0 else 0.0
+        transitions[k, 0, 1, c] = phi_mk
+        transitions[k, 1, 1, c] = noise[c, NOISE_MARKOV] * math.sqrt(1.0 - phi_mk * phi_mk) if noise[c, NOISE_MARKOV] > 0.0 else 0.0
+        transitions[k, 0, 2, c] = 1.0
+        transitions[k, 1, 2, c] = noise[c, NOISE_RANDOM_WALK] * root if noise[c, NOISE_RANDOM_WALK] > 0.0 else 0.0
+
+
+@inline_jit
+def advance_drift(transitions, k, drift, stream):
+    """Advance the drift states ``drift`` (3, 6) by the transition ``transitions[k]`` of
+    :func:`drift_transition`; returns the stream."""
+    for c in range(6):
+        for p in range(3):
+            if transitions[k, 1, p, c] > 0.0:
+                z, stream = normal(stream)
+                drift[p, c] = transitions[k, 0, p, c] * drift[p, c] + transitions[k, 1, p, c] * z
+    return stream
+
+
+@jit
+def initial_drift(noise, stream):
+    """Drift states at the start of the test, Gauss–Markov processes stationary and random walks
+    at 0: ``(drift (3, 6), stream)``."""
+    drift = np.zeros((3, 6))
+    for c in range(6):
+        if noise[c, NOISE_BIAS_INSTABILITY] > 0.0:
+            z, stream = normal(stream)
+            drift[0, c] = noise[c, NOISE_BIAS_INSTABILITY] * z
+        if noise[c, NOISE_MARKOV] > 0.0:
+            z, stream = normal(stream)
+            drift[1, c] = noise[c, NOISE_MARKOV] * z
+    return drift, stream
+
+
+@jit
+def noise_stream(key, trial, noise):
+    """The trial's noise stream (stream 1) and its drift states at the start of the test:
+    ``(stream, drift)``."""
+    drift, stream = initial_drift(noise, seed_stream(key, trial, STREAM_NOISE))
+    return stream, drift
+
+
+@inline_jit
+def segment_drift(drift, drift_coeffs, s, noise, stream, mean_out):
+    """Draw the segment-mean drift per channel and move the states to the end of the recording;
+    returns the stream.
+
+    ``drift_coeffs[s]`` (3, 5): per process (GM bias instability, GM drift, random walk) the unit-σ
+    coefficients a, c, L11, L21, L22 of mean = a·x0 + σ L11 z1, end = c·x0 + σ(L21 z1 + L22 z2).
+    """
+    for c in range(6):
+        mean_out[c] = 0.0
+        for p in range(3):
+            sigma = noise[c, NOISE_BIAS_INSTABILITY] if p == 0 else (noise[c, NOISE_MARKOV] if p == 1 else noise[c, NOISE_RANDOM_WALK])
+            if sigma <= 0.0:
+                continue
+            z1, stream = normal(stream)
+            z2, stream = normal(stream)
+            x0 = drift[p, c]
+            mean_out[c] += drift_coeffs[s, p, 0] * x0 + sigma * drift_coeffs[s, p, 2] * z1
+            drift[p, c] = drift_coeffs[s, p, 1] * x0 + sigma * (drift_coeffs[s, p, 3] * z1 + drift_coeffs[s, p, 4] * z2)
+    return stream
+
+
+def drift_coefficients(n: int, dt: float, hold_interval: float, tau: float | None) -> np.ndarray:
+    """Unit-σ coefficients (a, c, L11, L21, L22) of a held drift process over one recorded segment.
+
+    The process is advanced (exactly) at the end of each block of ``hold`` samples, as the
+    sample-level path does; ``tau=None`` means a random walk (φ = 1, increments √Δt). Returns the
+    coefficients of ``mean = a·x0 + L11 z1`` and ``end = c·x0 + L21 z1 + L22 z2`` (z independent
+    standard normals) for a process of unit σ (or unit random-walk coefficient).
+    """
+    hold = max(1, int(math.floor(hold_interval / dt + 0.5)))
+    blocks = -(-n // hold)
+    sizes = np.full(blocks, hold, dtype=float)
+    sizes[-1] = n - (blocks - 1) * hold
+    durations = sizes * dt
+    if tau is None:
+        phi = np.ones(blocks)
+        q = np.sqrt(durations)
+    else:
+        phi = np.exp(-durations / tau)
+        q = np.sqrt(1.0 - phi**2)
+    weight = sizes / n
+    A = np.concatenate([[1.0], np.cumprod(phi)])  # A_j = Π_{l<j} φ_l
+    a = float(np.sum(weight * A[:-1]))
+    c = float(A[-1])
+    T = np.zeros(blocks)  # T_i = Σ_{j>i} w_j Π_{i<l<j} φ_l
+    E = np.ones(blocks)  # E_i = Π_{i<l<B} φ_l
+    for i in range(blocks - 2, -1, -1):
+        T[i] = weight[i + 1] + phi[i + 1] * T[i + 1]
+        E[i] = phi[i + 1] * E[i + 1]
+    b = q * T
+    d = q * E
+    cov = np.array([[b @ b, b @ d], [b @ d, d @ d]])
+    L11 = math.sqrt(cov[0, 0])
+    L21 = cov[0, 1] / L11 if L11 > 0 else 0.0
+    L22 = math.sqrt(max(cov[1, 1] - L21**2, 0.0))
+    return np.array([a, c, L11, L21, L22])
