@@ -121,13 +121,13 @@ def test_failed_write_leaves_nothing(tmp_path, suffix):
 
 
 def test_csv_failure_in_the_second_file_leaves_neither(tmp_path, monkeypatch):
-    import plansim.io.recording as recording_module
+    import plansim.io.recording_csv as recording_csv_module
 
     def broken_writer(*args, **kwargs):
         raise OSError("disk full")
 
     # the segment table is written through csv.writer; break it after the samples are written
-    monkeypatch.setattr(recording_module.csv, "writer", broken_writer)
+    monkeypatch.setattr(recording_csv_module.csv, "writer", broken_writer)
     with pytest.raises(OSError, match="disk full"):
         write_recording(tiny_recording(), tmp_path / "run.csv")
     assert os.listdir(tmp_path) == []
