@@ -44,7 +44,8 @@ from plansim.kernels.options import COMPILE_IN_SECOND_PROCESS, SECOND_PROCESS_TI
 
 def bound_call(dispatcher, *args, **kwargs) -> tuple[object, tuple]:
     """``(dispatcher, positional arguments)`` of the call ``dispatcher(*args, **kwargs)``."""
-    bound = inspect.signature(dispatcher.py_func).bind(*args, **kwargs)
+    # under NUMBA_DISABLE_JIT=1 (the coverage run) a kernel is its plain Python function
+    bound = inspect.signature(getattr(dispatcher, "py_func", dispatcher)).bind(*args, **kwargs)
     return dispatcher, tuple(bound.args)
 
 
@@ -87,6 +88,8 @@ def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = COMPILE_
         Let a second process compile the first kernel when two or more need compiling and the
         machine has two or more cores.
     """
+    if numba.config.DISABLE_JIT:  # nothing to compile: the kernels run as Python (coverage run)
+        return
     pending = [(dispatcher, argument_types(arguments)) for dispatcher, arguments in calls]
     pending = [(dispatcher, types) for dispatcher, types in pending if not is_compiled_or_cached(dispatcher, types)]
     if not pending:
