@@ -1,7 +1,8 @@
 """The JJF 2003-2022 data reduction (plansim.estimate.jjf2003) against hand-worked examples.
 
 Every small example below is worked out by hand in its comment, citing the equation of the
-specification (digest §1.3), so a reader can check the expected numbers without running code.
+specification (JJF 2003-2022 §7.2.1–§7.2.5, eq. (3)–(13)), so a reader can check the expected
+numbers without running code.
 No simulator is run here: segment means are built analytically from a known truth.
 """
 
@@ -197,7 +198,7 @@ def test_rate_sensitivity_sign_conventions():
     # eq. (2) a'_Y = … + p_yx·ω_X²: U7 (at rest) = 0.02, p = 0.004, ω = 2 rad/s (ω² = 4)
     # -> U8 (rotating) = U7 + p·ω² = 0.02 + 0.016 = 0.036
     # "model":      (U8 − U7)/ω² = 0.016/4 = +0.004 = +p
-    # "as_printed": (U7 − U8)/ω² (eq. (12) as printed) = −0.004 = −p  (digest §1.4 known problem)
+    # "as_printed": (U7 − U8)/ω² (eq. (12) as printed) = −0.004 = −p  (§7.2.5.2 disagrees with eq. (2) of §5.2)
     p, omega, u7 = 0.004, 2.0, 0.02
     u8 = u7 + p * omega**2
     assert u8 == pytest.approx(0.036, rel=1e-15)

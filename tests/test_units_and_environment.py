@@ -258,18 +258,18 @@ def test_earth_rate_in_degrees_per_hour():
     # 7.292115e-5 rad/s × (180/π) °/rad × 3600 s/h = 15.0410669 °/h
     per_hour = EARTH_RATE * 180 / PI * 3600
     assert round(per_hour, 6) == 15.041067
-    assert round(per_hour, 5) == 15.04107  # the textbook's 15.04107 °/h (digest §5)
+    assert round(per_hour, 5) == 15.04107  # the textbook chapter's 15.04107 °/h (docs/specification.md)
     assert parse_quantity("15.041067 deg/h", "angular_rate", "f") == pytest.approx(EARTH_RATE, rel=1e-7)
 
 
 def test_earth_rate_period_is_a_sidereal_day_not_the_textbook_value():
-    # 2π/ω = 86 164.10 s = 23 h 56 min 4.10 s: one (stellar) sidereal day, 23 h 56 min 4.09 s to the
-    # 0.01 s the digest quotes. ω is a defining constant, truncated to 7 digits (half a unit in its
-    # last digit is 0.5e-11/7.292115e-5 ≈ 7e-8 relative, about 0.006 s of the day).
+    # 2π/ω = 86 164.10 s = 23 h 56 min 4.10 s: one (stellar) sidereal day, 23 h 56 min 4.09 s to
+    # within 0.01 s. ω is a defining constant, truncated to 7 digits (half a unit in its last digit
+    # is 0.5e-11/7.292115e-5 ≈ 7e-8 relative, about 0.006 s of the day).
     period = 2 * PI / EARTH_RATE
     assert round(period, 2) == 86164.10
     assert abs(period - (23 * 3600 + 56 * 60 + 4.09)) < 0.02
-    # the textbook's "23 h 59 min 57.33 s" = 86 397.33 s (digest §5) would give
+    # the textbook chapter's "23 h 59 min 57.33 s" = 86 397.33 s (its §6.2) would give
     # 360° × 3600/86 397.33 = 15.0005 °/h, not 15.04107 °/h
     textbook = 360.0 / ((23 * 3600 + 59 * 60 + 57.33) / 3600)
     assert round(textbook, 4) == 15.0005

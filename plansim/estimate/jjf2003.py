@@ -77,7 +77,8 @@ def rate_sensitivity(at_rest: np.ndarray, rotating: np.ndarray, rate: float, sig
 
     ``sign = "as_printed"`` returns ``(U7 − U8)/ω²`` as eq. (12) prints it; ``"model"`` (default)
     returns ``(U8 − U7)/ω²``, the estimator consistent with eq. (2), where the rotating reading is
-    ``U8 = U7 + p·ω²`` (digest §1.4: the printed sign returns −p).
+    ``U8 = U7 + p·ω²``. Eq. (12) as printed in §7.2.5.2 therefore returns −p: the formula and
+    eq. (2) of §5.2 disagree in sign (docs/specification.md, "The sign of eq. (12) and (13)").
     """
     if sign not in ("model", "as_printed"):
         raise ValueError(f"reduction.omega_squared_sign = {sign!r}; allowed: 'model', 'as_printed'")

@@ -27,11 +27,11 @@ def _kernel_cache_dir() -> Path | None:
         return None
     here = Path(__file__).resolve().parent
     sources = sorted(here.glob("*.py"))  # this module and every kernel module beside it
-    digest = hashlib.sha256(numba.__version__.encode())
+    source_hash = hashlib.sha256(numba.__version__.encode())
     for path in sources:
-        digest.update(path.read_bytes())
+        source_hash.update(path.read_bytes())
     root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    folder = root / "plansim" / f"numba-{digest.hexdigest()[:16]}"
+    folder = root / "plansim" / f"numba-{source_hash.hexdigest()[:16]}"
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError:  # no writable home: numba's default (__pycache__ beside the sources)
