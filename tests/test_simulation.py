@@ -113,7 +113,7 @@ def test_white_noise_variances_follow_the_closed_forms():
 
 
 def test_earth_rate_is_confounded_with_the_diagonal_g_sensitivity():
-    """Digest §1.4: the vertical Earth rate flips sign with the up/down pairs of §7.2.2, so
+    """JJF 2003 §7.2.2: the vertical Earth rate flips sign with the up/down pairs of §7.2.2.1 a), so eq. (7) gives
     ĝ_ii − g_ii = Kg_ii Ω_ie sin φ / g_ref exactly (the gyro sees the vertical Earth rate through its
     scale factor), while the horizontal part cancels in the 180° pairs."""
     sc = scenario_with(environment={"earth_rate": True})
@@ -131,7 +131,7 @@ def test_earth_rate_is_confounded_with_the_diagonal_g_sensitivity():
 
 
 def test_printed_sign_of_eq_12_returns_minus_p():
-    """Digest §1.4: with eq. (2) as written, (U7 − U8)/ω² is −p; the 'model' sign returns +p."""
+    """JJF 2003 §7.2.5.2: with eq. (2) of §5.2 as written, eq. (12)'s (U7 − U8)/ω² is −p; 'model' returns +p."""
     sc = scenario_with(reduction={"omega_squared_sign": "as_printed"})
     res = plansim.run(sc, trials=2, seed=1)
     for name in ("pxy", "pyx", "pzy"):
