@@ -12,9 +12,10 @@ import math
 import numpy as np
 import pytest
 
-from plansim.model.environment import normal_gravity
-from plansim.io.scenario_file import load_scenario, save_scenario
+from conftest import IDEAL_TOML
 from plansim.config import parse_scenario
+from plansim.io.scenario_file import load_scenario, save_scenario
+from plansim.model.environment import normal_gravity
 from plansim.units import DEG, STANDARD_GRAVITY
 
 
@@ -113,8 +114,10 @@ BAD_INPUT = [
     ("unknown top-level scalar", _set("seed", 3), ValueError, r"unknown .*'seed'"),
     ("unknown key in [environment]", _set("environment.lattitude", "40 deg"), ValueError,
      r"\[environment\] has unknown key\(s\) 'lattitude'"),
-    ("unknown key in [schedule]", _set("schedule.dwel", "30 s"), ValueError, r"\[schedule\] has unknown key\(s\) 'dwel'"),
-    ("unknown key in [reduction]", _set("reduction.sign", "model"), ValueError, r"\[reduction\] has unknown key\(s\) 'sign'"),
+    ("unknown key in [schedule]", _set("schedule.dwel", "30 s"), ValueError,
+     r"\[schedule\] has unknown key\(s\) 'dwel'"),
+    ("unknown key in [reduction]", _set("reduction.sign", "model"), ValueError,
+     r"\[reduction\] has unknown key\(s\) 'sign'"),
     ("unknown key in [mimu.noise]", _set("mimu.noise.gyro_arw", "0.1 deg/sqrt(h)"), ValueError,
      r"\[mimu\.noise\] has unknown key\(s\) 'gyro_arw'"),
     ("unknown sub-table of [mimu]", _set("mimu.truths", {}), ValueError, r"\[mimu\] has unknown key\(s\) 'truths'"),
@@ -136,9 +139,11 @@ BAD_INPUT = [
      r"schedule\.rate_points\[1\] = '5 deg': unit 'deg' is not a unit of angular_rate"),
     ("bare number where a unit is needed", _set("environment.latitude", 40), ValueError,
      r"environment\.latitude = 40: a unit is required"),
-    ("bare number for a bias", _set("mimu.truth.Bgx", 0.12), ValueError, r"mimu\.truth\.Bgx = 0\.12: a unit is required"),
+    ("bare number for a bias", _set("mimu.truth.Bgx", 0.12), ValueError,
+     r"mimu\.truth\.Bgx = 0\.12: a unit is required"),
     ("bare number for dwell", _set("schedule.dwell", 30), ValueError, r"schedule\.dwell = 30: a unit is required"),
-    ("unit without a number", _set("environment.height", "m"), ValueError, r"environment\.height = 'm': expected '<number> <unit>'"),
+    ("unit without a number", _set("environment.height", "m"), ValueError,
+     r"environment\.height = 'm': expected '<number> <unit>'"),
     ("NaN latitude", _set("environment.latitude", "nan deg"), ValueError, r"environment\.latitude = 'nan deg'.*finite"),
     ("infinite bias", _set("mimu.truth.Bgx", "inf deg/s"), ValueError, r"mimu\.truth\.Bgx = 'inf deg/s'.*finite"),
     ("NaN scale factor", _set("mimu.truth.Kgxx", math.nan), ValueError, r"mimu\.truth\.Kgxx = nan.*finite"),
@@ -147,9 +152,11 @@ BAD_INPUT = [
     # dwell
     ("negative dwell, custom segment", _custom(dwell="-1 s"), ValueError, r"dwell = -1\.0 s; it must be > 0"),
     ("zero dwell, custom segment", _custom(dwell="0 s"), ValueError, r"dwell = 0\.0 s; it must be > 0"),
-    ("negative dwell, jjf2003 builder", _set("schedule.dwell", "-30 s"), ValueError, r"dwell = -30\.0 s; it must be > 0"),
+    ("negative dwell, jjf2003 builder", _set("schedule.dwell", "-30 s"), ValueError,
+     r"dwell = -30\.0 s; it must be > 0"),
     ("zero dwell, jjf2003 builder", _set("schedule.dwell", "0 s"), ValueError, r"dwell = 0\.0 s; it must be > 0"),
-    ("negative settle, jjf2003 builder", _set("schedule.settle", "-1 s"), ValueError, r"settle = -1\.0 s; it must be >= 0"),
+    ("negative settle, jjf2003 builder", _set("schedule.settle", "-1 s"), ValueError,
+     r"settle = -1\.0 s; it must be >= 0"),
     # rate points
     ("one rate point", _set("schedule.rate_points", ["100 deg/s"]), ValueError,
      r"schedule\.rate_points = .*at least 2 distinct rate points"),
@@ -162,7 +169,8 @@ BAD_INPUT = [
     ("rank-deficient position set (+x, -x, +y only)", _custom(ups=("+x", "-x", "+y")), ValueError,
      r"multi-position groups \[1, 2, 3\] give a rank-3 design matrix A; eq\. \(7\) needs rank 4"),
     ("no multi-position group at all", _custom(ups=()), ValueError, r"rank-0 design matrix A"),
-    ("positions neither 6 nor 12", _set("schedule.positions", 8), ValueError, r"schedule\.positions = 8; allowed: 6 or 12"),
+    ("positions neither 6 nor 12", _set("schedule.positions", 8), ValueError,
+     r"schedule\.positions = 8; allowed: 6 or 12"),
     ("unknown procedure", _set("schedule.procedure", "jjf1535"), ValueError,
      r"schedule\.procedure = 'jjf1535'; allowed: 'jjf2003', 'custom'"),
     ("custom schedule without segments", _set("schedule", {"procedure": "custom"}), ValueError, r"schedule\.segments"),
@@ -178,7 +186,8 @@ BAD_INPUT = [
     ("error table with a string coverage factor", _set("turntable.position_accuracy",
                                                         {"expanded_uncertainty": "20 arcsec", "k": "2"}), ValueError,
      r"turntable\.position_accuracy\.k = '2'"),
-    ("error table with negative uncertainty", _set("turntable.axis_perpendicularity", {"standard_uncertainty": "-3 arcsec"}),
+    ("error table with negative uncertainty",
+     _set("turntable.axis_perpendicularity", {"standard_uncertainty": "-3 arcsec"}),
      ValueError, r"turntable\.axis_perpendicularity = .*must be >= 0"),
     ("error table with wrong unit", _set("turntable.position_accuracy", {"limit": "10 m"}), ValueError,
      r"turntable\.position_accuracy\.limit = '10 m': unit 'm' is not a unit of angle"),
@@ -207,7 +216,8 @@ BAD_INPUT = [
      r"reduction\.omega_squared_sign = 'printed'; allowed: 'model', 'as_printed'"),
     # monte carlo
     ("trials = 0", _set("monte_carlo.trials", 0), ValueError, r"monte_carlo\.trials = 0: must be >= 1"),
-    ("trials a float", _set("monte_carlo.trials", 10.0), TypeError, r"monte_carlo\.trials = 10\.0: expected a whole number"),
+    ("trials a float", _set("monte_carlo.trials", 10.0), TypeError,
+     r"monte_carlo\.trials = 10\.0: expected a whole number"),
     ("seed a string", _set("monte_carlo.seed", "1"), TypeError, r"monte_carlo\.seed = '1': expected a whole number"),
     ("seed a boolean", _set("monte_carlo.seed", True), TypeError, r"monte_carlo\.seed = True: expected a whole number"),
     ("seed negative", _set("monte_carlo.seed", -1), ValueError, r"monte_carlo\.seed = -1: must be >= 0"),
@@ -281,7 +291,9 @@ def test_error_distribution_forms(ideal_document, table, kind, scale):
 
 
 def _assert_round_trip(document, tmp_path, rtol):
-    scenario = parse_scenario(document)
+    # a name of the user's own: a file whose name key says a built-in's name is named by its stem instead
+    # (test_a_saved_builtin_is_named_by_its_file)
+    scenario = parse_scenario(document, name="round_trip")
     path = tmp_path / "x.toml"
     save_scenario(scenario, path)
     loaded = load_scenario(path)
@@ -310,7 +322,8 @@ ROUND_TRIP_CASES = {
     "ideal": None,
     "6 positions": _set("schedule.positions", 6),
     "hand-written custom": _custom(),
-    "rate points on a 12-digit degree grid": _set("schedule.rate_points", ["-123.456789 deg/s", "0 deg/s", "0.5 deg/s"]),
+    "rate points on a 12-digit degree grid": _set("schedule.rate_points",
+                                                  ["-123.456789 deg/s", "0 deg/s", "0.5 deg/s"]),
 }
 
 # Numbers that need more than 12 significant digits: save_scenario writes repr() in SI, so they round-trip
@@ -328,6 +341,15 @@ def test_save_then_load_round_trip(ideal_document, tmp_path, modify):
 @pytest.mark.parametrize("modify", list(NOT_TWELVE_DIGIT_CASES.values()), ids=list(NOT_TWELVE_DIGIT_CASES))
 def test_round_trip_to_1e_12(ideal_document, tmp_path, modify):
     _assert_round_trip(modify(ideal_document), tmp_path, rtol=1e-12)
+
+
+def test_a_saved_builtin_is_named_by_its_file(tmp_path):
+    scenario = load_scenario("ideal")
+    save_scenario(scenario, tmp_path / "x.toml")
+    loaded = load_scenario(tmp_path / "x.toml")
+    assert loaded.name == "x" and "copied from built-in scenario 'ideal'" in loaded.source
+    save_scenario(scenario, tmp_path / "ideal.toml")
+    assert load_scenario(tmp_path / "ideal.toml").name == "ideal"
 
 
 # ----------------------------------------------------------------------------- regressions (bugs found in review)
@@ -351,3 +373,140 @@ def test_segment_that_is_not_a_table_names_its_index(ideal_document):
     with_custom_schedule(ideal_document, segments)
     with pytest.raises(TypeError, match=r"schedule\.segments\[2\]"):
         parse_scenario(ideal_document)
+
+
+# ----------------------------------------------------------------------------- names
+
+
+def _copy_builtin(tmp_path, builtin, stem, edit=None):
+    text = (IDEAL_TOML.parent / f"{builtin}.toml").read_text(encoding="utf-8")
+    if edit:
+        text = edit(text)
+    path = tmp_path / f"{stem}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_a_copied_builtin_reports_the_files_own_name(tmp_path):
+    """A new user copies jjf2003.toml to lab.toml and edits it; its `name` key still says "jjf2003".
+    The run is of lab.toml: it must not report itself as the built-in (header, NetCDF attrs, plot title)."""
+    path = _copy_builtin(tmp_path, "jjf2003", "lab", edit=lambda text: text.replace("trials = 20000", "trials = 50"))
+    scenario = load_scenario(path)
+    assert scenario.name == "lab"
+    assert scenario.trials == 50
+    # where it came from stays known
+    assert "jjf2003" in scenario.source and "lab.toml" in scenario.source
+
+
+def test_a_files_own_name_key_is_kept(tmp_path):
+    path = _copy_builtin(tmp_path, "ideal", "lab", edit=lambda text: text.replace('name = "ideal"',
+                                                                                 'name = "Lab B, unit 7"'))
+    scenario = load_scenario(path)
+    assert scenario.name == "Lab B, unit 7"
+    assert "lab.toml" in scenario.source and "ideal" not in scenario.source
+
+
+def test_a_file_without_a_name_key_is_named_by_its_stem(tmp_path):
+    path = _copy_builtin(tmp_path, "ideal", "bench_7", edit=lambda text: text.replace('name = "ideal"\n', ""))
+    assert load_scenario(path).name == "bench_7"
+
+
+def test_a_builtin_reports_its_name_and_origin():
+    scenario = load_scenario("jjf2003")
+    assert scenario.name == "jjf2003" and scenario.source == "built-in scenario 'jjf2003'"
+
+
+def test_parse_scenario_honours_the_name_argument(ideal_document):
+    assert ideal_document["name"] == "ideal"
+    assert parse_scenario(ideal_document, name="mine").name == "mine"
+    assert parse_scenario(ideal_document).name == "ideal"
+    del ideal_document["name"]
+    assert parse_scenario(ideal_document).name == "unnamed"
+
+
+def test_parse_scenario_checks_the_name_argument(ideal_document):
+    with pytest.raises(TypeError, match=r"name = 5: expected a string"):
+        parse_scenario(ideal_document, name=5)
+    with pytest.raises(ValueError, match=r"name = '': expected a non-empty name"):
+        parse_scenario(ideal_document, name="")
+
+
+def test_the_run_of_a_copied_builtin_carries_the_files_name(tmp_path, capsys):
+    """Header and NetCDF attributes of `plansim run lab.toml` (2 trials of the ideal world)."""
+    import xarray as xr
+
+    from plansim.cli import main
+
+    path = _copy_builtin(tmp_path, "ideal", "lab")
+    out = tmp_path / "r.nc"
+    assert main(["run", str(path), "--trials", "2", "--out", str(out), "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "scenario 'lab'" in text and "scenario 'ideal'" not in text
+    with xr.open_dataset(out, engine="scipy") as results:
+        assert results.attrs["scenario"] == "lab" and "'lab'" in results.attrs["title"]
+
+
+# ----------------------------------------------------------------------------- repeated rate points
+
+
+def test_a_repeated_rate_point_is_refused(ideal_document):
+    ideal_document["schedule"]["rate_points"] = ["-100 deg/s", "-5 deg/s", "0 deg/s", "5 deg/s", "5 deg/s",
+                                                 "100 deg/s"]
+    with pytest.raises(ValueError, match=r"schedule\.rate_points\[4\] = '5 deg/s' repeats "
+                                         r"schedule\.rate_points\[3\] = '5 deg/s'"):
+        parse_scenario(ideal_document)
+
+
+def test_a_repeated_rate_point_in_other_units_is_refused(ideal_document):
+    ideal_document["schedule"]["rate_points"] = ["-1 deg/s", "1 deg/s", "3600 deg/h"]
+    with pytest.raises(ValueError, match=r"schedule\.rate_points\[2\] = '3600 deg/h' repeats "
+                                         r"schedule\.rate_points\[1\] = '1 deg/s'"):
+        parse_scenario(ideal_document)
+
+
+def test_a_repeated_rate_segment_in_a_custom_schedule_is_refused(ideal_document):
+    segments = custom_segments(rates_deg=(-50.0, 0.0, 50.0, -50.0))
+    with_custom_schedule(ideal_document, segments)
+    with pytest.raises(ValueError, match=r"schedule\.segments\[9\] \('rate x -50\.0 deg/s'\): rate '-50\.0 deg/s' "
+                                         r"repeats schedule\.segments\[6\] \('rate x -50\.0 deg/s'\) of the rate "
+                                         r"test about x"):
+        parse_scenario(ideal_document)
+
+
+# ----------------------------------------------------------------------------- files that are not scenario files
+
+
+def _png_bytes() -> bytes:
+    return b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x01\x00\x00\x00\x01\x08\x02\x00\x00\x00" + bytes(32)
+
+
+GARBLED_SCENARIO_FILES = {
+    "a PNG renamed .toml": (_png_bytes(), r"not UTF-8 text"),
+    "random bytes": (np.random.default_rng(9).bytes(256), r"not UTF-8 text"),
+    "UTF-16 text": ('name = "lab"\n'.encode("utf-16"), r"UTF-16 text.*save it as UTF-8"),
+    "an empty file": (b"", r"is empty"),
+    "comments only": (b"# to do\n\n", r"is empty"),
+    "NUL bytes": (b"name = \"lab\"\n\x00\x00\x00\n", r"is not valid TOML"),
+}
+
+
+@pytest.mark.parametrize("data, match", list(GARBLED_SCENARIO_FILES.values()), ids=list(GARBLED_SCENARIO_FILES))
+def test_a_garbled_scenario_file_is_a_value_error_naming_the_file(tmp_path, data, match):
+    path = tmp_path / "lab.toml"
+    path.write_bytes(data)
+    with pytest.raises(ValueError, match=r"scenario file '.*lab\.toml'.*" + match) as caught:
+        load_scenario(path)
+    assert type(caught.value) is ValueError  # not a UnicodeDecodeError (a ValueError subclass without the file)
+
+
+def test_a_utf8_byte_order_mark_is_accepted(tmp_path):
+    path = tmp_path / "lab.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + (IDEAL_TOML.read_bytes()))
+    assert load_scenario(path).trials == 20
+
+
+def test_a_folder_is_not_a_scenario_file(tmp_path):
+    folder = tmp_path / "lab.toml"
+    folder.mkdir()
+    with pytest.raises(ValueError, match=r"lab\.toml.*is a folder"):
+        load_scenario(folder)

@@ -7,9 +7,10 @@ A scenario file has the sections ``[monte_carlo]``, ``[environment]``, ``[mimu]`
 ``[mimu.truth]``, ``[mimu.truth_spread]``, ``[mimu.noise]``, ``[mimu.effects]``),
 ``[acquisition]``, ``[turntable]``, ``[schedule]`` and ``[reduction]``; docs/scenario-file.md
 explains every field. Quantities are strings ``"<number> <unit>"``; parsing is strict: an unknown
-key, a wrong unit, a NaN, a non-positive dwell, fewer than two distinct rate points or a
-rank-deficient position set raise ``ValueError``/``TypeError`` naming the field and what is allowed.
-Inside, everything is SI.
+key, a wrong unit, a NaN, a non-positive dwell, fewer than two distinct rate points, a repeated rate
+point, a rank-deficient position set or a rate that drives an output beyond its range
+(:mod:`plansim.config.saturation`) raise ``ValueError``/``TypeError`` naming the field, the value and
+what is allowed. Inside, everything is SI.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from plansim.config.saturation import check_saturation
 from plansim.estimate.jjf2003 import check_design
 from plansim.model.environment import earth_rate_enu, normal_gravity
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, PARAMETERS
@@ -105,6 +107,9 @@ class Acquisition:
     bits: int  # 0 = no quantisation
     gyro_full_scale: float  # rad/s
     accel_full_scale: float  # m/s²
+    #: the schedule may drive outputs beyond the range or full scale on purpose (they are clipped);
+    #: without it such a scenario is refused when it loads (plansim.config.saturation)
+    allow_saturation: bool = False
 
     @property
     def gyro_step(self) -> float:
@@ -141,6 +146,13 @@ class Reduction:
 
 @dataclass(frozen=True)
 class Scenario:
+    """The whole simulated world and procedure, SI inside; built by :func:`parse_scenario`.
+
+    ``name`` is what reports and results call the scenario; ``source`` says where it came from
+    (``"built-in scenario 'jjf2003'"``, ``"file 'lab.toml'"``, ``"file 'lab.toml', copied from built-in
+    scenario 'jjf2003'"``; empty for a document not read from a file).
+    """
+
     name: str
     description: str
     trials: int
@@ -156,6 +168,7 @@ class Scenario:
     schedule: Schedule
     reduction: Reduction
     document: dict = field(repr=False, default_factory=dict)  # the parsed TOML, for provenance and saving
+    source: str = ""
 
 
 # ----------------------------------------------------------------------------- parsing helpers
@@ -226,9 +239,11 @@ class _Section:
         if isinstance(raw, dict):
             keys = set(raw)
             if keys == {"limit"}:
-                return ErrorDistribution("uniform", _nonneg(parse_quantity(raw["limit"], kind, where + ".limit"), where))
+                limit = parse_quantity(raw["limit"], kind, where + ".limit")
+                return ErrorDistribution("uniform", _nonneg(limit, where))
             if keys == {"standard_uncertainty"}:
-                return ErrorDistribution("normal", _nonneg(parse_quantity(raw["standard_uncertainty"], kind, where), where))
+                u = parse_quantity(raw["standard_uncertainty"], kind, where)
+                return ErrorDistribution("normal", _nonneg(u, where))
             if keys == {"expanded_uncertainty", "k"}:
                 k = raw["k"]
                 if isinstance(k, bool) or not isinstance(k, (int, float)) or not k > 0:
@@ -276,7 +291,13 @@ def _parse_truth(section: _Section, default_zero: bool) -> np.ndarray:
     return out
 
 
-def _parse_schedule(document: dict) -> Schedule:
+def _same_rate(a: float, b: float) -> bool:
+    """Two rates the same rate point (written in different units, they may differ in the last bit)."""
+    return math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-15)
+
+
+def _parse_schedule(document: dict) -> tuple[Schedule, list[tuple[str, object] | None]]:
+    """The schedule, and per segment ``(field, value as written)`` of the rate that set it (``None`` at rest)."""
     s = _Section(document, "schedule")
     procedure = s.string("procedure", "jjf2003", allowed=("jjf2003", "custom"))
     if procedure == "custom":
@@ -307,12 +328,17 @@ def _parse_schedule(document: dict) -> Schedule:
             seg.check_unknown()
         s.check_unknown()
         schedule = Schedule(tuple(segments), procedure="custom")
+        origins = [(f"schedule.segments[{i}].rate", raw.get("rate")) if segment.is_rotating else None
+                   for i, (segment, raw) in enumerate(zip(segments, raw_segments))]
+        check_design(schedule)  # the estimators say what they need
+        _check_repeated_rate_segments(schedule, raw_segments)
     else:
         rate_points = s.get("rate_points", ["-100 deg/s", "-50 deg/s", "-20 deg/s", "-5 deg/s", "0 deg/s",
                                             "5 deg/s", "20 deg/s", "50 deg/s", "100 deg/s"])
         if not isinstance(rate_points, list):
             raise TypeError(f"schedule.rate_points = {rate_points!r}: expected a list of rates")
         rates = [parse_quantity(r, "angular_rate", f"schedule.rate_points[{i}]") for i, r in enumerate(rate_points)]
+        omega_squared_raw = s.get("omega_squared_rate", "100 deg/s")
         schedule = jjf2003(
             rate_points=rates,
             omega_squared_rate=s.quantity("omega_squared_rate", "angular_rate", "100 deg/s"),
@@ -325,12 +351,63 @@ def _parse_schedule(document: dict) -> Schedule:
                              else s.quantity("temperature_end", "temperature", None)),
         )
         s.check_unknown()
-    check_design(schedule)  # the estimators say what they need
-    return schedule
+        check_design(schedule)  # the estimators say what they need
+        for i, rate in enumerate(rates):
+            for j in range(i):
+                if _same_rate(rate, rates[j]):
+                    raise ValueError(f"schedule.rate_points[{i}] = {rate_points[i]!r} repeats "
+                                     f"schedule.rate_points[{j}] = {rate_points[j]!r}: each rate point is recorded "
+                                     "once per axis (JJF 2003 §7.2.1: 7 to 11 rate points, including the maximum "
+                                     "rate); remove the repeat")
+        origins = []
+        for segment in schedule.segments:
+            if not segment.is_rotating:
+                origins.append(None)
+            elif segment.test == "rate":
+                i = next(i for i, rate in enumerate(rates) if _same_rate(rate, segment.rate))
+                origins.append((f"schedule.rate_points[{i}]", rate_points[i]))
+            else:
+                origins.append(("schedule.omega_squared_rate", omega_squared_raw))
+    return schedule, origins
 
 
-def parse_scenario(document: dict, name: str | None = None) -> Scenario:
-    """Build a :class:`Scenario` from a parsed TOML document, validating every field."""
+def _check_repeated_rate_segments(schedule: Schedule, raw_segments: list[dict]) -> None:
+    """Two rate-test segments about the same axis at the same rate are a repeat (a typo, or a weight the
+    line fit of eq. (5) was not meant to have): refused, naming both."""
+    seen: dict[int, list[int]] = {}
+    for k, segment in enumerate(schedule.segments):
+        if segment.test != "rate":
+            continue
+        for j in seen.setdefault(segment.group, []):
+            if _same_rate(segment.rate, schedule.segments[j].rate):
+                raise ValueError(
+                    f"schedule.segments[{k}] ({segment.label!r}): rate {raw_segments[k].get('rate', '0 deg/s')!r} "
+                    f"repeats schedule.segments[{j}] ({schedule.segments[j].label!r}) of the rate test about "
+                    f"{'xyz'[segment.group]}: each rate point is recorded once per axis (JJF 2003 §7.2.1: 7 to 11 "
+                    "rate points); remove the repeat")
+        seen[segment.group].append(k)
+
+
+def parse_scenario(document: dict, name: str | None = None, source: str = "") -> Scenario:
+    """Build a :class:`Scenario` from a parsed TOML document, validating every field.
+
+    Parameters
+    ----------
+    document : dict
+        The scenario as TOML gives it (docs/scenario-file.md).
+    name : str, optional
+        The scenario's name; when given it wins over the document's ``name`` key. Without it: the
+        document's ``name``, else ``"unnamed"``.
+    source : str
+        Where the document came from, kept in :attr:`Scenario.source` (``load_scenario`` sets it).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A field is unknown, of the wrong kind or unit, out of range, or the schedule cannot give every
+        parameter, repeats a rate point, or drives an output beyond its range; the message names the
+        field, the value and what is allowed.
+    """
     if not isinstance(document, dict):
         raise TypeError(f"scenario: expected a TOML table, got {type(document).__name__}")
     unknown = set(document) - _TOP_LEVEL
@@ -393,7 +470,8 @@ def parse_scenario(document: dict, name: str | None = None) -> Scenario:
         accel_second_order=e.vector("accel_second_order", "per_acceleration"),
         gyro_bias_temperature_coefficient=e.vector("gyro_bias_temperature_coefficient", "angular_rate_per_temperature"),
         gyro_scale_temperature_coefficient=e.vector("gyro_scale_temperature_coefficient", "per_temperature"),
-        accel_bias_temperature_coefficient=e.vector("accel_bias_temperature_coefficient", "acceleration_per_temperature"),
+        accel_bias_temperature_coefficient=e.vector("accel_bias_temperature_coefficient",
+                                                    "acceleration_per_temperature"),
         accel_scale_temperature_coefficient=e.vector("accel_scale_temperature_coefficient", "per_temperature"),
         reference_temperature=e.quantity("reference_temperature", "temperature", "20 degC"),
         accel_lever_arm=e.matrix("accel_lever_arm", "length"),
@@ -408,7 +486,8 @@ def parse_scenario(document: dict, name: str | None = None) -> Scenario:
         raise ValueError(f"acquisition.bits = {bits}: must be 0 (no quantisation) to 52")
     acquisition = Acquisition(bits=bits,
                               gyro_full_scale=a.quantity("gyro_full_scale", "angular_rate", "125 deg/s"),
-                              accel_full_scale=a.quantity("accel_full_scale", "acceleration", "8 g"))
+                              accel_full_scale=a.quantity("accel_full_scale", "acceleration", "8 g"),
+                              allow_saturation=a.boolean("allow_saturation", False))
     a.check_unknown()
     if bits and not (acquisition.gyro_full_scale > 0 and acquisition.accel_full_scale > 0):
         raise ValueError("acquisition: gyro_full_scale and accel_full_scale must be > 0 when bits > 0")
@@ -426,7 +505,7 @@ def parse_scenario(document: dict, name: str | None = None) -> Scenario:
     )
     t.check_unknown()
 
-    schedule = _parse_schedule(document)
+    schedule, origins = _parse_schedule(document)
 
     r = _Section(document, "reduction")
     raw_g = r.get("reference_gravity", "local")
@@ -446,13 +525,24 @@ def parse_scenario(document: dict, name: str | None = None) -> Scenario:
                           omega_squared_sign=r.string("omega_squared_sign", "model", allowed=("model", "as_printed")))
     r.check_unknown()
 
-    scenario_name = document.get("name", name or "unnamed")
     description = document.get("description", "")
-    for key, value in (("name", scenario_name), ("description", description)):
-        if not isinstance(value, str):
+    for key, value in (("name", document.get("name", "unnamed")), ("name", name), ("description", description)):
+        if value is not None and not isinstance(value, str):
             raise TypeError(f"{key} = {value!r}: expected a string")
-    return Scenario(name=scenario_name, description=description, trials=trials, seed=seed,
-                    environment=environment, mimu_description=mimu_description,
-                    truth_nominal=truth_nominal, truth_spread=truth_spread, noise=noise, effects=effects,
-                    acquisition=acquisition, turntable=turntable, schedule=schedule, reduction=reduction,
-                    document=copy.deepcopy(document))
+    scenario_name = name if name is not None else document.get("name", "unnamed")
+    if not scenario_name.strip():
+        raise ValueError(f"name = {scenario_name!r}: expected a non-empty name")
+    if not isinstance(source, str):
+        raise TypeError(f"source = {source!r}: expected a string")
+    scenario = Scenario(name=scenario_name, description=description, trials=trials, seed=seed,
+                        environment=environment, mimu_description=mimu_description,
+                        truth_nominal=truth_nominal, truth_spread=truth_spread, noise=noise, effects=effects,
+                        acquisition=acquisition, turntable=turntable, schedule=schedule, reduction=reduction,
+                        document=copy.deepcopy(document), source=source)
+    check_saturation(scenario, origins, {
+        "mimu.gyro_range": mimu.data.get("gyro_range", "0 deg/s"),
+        "mimu.accel_range": mimu.data.get("accel_range", "0 g"),
+        "acquisition.gyro_full_scale": a.data.get("gyro_full_scale", "125 deg/s"),
+        "acquisition.accel_full_scale": a.data.get("accel_full_scale", "8 g"),
+    })
+    return scenario

@@ -1,9 +1,10 @@
 """Scenario files: the built-in scenarios, and reading and writing scenario TOML.
 
 Parsing is strict (:func:`plansim.config.parse_scenario`): an unknown key, a wrong unit, a NaN, a
-non-positive dwell, fewer than two distinct rate points or a rank-deficient position set raise
-``ValueError``/``TypeError`` naming the field and what is allowed. docs/scenario-file.md explains
-every field.
+non-positive dwell, fewer than two distinct rate points, a repeated rate point, a rank-deficient
+position set or a rate beyond the range raise ``ValueError``/``TypeError`` naming the field and what
+is allowed; a file that is not UTF-8 TOML (binary, UTF-16, empty) is a ``ValueError`` naming the
+file. docs/scenario-file.md explains every field.
 """
 
 from __future__ import annotations
@@ -29,22 +30,72 @@ def builtin_scenarios() -> dict[str, Path]:
 
 
 def load_scenario(name_or_path: str | os.PathLike = "jjf2003") -> Scenario:
-    """Load a built-in scenario by name, or a TOML file by path."""
+    """Load a built-in scenario by name, or a TOML file by path.
+
+    The scenario's name: a built-in one's is its own; a file's is the document's ``name`` key, else
+    the file name without ``.toml`` — except that a ``name`` still saying a built-in scenario's name
+    in a file that is not that built-in (a copy a user edits: ``jjf2003.toml`` copied to ``lab.toml``)
+    gives way to the file name, so that the run of ``lab.toml`` does not report itself as
+    ``jjf2003``. :attr:`Scenario.source` keeps where it came from (``"file 'lab.toml', copied from
+    built-in scenario 'jjf2003'"``).
+
+    Raises
+    ------
+    ValueError
+        No such file or built-in; the file is a folder, cannot be read, is not UTF-8 text (binary
+        data, UTF-16), is empty or holds only comments, is not valid TOML, or fails
+        :func:`plansim.config.parse_scenario`. The message names the file.
+    """
     text_name = str(name_or_path)
     builtin = builtin_scenarios()
     if text_name in builtin:
-        path = builtin[text_name]
-    else:
-        path = Path(text_name)
-        if not path.is_file():
-            raise ValueError(f"scenario {text_name!r}: no such file and no built-in scenario of that name; "
-                             f"built-in: {', '.join(builtin)}")
+        document = _read_document(builtin[text_name])
+        return parse_scenario(document, name=text_name, source=f"built-in scenario {text_name!r}")
+    path = Path(text_name)
+    if path.is_dir():
+        raise ValueError(f"scenario file {text_name!r} is a folder, not a TOML file")
+    if not path.is_file():
+        raise ValueError(f"scenario {text_name!r}: no such file and no built-in scenario of that name; "
+                         f"built-in: {', '.join(builtin)}")
+    document = _read_document(path)
+    source = f"file {str(path)!r}"
+    named = document.get("name")
+    if isinstance(named, str) and named in builtin and not _same_file(path, builtin[named]):
+        # a copy of a built-in whose name key was never changed: the file is the user's, not the built-in
+        return parse_scenario(document, name=path.stem, source=f"{source}, copied from built-in scenario {named!r}")
+    return parse_scenario(document, name=None if named is not None else path.stem, source=source)
+
+
+def _same_file(a: Path, b: Path) -> bool:
     try:
-        with open(path, "rb") as fh:
-            document = tomllib.load(fh)
+        return a.samefile(b)
+    except OSError:
+        return False
+
+
+def _read_document(path: Path) -> dict:
+    """The TOML document of *path*; every way a file can fail to be one is a ValueError naming it."""
+    where = f"scenario file {str(path)!r}"
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"{where} cannot be read: {exc.strerror or exc}") from None
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise ValueError(f"{where} is UTF-16 text; TOML is UTF-8: save it as UTF-8")
+    try:
+        text = data.decode("utf-8-sig")  # a UTF-8 byte-order mark, as some editors write it, is accepted
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{where} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}): binary "
+                         "data, such as an image or a NetCDF file, is not a scenario; a scenario file is TOML "
+                         "(docs/scenario-file.md)") from None
+    try:
+        document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
-    return parse_scenario(document, name=path.stem)
+        raise ValueError(f"{where} is not valid TOML: {exc}") from None
+    if not document:
+        raise ValueError(f"{where} is empty (no key, only comments or nothing): a file cut short or never written? "
+                         "To run the default world on purpose, write at least one key, e.g. a name = \"...\" line")
+    return document
 
 
 def schedule_to_document(schedule: Schedule) -> dict:
