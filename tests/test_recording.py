@@ -321,3 +321,108 @@ def test_simulate_and_record_matches_the_engine():
     assert recording.attrs["source"] == "simulated" and recording.attrs["scenario"] == scenario.name
     assert recording.attrs["seed"] == 7 and recording.attrs["trial"] == 1
     assert recording.schedule is scenario.schedule
+
+
+# ----------------------------------------------------------------------------- cut short, binary or garbled files
+
+
+def test_csv_cut_inside_its_last_number_is_refused(tmp_path):
+    """A copy that stopped mid-file: the last line keeps all its columns but loses the last number's final
+    digits, so every count still agrees. Only the missing line end shows it."""
+    path, _ = write_csv_pair(tmp_path)
+    text = path.read_text(encoding="utf-8")
+    assert text.endswith("\n")
+    cut = text[:-4]  # the line end and three digits of the last az
+    assert cut.rsplit("\n", 1)[1].count(",") == len(CSV_SAMPLE_COLUMNS) - 1
+    path.write_text(cut, encoding="utf-8")
+    lines = cut.count("\n") + 1
+    with pytest.raises(ValueError, match=rf"run\.csv.*last line \(line {lines}\) does not end with a line break.*"
+                                         r"cut short"):
+        read_recording(path)
+
+
+def test_csv_cut_inside_its_last_line_is_refused(tmp_path):
+    path, _ = write_csv_pair(tmp_path)
+    text = path.read_text(encoding="utf-8")
+    path.write_text(text[:text.rindex(",")], encoding="utf-8")  # the last row loses its last column
+    with pytest.raises(ValueError, match=r"run\.csv.*(cut short|column)"):
+        read_recording(path)
+
+
+def test_segment_table_cut_at_its_end_is_refused(tmp_path):
+    """Its last column (samples, 6) loses its line end: a cut there cannot be told from a complete row."""
+    path, table = write_csv_pair(tmp_path)
+    text = table.read_text(encoding="utf-8")
+    table.write_text(text[:-1], encoding="utf-8")
+    with pytest.raises(ValueError, match=r"run\.segments\.csv.*does not end with a line break"):
+        read_recording(path)
+
+
+def test_csv_without_a_final_line_end_but_complete_is_still_refused_with_the_fix(tmp_path):
+    path, _ = write_csv_pair(tmp_path)
+    path.write_text(path.read_text(encoding="utf-8").rstrip("\n"), encoding="utf-8")
+    with pytest.raises(ValueError, match=r"if the file is complete, end it with a line break"):
+        read_recording(path)
+    path.write_text(path.read_text(encoding="utf-8") + "\r\n", encoding="utf-8")  # CRLF line ends are fine
+    assert read_recording(path) == tiny_recording()
+
+
+def _png_bytes() -> bytes:
+    return b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x01\x00\x00\x00\x01\x08\x02\x00\x00\x00" + bytes(32)
+
+
+GARBLED = {
+    "a PNG": _png_bytes(),
+    "random bytes": np.random.default_rng(4).bytes(600),
+    "UTF-16 text": ",".join(CSV_SAMPLE_COLUMNS).encode("utf-16") + "\n0,0,1,2,3,4,5,6\n".encode("utf-16-le"),
+    "an empty file": b"",
+    "NUL bytes": b"time_s,segment\x00\x00,gx\n",
+}
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".nc"])
+@pytest.mark.parametrize("data", list(GARBLED.values()), ids=list(GARBLED))
+def test_a_garbled_recording_is_a_value_error_naming_the_file(tmp_path, data, suffix):
+    path = tmp_path / f"lab{suffix}"
+    path.write_bytes(data)
+    if suffix == ".csv":
+        write_recording(tiny_recording(), tmp_path / "good.csv")
+        (tmp_path / "good.segments.csv").rename(tmp_path / "lab.segments.csv")
+    with pytest.raises(ValueError, match=rf"recording file '.*lab\{suffix}'") as caught:
+        read_recording(path)
+    assert type(caught.value) is ValueError
+
+
+def test_a_garbled_segment_table_is_a_value_error_naming_it(tmp_path):
+    path, table = write_csv_pair(tmp_path)
+    table.write_bytes(_png_bytes())
+    with pytest.raises(ValueError, match=r"segment table '.*run\.segments\.csv'.*not UTF-8 text") as caught:
+        read_recording(path)
+    assert type(caught.value) is ValueError
+
+
+def test_a_utf16_csv_says_so(tmp_path):
+    path, _ = write_csv_pair(tmp_path)
+    path.write_bytes(path.read_text(encoding="utf-8").encode("utf-16"))
+    with pytest.raises(ValueError, match=r"run\.csv.*UTF-16 text.*save it as UTF-8"):
+        read_recording(path)
+
+
+def test_a_netcdf_cut_short_or_damaged_is_a_value_error_naming_the_file(tmp_path):
+    """Every cut of a good file, and bytes flipped at random: never an IndexError, KeyError or struct.error."""
+    good = tmp_path / "good.nc"
+    write_recording(tiny_recording(), good)
+    data = good.read_bytes()
+    path = tmp_path / "lab.nc"
+    rng = np.random.default_rng(11)
+    damaged = [data[:cut] for cut in range(0, len(data), 97)]
+    for _ in range(60):
+        flipped = np.frombuffer(data, dtype=np.uint8).copy()
+        flipped[rng.integers(0, 400, 4)] = rng.integers(0, 256, 4)  # the header: dimensions, names, types
+        damaged.append(flipped.tobytes())
+    for k, content in enumerate(damaged):
+        path.write_bytes(content)
+        try:
+            read_recording(path)
+        except ValueError as exc:
+            assert type(exc) is ValueError and "lab.nc" in str(exc), (k, repr(exc))

@@ -46,10 +46,13 @@ def schedule_notes_text(schedule: Schedule) -> str:
 
 
 
-def plain(value: object) -> object:
-    """numpy scalars and bytes from a file -> plain Python values."""
+def plain(value: object, where: str = "recording") -> object:
+    """numpy scalars and bytes from a file -> plain Python values; bytes that are not UTF-8 are a ValueError."""
     if isinstance(value, bytes):
-        return value.decode("utf-8")
+        try:
+            return value.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ValueError(f"{where}: text {value[:40]!r} is not UTF-8") from None
     if isinstance(value, np.generic):
         return value.item()
     return value

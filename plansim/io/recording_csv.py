@@ -12,6 +12,8 @@ import json
 import math
 import os
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -112,6 +114,72 @@ def write_csv(recording: Recording, target: Path) -> None:
         raise
 
 
+#: how much of a file's start is checked for binary content before it is parsed, bytes
+_HEAD_BYTES = 8192
+
+
+@contextmanager
+def _text_file(path: Path, where: str) -> Iterator:
+    """Open *path* as UTF-8 text for the CSV reader; every way it fails to be text is a ValueError naming it.
+
+    Before parsing: unreadable, empty, UTF-16 (byte-order mark), NUL bytes or undecodable bytes at the
+    start (a binary file renamed .csv). While parsing (inside the ``with`` block): undecodable bytes
+    further on, and the csv module's errors.
+    """
+    try:
+        with open(path, "rb") as raw:
+            head = raw.read(_HEAD_BYTES)
+    except OSError as exc:
+        raise ValueError(f"{where} cannot be read: {exc.strerror or exc}") from None
+    if not head:
+        raise ValueError(f"{where} is empty; expected a header line of column names, then one row per "
+                         "sample or segment")
+    if head[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise ValueError(f"{where} is UTF-16 text; plansim reads UTF-8 CSV: save it as UTF-8")
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        # a multi-byte character cut by the end of the head is not an error
+        if exc.start < len(head) - 3:
+            raise ValueError(_not_utf8(where, exc)) from None
+    if b"\x00" in head:
+        raise ValueError(f"{where} holds NUL bytes: binary data or UTF-16 text, not a UTF-8 CSV file")
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as fh:
+            yield fh
+    except UnicodeDecodeError as exc:
+        raise ValueError(_not_utf8(where, exc)) from None
+    except csv.Error as exc:
+        raise ValueError(f"{where}: not a readable CSV file ({exc})") from None
+    except OSError as exc:
+        raise ValueError(f"{where} cannot be read: {exc.strerror or exc}") from None
+
+
+def _not_utf8(where: str, exc: UnicodeDecodeError) -> str:
+    byte = exc.object[exc.start]
+    return (f"{where} is not UTF-8 text (byte 0x{byte:02x} cannot be decoded): binary data, such as an image or "
+            "a NetCDF file renamed .csv? A CSV recording is UTF-8 text (docs/recording.md)")
+
+
+def _check_line_end(path: Path, where: str) -> None:
+    """A complete file ends with a line break: text after the last one may be a number cut short.
+
+    A file cut inside its last number keeps every row and column, so no count shows it; plansim ends
+    every line it writes, and so do spreadsheet and acquisition exports.
+    """
+    with open(path, "rb") as raw:
+        size = raw.seek(0, os.SEEK_END)
+        raw.seek(max(0, size - 64))
+        tail = raw.read().rstrip(b" \t")
+        if not tail or tail[-1:] in (b"\n", b"\r"):
+            return
+        raw.seek(0)
+        breaks = sum(block.count(b"\n") for block in iter(lambda: raw.read(1 << 20), b""))
+    raise ValueError(f"{where}: the last line (line {breaks + 1}) does not end with a line break: the file may "
+                     "have been cut short inside its last number (a copy or transfer that stopped); if the file is "
+                     "complete, end it with a line break")
+
+
 def _read_header(fh, where: str) -> tuple[dict, list[str], int]:
     """Leading ``#`` lines -> attributes (``# key: JSON value``; other text is kept as a string);
     then the column names. Returns (attrs, columns, line number of the column names)."""
@@ -119,6 +187,9 @@ def _read_header(fh, where: str) -> tuple[dict, list[str], int]:
     line_number = 0
     for line in fh:
         line_number += 1
+        if "\x00" in line:
+            raise ValueError(f"{where}: line {line_number} holds NUL characters: binary data or UTF-16 text, not a "
+                             "UTF-8 CSV file")
         stripped = line.strip()
         if not stripped:
             continue
@@ -146,9 +217,10 @@ def _read_table_csv(table_target: Path, procedure: str, notes: dict) -> Schedule
     if not table_target.is_file():
         raise ValueError(f"{where} does not exist; a CSV recording is two files, the samples and "
                          f"<stem>{SEGMENT_TABLE_SUFFIX} beside them")
-    with open(table_target, encoding="utf-8-sig", newline="") as fh:
+    with _text_file(table_target, where) as fh:
         _, columns, _ = _read_header(fh, where)
         rows = list(csv.reader(fh))
+    _check_line_end(table_target, where)
     rows = [row for row in rows if any(cell.strip() for cell in row)]
     required = ["segment"] + list(_CSV_FIELD_COLUMNS.values())
     missing = [name for name in required if name not in columns]
@@ -211,7 +283,7 @@ def _read_table_csv(table_target: Path, procedure: str, notes: dict) -> Schedule
 def read_csv(target: Path) -> Recording:
     where = f"recording file {str(target)!r}"
     table_target = segment_table_path(target)
-    with open(target, encoding="utf-8-sig", newline="") as fh:
+    with _text_file(target, where) as fh:
         attrs, columns, header_line = _read_header(fh, where)
         missing = [name for name in CSV_SAMPLE_COLUMNS if name not in columns]
         if missing:
@@ -222,6 +294,7 @@ def read_csv(target: Path) -> Recording:
         except ValueError as exc:
             raise ValueError(f"{where}: {exc} (rows counted after the header, line {header_line}); every value of "
                              f"{', '.join(CSV_SAMPLE_COLUMNS)} must be a number") from None
+    _check_line_end(target, where)
     check_format_attributes(attrs, where)
     procedure = attrs.pop("schedule_procedure", "custom")
     notes = schedule_notes(attrs.pop("schedule_notes", None), where)

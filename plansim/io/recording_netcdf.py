@@ -110,7 +110,7 @@ def dataset_to_recording(dataset: xr.Dataset, where: str = "dataset") -> Recordi
     """
     if not isinstance(dataset, xr.Dataset):
         raise TypeError(f"{where}: expected an xarray Dataset, got {type(dataset).__name__}")
-    attrs = {key: plain(value) for key, value in dataset.attrs.items()}
+    attrs = {key: plain(value, where) for key, value in dataset.attrs.items()}
     check_format_attributes(attrs, where)
     procedure = str(attrs.pop("schedule_procedure", "custom"))
     notes = schedule_notes(attrs.pop("schedule_notes", None), where)
@@ -125,14 +125,14 @@ def dataset_to_recording(dataset: xr.Dataset, where: str = "dataset") -> Recordi
         if var.dims != (dimension,):
             raise ValueError(f"{where}: variable {name!r} has dimensions {var.dims}; expected ({dimension!r},)")
         found_units = var.attrs.get("units")
-        if units is not None and found_units is not None and plain(found_units) != units:
-            raise ValueError(f"{where}: variable {name!r} has units {plain(found_units)!r}; expected {units!r} "
+        if units is not None and found_units is not None and plain(found_units, where) != units:
+            raise ValueError(f"{where}: variable {name!r} has units {plain(found_units, where)!r}; expected {units!r} "
                              "(convert to SI before writing the file)")
         return np.asarray(var.values)
 
     table = {name: variable(name, "segment", units) for name, (units, _) in SEGMENT_FIELDS.items()}
     for name in TEXT_FIELDS:
-        table[name] = [plain(value) for value in table[name]]
+        table[name] = [plain(value, where) for value in table[name]]
     schedule = schedule_from_columns(table, where, column_names={name: name for name in SEGMENT_FIELDS},
                                       procedure=procedure, notes=notes)
     channels = []
@@ -176,9 +176,10 @@ def read_netcdf(target: Path) -> Recording:
     where = f"recording file {str(target)!r}"
     try:
         dataset = xr.load_dataset(target, engine="scipy", decode_times=False, decode_timedelta=False)
-    except (OSError, TypeError, ValueError) as exc:
-        raise ValueError(f"{where}: not a readable NetCDF-3 file ({exc})") from None
-    attrs = {key: plain(value) for key, value in dataset.attrs.items()}
+    except Exception as exc:  # the parser, fed arbitrary bytes, fails in many ways: IndexError, KeyError, ...
+        raise ValueError(f"{where}: not a readable NetCDF-3 file, or one cut short or damaged "
+                         f"({type(exc).__name__}: {exc})") from None
+    attrs = {key: plain(value, where) for key, value in dataset.attrs.items()}
     for key in str(attrs.pop("integer_text_attributes", "")).split():
         try:
             attrs[key] = int(attrs[key])
