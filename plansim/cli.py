@@ -109,6 +109,60 @@ def _cmd_record(args) -> int:
     return 0
 
 
+def _cmd_validate(args) -> int:
+    from plansim.io.claims import load_claims
+    from plansim.io.scenario_file import load_scenario
+    from plansim.report.validation import format_report, stderr_block_progress, validation_json
+    from plansim.runner import validate
+
+    scenario = load_scenario(args.scenario)
+    claims = load_claims(args.claims, scenario) if args.claims else None
+    for option, value, minimum in (("--trials-per-block", args.trials_per_block, 2),
+                                   ("--max-trials", args.max_trials, 1), ("--digits", args.digits, 1)):
+        if value < minimum:
+            raise ValueError(f"{option} {value}: must be >= {minimum}")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    progress = None if (args.quiet or args.json) else stderr_block_progress(f"plansim validate {scenario.name}")
+    report = validate(scenario, claims, digits=args.digits, trials_per_block=args.trials_per_block,
+                      max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
+    if progress is not None:
+        sys.stderr.write("\n")
+    if args.json:
+        print(json.dumps(validation_json(report), indent=2))
+    else:
+        print(format_report(report, details=not args.summary))
+    return 0
+
+
+def _add_validate_command(sub) -> None:
+    from plansim.uncertainty.metrology.monte_carlo import DEFAULT_DIGITS, DEFAULT_TRIALS_PER_BLOCK
+    from plansim.uncertainty.validation import DEFAULT_MAX_TRIALS
+
+    p = sub.add_parser(
+        "validate", help="GUM budget from the schedule, validated by adaptive Monte Carlo (JCGM 101/102); "
+                         "checks a claimed budget (default: JJF 2003 Appendix A)")
+    p.add_argument("scenario", nargs="?", default="jjf2003",
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+    p.add_argument("--claims", default=None,
+                   help="TOML file of claimed expanded uncertainties ([items.\"A.2\"] U = ...; [parameters.Bgx] "
+                        "U = \"10 deg/h\"; k = 2 by default); default: the Appendix A budgets as printed")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the text report")
+    p.add_argument("--trials-per-block", type=int, default=DEFAULT_TRIALS_PER_BLOCK,
+                   help=f"M, Monte Carlo trials per block (JCGM 101 7.9.4 b); default {DEFAULT_TRIALS_PER_BLOCK}")
+    p.add_argument("--max-trials", type=int, default=DEFAULT_MAX_TRIALS,
+                   help=f"stop the adaptive procedure here at the latest (default {DEFAULT_MAX_TRIALS})")
+    p.add_argument("--seed", type=int, default=None, help="root seed of the block seeds (default: the scenario's)")
+    p.add_argument("--digits", type=int, default=DEFAULT_DIGITS,
+                   help="n_dig, significant digits of the numerical tolerance δ "
+                        f"(JCGM 101 7.9.2; default {DEFAULT_DIGITS})")
+    p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
+                   help="simulation path: auto takes the segment-statistics path only where it is exact")
+    p.add_argument("--summary", action="store_true", help="text report without the per-parameter budgets")
+    p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
+    p.set_defaults(func=_cmd_validate)
+
+
 def _cmd_bench(args) -> int:
     import numba
 
@@ -155,8 +209,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="small sizes (seconds): checks the method, not the speed")
     p.add_argument("--threads", type=int, default=None, help="pin the kernel thread count (default: all cores)")
     p.set_defaults(func=_cmd_bench)
-    from plansim.uncertainty.validate import add_validate_command
-    add_validate_command(sub)
+    _add_validate_command(sub)
     return parser
 
 

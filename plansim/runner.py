@@ -4,12 +4,15 @@
 and returns an :class:`xarray.Dataset` with ``truth``, ``estimate`` and ``error`` over
 (``trial``, ``parameter``); parameter labels are the specification's symbols, values are SI with a
 ``units`` attribute, and the provenance (package version, scenario, seed, path) is in ``attrs``.
+``validate`` and ``adaptive_monte_carlo`` hand :mod:`plansim.uncertainty` a simulate callable
+built on ``run`` (:func:`error_simulator`), so the uncertainty layer never imports the runner.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 import tomli_w
@@ -24,6 +27,10 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, PARAMETERS
 from plansim.simulate.chunks import ProgressCallback, iterate_chunks, simulate_recording
 from plansim.simulate.paths import PATH_NAMES, choose_path
+
+if TYPE_CHECKING:  # imported where used: `plansim run` does not load the uncertainty layer
+    from plansim.uncertainty.monte_carlo import CalibrationMonteCarlo
+    from plansim.uncertainty.validation import ValidationReport
 
 
 def _scenario_of(scenario: Scenario | str) -> Scenario:
@@ -158,3 +165,70 @@ def simulate_and_record(scenario, seed: int, trial: int = 0) -> Recording:
     attrs = {"plansim_version": plansim_version(), "scenario": scenario.name, "seed": int(seed),
              "trial": int(trial), "source": "simulated", "units": UNITS_DESCRIPTION}
     return Recording(samples=samples, schedule=scenario.schedule, attrs=attrs)
+
+def error_simulator(scenario: Scenario, path: str = "auto"):
+    """The scenario's calibration as ``simulate(trials, seed) -> (trials, 39)`` errors, and the name of its path.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    path : {"auto", "sample", "segment"}
+        As in :func:`run`.
+
+    Returns
+    -------
+    simulate : callable
+        ``run(scenario, trials, seed, path)["error"].values``: estimate − truth, SI.
+    path_name : str
+        The simulation path ``run`` takes for this scenario (its ``attrs["simulation_path"]``).
+    """
+    chosen, _ = choose_path(scenario, path)
+
+    def simulate(trials: int, seed: int) -> np.ndarray:
+        return run(scenario, trials=trials, seed=seed, path=path)["error"].values
+
+    return simulate, PATH_NAMES[chosen]
+
+
+def adaptive_monte_carlo(scenario: Scenario, *, path: str = "auto", **options) -> CalibrationMonteCarlo:
+    """JCGM 101 7.9.4 adaptive Monte Carlo of the scenario's calibration (outputs: the 39 errors).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    path : {"auto", "sample", "segment"}
+        Simulation path.
+    **options
+        ``digits``, ``trials_per_block``, ``max_trials``, ``seed``, ``tolerance``, ``parameters``,
+        ``coverage_probability``, ``progress`` of
+        :func:`plansim.uncertainty.monte_carlo.calibration_monte_carlo`.
+    """
+    from plansim.uncertainty.monte_carlo import calibration_monte_carlo
+
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
+    simulate, path_name = error_simulator(scenario, path)
+    return calibration_monte_carlo(simulate, scenario, path=path_name, **options)
+
+
+def validate(scenario: Scenario | str = "jjf2003", claims=None, *, path: str = "auto", **options) -> ValidationReport:
+    """``plansim validate``: GUM budget, adaptive MCM, JCGM 101 §8 validation and coverage of the truth.
+
+    Parameters
+    ----------
+    scenario : Scenario or str
+        A scenario, a built-in name or a TOML path.
+    claims : mapping of parameter name -> Claim, optional
+        Default: the Appendix A budgets as printed.
+    path : {"auto", "sample", "segment"}
+        Simulation path of the Monte Carlo.
+    **options
+        The keyword arguments of :func:`plansim.uncertainty.validation.validate` (``digits``,
+        ``trials_per_block``, ``max_trials``, ``seed``, ``tolerance_fraction``,
+        ``coverage_probability``, ``joint_parameters``, ``monitor``, ``progress``).
+    """
+    from plansim.uncertainty.validation import validate as validate_scenario
+
+    sc = _scenario_of(scenario)
+    simulate, path_name = error_simulator(sc, path)
+    return validate_scenario(sc, simulate, claims, path=path_name, **options)

@@ -10,22 +10,21 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.io.scenario_file import load_scenario
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.schedule.segments import Schedule
 from plansim.uncertainty import (
     APPENDIX_A,
     UncertaintyComponent,
     acquisition_quantisation_uncertainty,
     appendix_a_budget,
-    appendix_a_verdict,
     compare_with_appendix_a,
-    coverage_tolerance,
     errors_in_reading_units,
     expanded_uncertainty_in_si,
     omega_squared_test_rate,
     reading_unit_in_si,
 )
+from plansim.uncertainty.metrology import coverage_tolerance, coverage_verdict
 from plansim.units import DEG, STANDARD_GRAVITY
 
 
@@ -294,6 +293,10 @@ def test_verdict_thresholds():
     n = 1000
     tol = coverage_tolerance(n)
     assert tol == pytest.approx(3 * math.sqrt(0.95 * 0.05 / n))
+
+    def appendix_a_verdict(coverage, n, budget_expanded, mc_U95):  # the comparison's reading of the one verdict
+        return coverage_verdict(coverage, n, 0.95, budget_expanded, mc_U95, show_understatement_factor=False)
+
     assert appendix_a_verdict(0.95 - tol - 1e-9, n, 1.0, 1.0)[0] == "under-stated"
     assert appendix_a_verdict(0.95 - tol + 1e-9, n, 1.0, 1.0)[0] == "supported"
     assert appendix_a_verdict(0.95 + tol, n, 1.0, 0.5)[0] == "supported"  # F = 2 is not > 2

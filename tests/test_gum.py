@@ -17,15 +17,18 @@ import pytest
 from GTC import reporting, tb, ureal
 
 from plansim.estimate import reduce
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS, unpack
-from plansim.runner import run
 from plansim.io.scenario_file import load_scenario
 from plansim.kernels.quantiser import quantised_gaussian_moments
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS, unpack
+from plansim.report.validation import format_report
+from plansim.runner import run, validate
 from plansim.uncertainty import APPENDIX_A, appendix_a_budget
-from plansim.uncertainty.gum import (combine, coverage_factor, drift_covariance, estimator_matrix, evaluate_gum,
-                                     quantisation_covariance, quantisation_variance, systematic_effects,
-                                     welch_satterthwaite)
-from plansim.uncertainty.validate import format_report, validate
+from plansim.uncertainty.drift import drift_covariance
+from plansim.uncertainty.gum import evaluate_gum
+from plansim.uncertainty.metrology import combine, coverage_factor, welch_satterthwaite
+from plansim.uncertainty.quantisation import quantisation_covariance, quantisation_variance
+from plansim.uncertainty.sensitivities import estimator_matrix
+from plansim.uncertainty.systematic import systematic_effects
 
 Z = 5.0  # standard errors allowed in the statistical comparisons
 SEED = 20240603
@@ -325,7 +328,7 @@ def test_budget_lines_are_complete_and_ordered(jjf_gum):
 
 def test_systematic_effects_against_closed_forms(jjf, jjf_gum):
     """Earth rate: its vertical component Ω sin φ flips with the up/down pair, so the diagonal
-    g-sensitivity absorbs Kg_ii·Ω sin φ / g_ref (digest §1.4); lever arm: p_ij absorbs the r of
+    g-sensitivity absorbs Kg_ii·Ω sin φ / g_ref (the up/down pairs of §7.2.2); lever arm: p_ij absorbs the r of
     accelerometer i through Ka (centripetal −ω²(r − (r·u)u), the ω² law of P)."""
     from plansim.model.environment import EARTH_RATE
 

@@ -1,4 +1,4 @@
-"""Monte Carlo per JCGM 101 / JCGM 102 (plansim.uncertainty.mcm) and `plansim validate`.
+"""Monte Carlo per JCGM 101 / JCGM 102 (plansim.uncertainty.metrology and .monte_carlo) and `plansim validate`.
 
 Acceptance of issue 3:
 (1) linear-Gaussian scenario: GUM and adaptive MCM agree, the validation says "yes" for every
@@ -22,14 +22,23 @@ import pytest
 from scipy import stats
 
 from plansim.cli import main
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
-from plansim.runner import run
+from plansim.io.claims import load_claims
 from plansim.io.scenario_file import load_scenario
-from plansim.uncertainty.mcm import (adaptive_monte_carlo, block_seeds, correlation_matrix, coverage_intervals,
-                                     coverage_tolerance, joint_region_check, minimum_block_size, numerical_tolerance,
-                                     validate_gum)
-from plansim.uncertainty.validate import (KG_PARAMETERS, appendix_a_claims, claim_verdict, format_report,
-                                          load_claims, parse_claims, validate)
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
+from plansim.report.validation import format_report
+from plansim.runner import adaptive_monte_carlo, run, validate
+from plansim.uncertainty.claims import appendix_a_claims, parse_claims
+from plansim.uncertainty.metrology import (
+    block_seeds,
+    correlation_matrix,
+    coverage_intervals,
+    coverage_tolerance,
+    coverage_verdict,
+    minimum_block_size,
+    numerical_tolerance,
+    validate_gum,
+)
+from plansim.uncertainty.monte_carlo import KG_PARAMETERS, joint_region_check
 
 SEED = 7_20_2024
 COVERAGE_Z = 4.0  # binomial standard deviations allowed for an observed coverage
@@ -292,9 +301,9 @@ def test_claims_file_and_verdicts(tmp_path, linear, linear_report):
     defaults = appendix_a_claims(linear)
     assert len(defaults) == 27 and defaults["Kgxx"].source == "Appendix A A.1 (printed)"
     # verdicts: a 95 % claim that covers 80 % is under-stated; one that covers everything, 3× wide, over-stated
-    assert claim_verdict(0.80, 10_000, P, 0.6).startswith("under-stated")
-    assert claim_verdict(0.9999, 10_000, P, 3.0) == "over-stated ×3"
-    assert claim_verdict(0.95, 10_000, P, 1.0) == "supported"
+    assert coverage_verdict(0.80, 10_000, P, 0.6, 1.0)[0].startswith("under-stated")
+    assert coverage_verdict(0.9999, 10_000, P, 3.0, 1.0)[0] == "over-stated ×3"
+    assert coverage_verdict(0.95, 10_000, P, 1.0, 1.0)[0] == "supported"
     # the linear report's coverage of the Appendix A claims: over-stated by large factors
     kgxx = linear_report.parameter("Kgxx")
     assert kgxx.coverage_claimed == 1.0 and kgxx.claim_verdict.startswith("over-stated")

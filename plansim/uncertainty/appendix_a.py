@@ -1,4 +1,4 @@
-"""JJF 2003-2022 Appendix A: the five published uncertainty budgets, as data, and a check against Monte Carlo.
+"""JJF 2003-2022 Appendix A: the five published uncertainty budgets as data, their printed arithmetic and readings.
 
 Appendix A ("MIMU 测量不确定度评定示例") evaluates five example budgets, all with coverage
 factor k = 2:
@@ -64,19 +64,21 @@ each budget in the unit that makes its three components commensurable with the m
     FS_a) by ω²; ω is the rate of the rotating ("U8") ``omega_squared`` segment of the schedule
     about the parameter's input axis (column *j* of P is measured with axis *j* up, §7.2.5).
 
-:func:`reading_unit_in_si` gives the SI size of one reading unit, :func:`errors_in_reading_units`
-converts errors, and :func:`compare_with_appendix_a` compares Monte Carlo errors with each budget.
+:func:`reading_unit_in_si` gives the SI size of one reading unit and :func:`errors_in_reading_units`
+converts errors; :func:`printed_arithmetic_slips` lists the slips in words.
+:func:`plansim.uncertainty.appendix_a_comparison.compare_with_appendix_a` compares Monte Carlo errors
+with each budget.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from decimal import Decimal
 
 import numpy as np
 
-from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, parameter
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, parameter
 
 __all__ = [
     "ACQUISITION_BITS",
@@ -86,18 +88,13 @@ __all__ = [
     "TABLE_COVERAGE_FACTOR",
     "TABLE_EXPANDED_UNCERTAINTY",
     "AppendixABudget",
-    "ItemComparison",
-    "ParameterComparison",
     "UncertaintyComponent",
     "acquisition_quantisation_uncertainty",
-    "NOMINAL_COVERAGE",
     "appendix_a_budget",
-    "appendix_a_verdict",
-    "coverage_tolerance",
-    "compare_with_appendix_a",
     "errors_in_reading_units",
     "expanded_uncertainty_in_si",
     "omega_squared_test_rate",
+    "printed_arithmetic_slips",
     "reading_unit_description",
     "reading_unit_in_si",
 ]
@@ -459,7 +456,7 @@ def omega_squared_test_rate(scenario, input_axis: int) -> float:
 
     Parameters
     ----------
-    scenario : plansim.scenario.Scenario
+    scenario : plansim.config.Scenario
         Its schedule's ``omega_squared`` segments of group *input_axis* are searched.
     input_axis : int
         0, 1, 2 for x, y, z: the column *j* of P (p_ij is measured with axis *j* up, JJF 2003 §7.2.5).
@@ -505,7 +502,7 @@ def reading_unit_in_si(budget: AppendixABudget, parameter_name: str, scenario, t
         The budget (its ``reading_kind`` selects the reading, module docstring).
     parameter_name : str
         One of ``budget.parameters``.
-    scenario : plansim.scenario.Scenario
+    scenario : plansim.config.Scenario
         Supplies ``acquisition.gyro_full_scale`` (A.2, A.3), ``reduction.reference_gravity`` (A.3),
         ``acquisition.accel_full_scale`` and the ω² test rate (A.5).
     truth : float or array, optional
@@ -590,230 +587,59 @@ def reading_unit_description(budget: AppendixABudget, scenario) -> str:
     return f"{symbol}, in {si} per parameter ({listing})"
 
 
-# ----------------------------------------------------------------------------- comparison with Monte Carlo
-
-#: Nominal coverage probability of an expanded uncertainty with k = 2 (GUM 6.2, 6.3.3: ≈ 95 %).
-NOMINAL_COVERAGE = 0.95
+# ----------------------------------------------------------------------------- the printed arithmetic, in words
 
 
-def _statistics(errors: np.ndarray, expanded: float) -> tuple[float, float, float, float]:
-    magnitude = np.abs(errors)
-    return (float(np.mean(errors)), float(np.std(errors, ddof=1)),
-            float(np.quantile(magnitude, NOMINAL_COVERAGE)), float(np.mean(magnitude <= expanded)))
+def _significant_digits(value: float) -> int:
+    return len(Decimal(repr(value)).normalize().as_tuple().digits)
 
 
-@dataclass(frozen=True)
-class ParameterComparison:
-    """Monte Carlo errors of one parameter in the reading units of its Appendix A budget.
-
-    Attributes
-    ----------
-    name : str
-        Parameter symbol.
-    mean : float
-        Mean error (bias).
-    std : float
-        Standard deviation of the errors (ddof = 1).
-    U95 : float
-        95th percentile of ``|error|``.
-    coverage : float
-        Fraction of ``|error| ≤`` the printed ``U``.
-    reading_unit_in_si : float
-        SI size of one reading unit for this parameter (for A.1 the mean ``|truth|``).
-    budget_U_si : float
-        The printed ``U`` in SI (``U × reading_unit_in_si``).
-    """
-
-    name: str
-    mean: float
-    std: float
-    U95: float
-    coverage: float
-    reading_unit_in_si: float
-    budget_U_si: float
-
-    def as_dict(self) -> dict:
-        return {"name": self.name, "mean": self.mean, "std": self.std, "U95": self.U95,
-                "coverage": self.coverage, "reading_unit_in_si": self.reading_unit_in_si,
-                "budget_U_si": self.budget_U_si}
+def _round_to(value: float, digits: int, up: bool) -> float:
+    exponent = math.floor(math.log10(abs(value))) - digits + 1
+    scaled = value / 10.0**exponent
+    return (math.ceil(scaled - 1e-9) if up else round(scaled)) * 10.0**exponent
 
 
-@dataclass(frozen=True)
-class ItemComparison:
-    """One Appendix A budget compared with the pooled Monte Carlo errors of its parameters.
+def printed_arithmetic_slips(budget: AppendixABudget) -> tuple[str, ...]:
+    """The slips in one budget's printed arithmetic, in words with their numbers.
 
-    All error statistics are in the budget's reading units (module docstring).
-
-    Attributes
-    ----------
-    item, quantity, reading : str
-        From the budget.
-    reading_unit : str
-        The reading's unit, with its SI size in the scenario (:func:`reading_unit_description`).
-    parameters : tuple of str
-        The pooled parameters.
-    n : int
-        Number of pooled errors (trials × parameters).
-    budget_uc, budget_U : float
-        ``u_c`` and ``U`` as printed.
-    coverage_factor : float
-        ``k`` of the budget.
-    arithmetic_uc, arithmetic_U : float
-        ``u_c`` and ``U = k·u_c`` recomputed from the printed components.
-    mc_bias : float
-        Mean error.
-    mc_u : float
-        Standard deviation of the errors (ddof = 1), the Monte Carlo standard uncertainty.
-    mc_U95 : float
-        95th percentile of ``|error|``: half-width of the interval about the truth holding 95 % of errors.
-    coverage : float
-        Fraction of errors with ``|error| ≤ budget_U``.
-    ratio : float
-        ``mc_u / budget_uc``.
-    tolerance : float
-        ``3·sqrt(0.95·0.05/n)``, three binomial standard deviations of the coverage at 95 %.
-    overstatement_factor : float
-        ``budget_U / mc_U95`` (``inf`` when every error is zero).
-    verdict : str
-        ``"supported"``; ``"under-stated"`` if ``coverage < 0.95 − tolerance``; ``"over-stated ×F"``
-        if ``coverage ≥ 0.95 + tolerance`` and ``F = overstatement_factor > 2``.
-    per_parameter : tuple of ParameterComparison
-        The same statistics for each parameter alone.
-    """
-
-    item: str
-    quantity: str
-    reading: str
-    reading_unit: str
-    parameters: tuple[str, ...]
-    n: int
-    budget_uc: float
-    budget_U: float
-    coverage_factor: float
-    arithmetic_uc: float
-    arithmetic_U: float
-    mc_bias: float
-    mc_u: float
-    mc_U95: float
-    coverage: float
-    ratio: float
-    tolerance: float
-    overstatement_factor: float
-    verdict: str
-    per_parameter: tuple[ParameterComparison, ...] = field(default_factory=tuple)
-
-    def as_dict(self) -> dict:
-        """Plain-Python dictionary for JSON (keys ``item``, ``budget_uc``, ``budget_U``, ``mc_u``,
-        ``mc_U95``, ``coverage`` and the other attributes; ``per_parameter`` as a list of dicts)."""
-        return {
-            "item": self.item, "quantity": self.quantity, "reading": self.reading,
-            "reading_unit": self.reading_unit, "parameters": list(self.parameters), "n": self.n,
-            "budget_uc": self.budget_uc, "budget_U": self.budget_U, "coverage_factor": self.coverage_factor,
-            "arithmetic_uc": self.arithmetic_uc, "arithmetic_U": self.arithmetic_U,
-            "mc_bias": self.mc_bias, "mc_u": self.mc_u, "mc_U95": self.mc_U95, "coverage": self.coverage,
-            "ratio": self.ratio, "tolerance": self.tolerance,
-            "overstatement_factor": self.overstatement_factor, "verdict": self.verdict,
-            "per_parameter": [p.as_dict() for p in self.per_parameter],
-        }
-
-
-def coverage_tolerance(n: int) -> float:
-    """``3·sqrt(0.95·0.05/n)``: three binomial standard deviations of an observed 95 % coverage from *n* errors."""
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n = {n!r}: the number of errors must be a whole number >= 1")
-    return 3.0 * math.sqrt(NOMINAL_COVERAGE * (1.0 - NOMINAL_COVERAGE) / n)
-
-
-def appendix_a_verdict(coverage: float, n: int, budget_expanded: float, mc_U95: float) -> tuple[str, float]:
-    """Verdict on a printed ``U`` from the Monte Carlo coverage of *n* errors.
-
-    Returns
-    -------
-    verdict : str
-        ``"under-stated"`` if ``coverage < 0.95 − tol``; ``"over-stated ×F"`` if
-        ``coverage ≥ 0.95 + tol`` and ``F = budget_expanded / mc_U95 > 2``; else ``"supported"``;
-        ``tol`` = :func:`coverage_tolerance` (n).
-    F : float
-        ``budget_expanded / mc_U95`` (``inf`` if ``mc_U95 == 0``).
-    """
-    tolerance = coverage_tolerance(n)
-    factor = budget_expanded / mc_U95 if mc_U95 > 0 else math.inf
-    if coverage < NOMINAL_COVERAGE - tolerance:
-        return "under-stated", factor
-    if coverage >= NOMINAL_COVERAGE + tolerance and factor > 2.0:
-        return f"over-stated ×{factor:.3g}", factor
-    return "supported", factor
-
-
-def _check_parameter_array(name: str, value) -> np.ndarray:
-    array = np.asarray(value, dtype=float)
-    if array.ndim != 2 or array.shape[1] != N_PARAMETERS:
-        raise ValueError(f"{name}: shape {array.shape}; expected (trials, {N_PARAMETERS}) ordered as "
-                         "plansim.model.parameters.PARAMETER_NAMES")
-    if array.shape[0] < 2:
-        raise ValueError(f"{name}: {array.shape[0]} trial(s); a standard deviation needs at least 2")
-    return array
-
-
-def compare_with_appendix_a(truth, estimate, scenario, budgets: Iterable[AppendixABudget] = APPENDIX_A
-                            ) -> list[ItemComparison]:
-    """Compare Monte Carlo calibration errors with the Appendix A budgets of JJF 2003-2022.
-
-    For each budget the errors ``estimate − truth`` of its parameters are converted into the
-    budget's reading units (:func:`errors_in_reading_units`), pooled, and summarised.
+    - a component whose readings the text adds linearly (A.2.2.3, A.3.2.3, A.5.2.3), against the
+      GUM law of propagation for independent readings (JCGM 100 5.1.2): ``c·√n·u``;
+    - an expanded uncertainty that is not ``k·u_c`` rounded to nearest: rounded up (JCGM 100 7.2.6
+      allows it) or not explained by rounding;
+    - in every budget, u1 (a relative rate error), u2 (a fraction of full scale) and u3 (output
+      units) added without units or sensitivity coefficients (A.1.3 … A.5.3).
 
     Parameters
     ----------
-    truth, estimate : (trials, 39) array_like
-        True and estimated parameters, SI, ordered as :data:`plansim.model.parameters.PARAMETER_NAMES`.
-    scenario : plansim.scenario.Scenario
-        Supplies full scales, reference gravity and the ω² test rate for the readings.
-    budgets : iterable of AppendixABudget
-        Default: all of :data:`APPENDIX_A`.
+    budget : AppendixABudget
 
     Returns
     -------
-    list of ItemComparison
-        One per budget, in the order given.
+    tuple of str
     """
-    truth = _check_parameter_array("truth", truth)
-    estimate = _check_parameter_array("estimate", estimate)
-    if truth.shape != estimate.shape:
-        raise ValueError(f"estimate: shape {estimate.shape} differs from truth's {truth.shape}")
-    budgets = tuple(budgets)
-    for budget in budgets:
-        if not isinstance(budget, AppendixABudget):
-            raise TypeError(f"budgets: element {budget!r} is not an AppendixABudget")
-    results: list[ItemComparison] = []
-    for budget in budgets:
-        expanded = budget.printed_expanded_uncertainty
-        pooled, per_parameter = [], []
-        for name in budget.parameters:
-            k = PARAMETER_INDEX[name]
-            if not (np.all(np.isfinite(truth[:, k])) and np.all(np.isfinite(estimate[:, k]))):
-                bad = int(np.argmax(~(np.isfinite(truth[:, k]) & np.isfinite(estimate[:, k]))))
-                raise ValueError(f"parameter {name}: trial {bad} has truth {truth[bad, k]!r} and estimate "
-                                 f"{estimate[bad, k]!r}; every value must be finite")
-            errors = errors_in_reading_units(budget, name, estimate[:, k] - truth[:, k], scenario, truth[:, k])
-            pooled.append(errors)
-            mean, std, u95, coverage = _statistics(errors, expanded)
-            unit = float(np.mean(reading_unit_in_si(budget, name, scenario, truth[:, k])))
-            per_parameter.append(ParameterComparison(name=name, mean=mean, std=std, U95=u95, coverage=coverage,
-                                                     reading_unit_in_si=unit, budget_U_si=expanded * unit))
-        errors = np.concatenate(pooled)
-        n = int(errors.size)
-        mean, std, u95, coverage = _statistics(errors, expanded)
-        verdict, factor = appendix_a_verdict(coverage, n, expanded, u95)
-        results.append(ItemComparison(
-            item=budget.item, quantity=budget.quantity, reading=budget.reading,
-            reading_unit=reading_unit_description(budget, scenario), parameters=tuple(budget.parameters), n=n,
-            budget_uc=budget.printed_combined_standard_uncertainty, budget_U=expanded,
-            coverage_factor=budget.coverage_factor,
-            arithmetic_uc=budget.recomputed_combined_standard_uncertainty(),
-            arithmetic_U=budget.recomputed_expanded_uncertainty(),
-            mc_bias=mean, mc_u=std, mc_U95=u95, coverage=coverage,
-            ratio=std / budget.printed_combined_standard_uncertainty,
-            tolerance=coverage_tolerance(n), overstatement_factor=factor, verdict=verdict,
-            per_parameter=tuple(per_parameter),
-        ))
-    return results
+    if not isinstance(budget, AppendixABudget):
+        raise TypeError(f"budget = {budget!r}: expected an AppendixABudget (e.g. an element of APPENDIX_A)")
+    slips = []
+    for c in budget.components:
+        if c.combination_as_printed == "linear_sum":
+            slips.append(
+                f"linear-sum slip ({c.clause}): {c.symbol} = {c.count} × {c.value_per_reading:g} = "
+                f"{c.printed_value:g} "
+                f"adds the readings linearly; the model's sensitivity is {c.sensitivity_coefficient:.3g} per reading "
+                f"and the GUM law of propagation (JCGM 100 5.1.2) gives c·√n·u = {c.gum_standard_uncertainty:.3g}")
+    arithmetic = budget.recomputed_expanded_uncertainty()
+    printed = budget.printed_expanded_uncertainty
+    digits = _significant_digits(printed)
+    if not math.isclose(_round_to(arithmetic, digits, up=False), printed, rel_tol=1e-9):
+        if math.isclose(_round_to(arithmetic, digits, up=True), printed, rel_tol=1e-9):
+            nearest = _round_to(arithmetic, digits, up=False)
+            slips.append(f"rounding: k·u_c = {arithmetic:.5g} is printed as {printed:g}, rounded up to {digits} "
+                         f"digits (GUM 7.2.6 allows rounding up; to nearest it is {nearest:g})")
+        else:
+            uc = budget.recomputed_combined_standard_uncertainty()
+            slips.append(f"rounding slip: k·u_c = {budget.coverage_factor:g} × {uc:.4g} = {arithmetic:.4g}, "
+                         f"printed {printed:g}")
+    slips.append("u1 (relative rate error), u2 (fraction of full scale) and u3 (output units) are added without "
+                 "units or sensitivity coefficients (JJF 2003-2022 A.1.3-A.5.3)")
+    return tuple(slips)

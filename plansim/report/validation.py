@@ -1,0 +1,208 @@
+"""The report of ``plansim validate``: the text, the JSON object and the progress line.
+
+The computation is :func:`plansim.uncertainty.validation.validate`; this module only shapes its
+:class:`~plansim.uncertainty.validation.ValidationReport` for people (:func:`format_report`) and
+for programs (:func:`validation_json`, strict JSON).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+
+from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, parameter
+from plansim.uncertainty.budget import ParameterBudget
+from plansim.uncertainty.validation import ValidationReport
+
+__all__ = ["format_report", "stderr_block_progress", "validation_json"]
+
+
+def validation_json(report: ValidationReport) -> dict:
+    """The report as one JSON-ready dictionary (strict JSON: ``inf`` as the string ``"inf"``, ``nan`` as ``null``).
+
+    Keys: ``scenario``, ``description``, ``claims``, ``mcm`` (trials, blocks, trials_per_block, seed,
+    digits, tolerance_fraction, converged, path), ``parameters``, ``appendix_a``, ``joint_Kg``,
+    ``correlation`` (names, mcm, gum) and ``gum_budgets`` (docs/uncertainty.md).
+    """
+    gum_corr = report.gum.correlation()
+    mc = report.mcm
+    return _json_ready({
+        "scenario": report.scenario,
+        "description": report.description,
+        "claims": report.claims_source,
+        "mcm": {"trials": mc.trials, "blocks": mc.blocks, "trials_per_block": mc.trials_per_block,
+                "seed": mc.seed, "digits": report.digits, "tolerance_fraction": report.tolerance_fraction,
+                "converged": mc.converged, "path": mc.path},
+        "parameters": [p.as_dict() for p in report.parameters],
+        "appendix_a": [c.as_dict() for c in report.appendix_items],
+        "joint_Kg": report.joint.as_dict(),
+        "correlation": {"names": list(PARAMETER_NAMES), "mcm": np.round(report.mcm_correlation, 6).tolist(),
+                        "gum": np.round(gum_corr, 6).tolist()},
+        "gum_budgets": [b.as_dict() for b in report.gum.budgets],
+    })
+
+
+def _json_ready(value):
+    """Recursively: numpy scalars to Python, ``nan`` to None, ``±inf`` to ``"inf"``/``"-inf"`` (strict JSON)."""
+    if isinstance(value, dict):
+        return {k: _json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_ready(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float):
+        if math.isnan(value):
+            return None
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+    return value
+
+
+
+def _fmt(x, digits: int = 4) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, float) and math.isnan(x):
+        return "—"
+    if isinstance(x, float) and math.isinf(x):
+        return "∞"
+    return f"{x:.{digits}g}"
+
+
+def _budget_table(budget: ParameterBudget) -> list[str]:
+    lines = [f"  {'input':30s} {'type':4s} {'u(x_i)':>10s} {'unit':>7s} {'c_i':>10s} {'u_i(y)':>10s} {'share':>6s} "
+             f"{'ν_i':>8s}  distribution"]
+    uc = budget.combined_standard_uncertainty
+    for line in budget.inputs:
+        share = (line.contribution / uc) ** 2 if uc > 0 else math.nan
+        unit = line.input_unit if len(line.input_unit) <= 7 else "SI"
+        lines.append(f"  {line.name[:30]:30s} {line.evaluation:4s} {_fmt(line.standard_uncertainty, 3):>10s} "
+                     f"{unit:>7s} {_fmt(line.sensitivity, 3):>10s} {_fmt(line.contribution, 3):>10s} "
+                     f"{share:>6.1%} {_fmt(line.dof, 3):>8s}  {line.distribution}")
+    lines.append(f"  u_c = {_fmt(uc)} {budget.unit}, ν_eff = {_fmt(budget.effective_dof, 3)}, "
+                 f"k({budget.coverage_probability:.0%}) = {budget.coverage_factor:.3f}, "
+                 f"U95 = {_fmt(budget.expanded_uncertainty)} {budget.unit}"
+                 f"   [largest 2nd-order term {_fmt(budget.largest_second_order, 2)}]")
+    if budget.systematic_effects:
+        parts = [f"{e.name} {e.bias:+.3g}" + (f" ({e.bias / uc:+.2g} u_c)" if uc > 0 else "")
+                 for e in budget.systematic_effects]
+        lines.append(f"  not corrected (bias; GUM 3.2.4 asks to correct): y = {budget.estimate:+.4g} = "
+                     + "; ".join(parts))
+    return lines
+
+
+def format_report(report: ValidationReport, details: bool = True) -> str:
+    """The text report of ``plansim validate``: summary, Appendix A, JCGM 102, per-parameter budgets."""
+    mc = report.mcm
+    out = [
+        f"plansim validate — scenario {report.scenario!r}: {report.description}",
+        f"GUM (JCGM 100) budgets derived from the schedule; adaptive Monte Carlo (JCGM 101 7.9.4): "
+        f"{mc.blocks} blocks × {mc.trials_per_block} = {mc.trials} trials ({mc.path} path, seed {mc.seed}), "
+        f"n_dig = {report.digits}, run to {report.tolerance_fraction:g}·δ of the GUM u_c (JCGM 101 8.2): "
+        + ("reached" if mc.converged else "NOT reached (max trials)"),
+        f"Output quantity: the error E = estimate − truth of each parameter (SI). Claims: {report.claims_source}.",
+        "",
+        "Summary (JCGM 101 8: validated if d_low and d_high ≤ δ; coverage = fraction of trials with |E| ≤ U)",
+        f"{'name':5s} {'GUM y':>10s} {'GUM u_c':>10s} {'ν_eff':>7s} {'U95':>10s} {'MCM u':>10s} {'MCM low':>11s} "
+        f"{'MCM high':>11s} {'δ':>8s} {'d_low':>8s} {'d_high':>8s} {'valid':>5s} {'cov GUM':>7s} "
+        f"{'claimed U':>10s} {'cov claim':>9s}  claim verdict",
+    ]
+    for p in report.parameters:
+        out.append(
+            f"{p.name:5s} {p.gum_y:>10.3g} {p.gum_u:>10.3g} {_fmt(p.gum_dof, 2):>7s} {p.gum_U95:>10.3g} "
+            f"{p.mcm_u:>10.3g} "
+            f"{p.mcm_low:>11.3g} {p.mcm_high:>11.3g} {p.delta:>8.2g} {p.d_low:>8.2g} {p.d_high:>8.2g} "
+            f"{'yes' if p.validated else 'NO':>5s} {p.coverage_gum:>7.1%} {_fmt(p.claimed_U, 3):>10s} "
+            f"{'—' if p.coverage_claimed is None else format(p.coverage_claimed, '.1%'):>9s}  "
+            f"{p.claim_verdict or '—'}")
+    failed = [p for p in report.parameters if not p.validated]
+    out.append(f"GUM framework validated for {N_PARAMETERS - len(failed)} of {N_PARAMETERS} parameters"
+               + (f"; not for {', '.join(p.name for p in failed)}" if failed else ""))
+
+    if report.appendix_items:
+        out += ["", "Appendix A of JJF 2003-2022 — claimed and achieved (reading units; k = 2)"]
+        for c in report.appendix_items:
+            out.append(f"{c.item} {c.quantity} — reading: {c.reading_unit}")
+            out.append(f"    printed u_c {c.printed_uc:g}, U {c.printed_U:g}; recomputed k·u_c {c.arithmetic_U:.4g}; "
+                       f"the same inputs by the GUM: u_c {c.same_inputs_gum_uc:.3g}, U {c.same_inputs_gum_U:.3g}")
+            for slip in c.slips:
+                out.append(f"    ! {slip}")
+            gum_list = ", ".join(f"{n} {v:.3g}" for n, v in zip(c.parameters, c.gum_U95))
+            mcm_list = ", ".join(f"{n} {v:.3g}" for n, v in zip(c.parameters, c.mcm_U95))
+            out.append(f"    achieved by this schedule: GUM U95 {gum_list}")
+            out.append(f"                               MCM U95 {mcm_list}")
+            out.append(f"    claimed U {c.claimed_U:g} covers the truth in {c.coverage:.2%} of the trials: {c.verdict}")
+
+    j = report.joint
+    out += ["", f"Several outputs at once (JCGM 102): {', '.join(j.parameters)}",
+            f"    inside the {j.coverage_probability:.0%} ellipsoid χ²_{j.dimension}({j.coverage_probability:g}) = "
+            f"{j.chi2_quantile:.3g}: {j.fraction_in_ellipsoid:.2%} of the trials (MCM k_p = {j.mc_k:.3g}, "
+            f"√χ² = {math.sqrt(j.chi2_quantile):.3g}); GUM ellipsoid about the truth: "
+            f"{j.gum_fraction_in_ellipsoid:.2%}",
+            f"    all {len(j.parameters)} inside their marginal k = {j.marginal_k:g} intervals: "
+            f"{j.fraction_all_marginal:.2%}; box for a joint {j.coverage_probability:.0%}: k = {j.box_k:.3g}",
+            f"    {'! ' if j.misleading else ''}{j.message}"]
+    corr = report.mcm_correlation
+    idx = [PARAMETER_INDEX[n] for n in j.parameters]
+    pairs = sorted(((abs(corr[a, b]), a, b) for ai, a in enumerate(idx) for b in idx[ai + 1:]), reverse=True)[:3]
+    if pairs:
+        out.append("    strongest correlations: " + ", ".join(
+            f"r({PARAMETER_NAMES[a]}, {PARAMETER_NAMES[b]}) = {corr[a, b]:+.3f}" for _, a, b in pairs))
+
+    gum_corr = report.gum.correlation()
+    pairs = sorted(((abs(corr[a, b]), a, b) for a in range(N_PARAMETERS) for b in range(a + 1, N_PARAMETERS)),
+                   reverse=True)[:8]
+    out.append("Correlation of the estimated parameters (JCGM 102; Kg, G, Ka, P come from shared fits), "
+               "strongest pairs, MCM (GUM):")
+    out.append("    " + ", ".join(f"r({PARAMETER_NAMES[a]}, {PARAMETER_NAMES[b]}) = {corr[a, b]:+.3f} "
+                                  f"({gum_corr[a, b]:+.3f})" for _, a, b in pairs))
+
+    if details:
+        for p, budget in zip(report.parameters, report.gum.budgets):
+            spec = parameter(p.name)
+            out += ["", f"== {p.name}: {spec.long_name} [{p.unit}]"
+                    + (f" — Appendix A {p.appendix_item}" if p.appendix_item else "")]
+            out.append("GUM budget (JCGM 100 5.1.2; output: the error E of the parameter)")
+            out += _budget_table(budget)
+            out.append(f"MCM: y = {p.mcm_y:.4g}, u = {p.mcm_u:.4g}, {mc.coverage_probability:.0%} interval "
+                       f"[{p.mcm_low:.4g}, {p.mcm_high:.4g}] "
+                       f"(shortest [{p.mcm_shortest_low:.4g}, {p.mcm_shortest_high:.4g}])")
+            out.append(f"Validation (JCGM 101 8): δ = {p.delta:.2g}, d_low = {p.d_low:.2g}, "
+                       f"d_high = {p.d_high:.2g} → "
+                       f"GUM framework validated: {'yes' if p.validated else 'no'}")
+            for reason in p.reasons:
+                out.append(f"    because {reason}")
+            line = f"Coverage of the truth: GUM U95 {p.coverage_gum:.2%}"
+            if p.claimed_U is not None:
+                line += (f"; claimed U = {p.claimed_U:.4g} ({p.claim_source}) {p.coverage_claimed:.2%} → "
+                         f"{p.claim_verdict} (U needed for {p.claim_probability:.0%}: "
+                         f"{p.claimed_U / p.claim_factor:.3g})")
+            out.append(line)
+            if budget.appendix_a is not None:
+                a = budget.appendix_a
+                out.append(f"Appendix A {a.item} in its reading unit (1 unit = {a.reading_unit_si:.4g} {p.unit}): "
+                           f"printed u1 {a.printed_u[0]:g}, u2 {a.printed_u[1]:g}, u3 {a.printed_u[2]:g} → "
+                           f"u_c {a.printed_uc:g}, "
+                           f"U {a.printed_U:g} (same inputs by the GUM: U {a.same_inputs_gum_U:.3g}); this schedule: "
+                           f"table {a.plansim_u[0]:.3g}, acquisition {a.plansim_u[1]:.3g}, repeatability "
+                           f"{a.plansim_u[2]:.3g} → u_c {a.plansim_uc:.3g}, U95 {a.plansim_U95:.3g}")
+    return "\n".join(out)
+
+
+
+def stderr_block_progress(label: str):
+    """A progress line on stderr for the adaptive Monte Carlo, redrawn in place after each block.
+
+    Returns ``report(trials_done, blocks, worst)``, ``worst`` the largest ``2s/δ`` (stop at ≤ 1).
+    """
+    start = time.perf_counter()
+
+    def report(done: int, blocks: int, worst: float) -> None:
+        elapsed = time.perf_counter() - start
+        sys.stderr.write(f"\r{label}: {blocks} blocks, {done} trials, max 2s/δ = {worst:.3g} ({elapsed:.0f} s)   ")
+        sys.stderr.flush()
+
+    return report

@@ -1,0 +1,237 @@
+"""The lines of the GUM budget of a schedule: every input quantity, propagated to all 39 parameters at once.
+
+Each :class:`Line` holds either the signed contributions ``c_i·u(x_i)`` of independent components
+(JCGM 100 5.1.2, eq. (10)) or, for correlated inputs, the covariance they give the parameters
+(5.2.2, eq. (13)). :func:`model_lines` builds them from the scenario: table and fixture errors
+(JJF 2003 Table 1) by finite differences, the table start angle exactly, the unit-to-unit spread,
+white noise (type A, 4.2), drift (Allan coefficients), rate smoothness, and quantisation
+(Appendix A eq. (A.3), with the averaging and correlation of segment means).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from plansim.config import ErrorDistribution, Scenario
+from plansim.kernels.layout import ACCEL_CHANNELS, GYRO_CHANNELS, N_CHANNELS, NOISE_WHITE
+from plansim.model.parameters import N_PARAMETERS
+from plansim.simulate.arguments import kernel_arguments, noise_free_segment_means
+from plansim.uncertainty.drift import drift_covariance
+from plansim.uncertainty.quantisation import quantisation_covariance, quantisation_variance
+from plansim.uncertainty.sensitivities import (
+    PHASE_NODES,
+    finite_differences,
+    phase_grid_draws,
+    rate_derivatives,
+    table_groups,
+)
+
+__all__ = ["Line", "model_lines"]
+
+_GYROS = range(GYRO_CHANNELS.start, GYRO_CHANNELS.stop)
+_ACCELS = range(ACCEL_CHANNELS.start, ACCEL_CHANNELS.stop)
+
+
+@dataclass
+class Line:
+    """A budget line for all parameters at once: columns of signed contributions (39, K) or a covariance."""
+
+    name: str
+    category: str
+    evaluation: str
+    distribution: str
+    u: np.ndarray  # (K,) standard uncertainty of each component, or empty for covariance lines
+    input_unit: str
+    columns: np.ndarray | None = None  # (39, K): c_i·u_i
+    covariance: np.ndarray | None = None  # (39, 39) for lines that are not a sum of independent columns
+    dof: np.ndarray | None = None  # (K,) for type A lines
+    note: str = ""
+    linearised: bool = True
+    second_order: np.ndarray | None = None  # (39,) largest ½|c_ii|u² of the line
+    mixed_units: bool = False  # components in different units: no single u(x_i) or c_i to show
+    line_dof: float = math.inf  # ν of a covariance line taken as one input (G.4.2 for type B)
+
+    def variance(self) -> np.ndarray:
+        if self.columns is not None:
+            return np.sum(self.columns**2, axis=1)
+        return np.clip(np.diag(self.covariance), 0.0, None)
+
+    def cov(self) -> np.ndarray:
+        if self.columns is not None:
+            return self.columns @ self.columns.T
+        return self.covariance
+
+
+def _distribution_text(error: ErrorDistribution, unit: str) -> str:
+    shown = "" if unit == "1" else f" {unit}"
+    if error.kind == "uniform":
+        return f"rectangular ±{error.scale:.4g}{shown}"
+    return f"normal, σ = {error.scale:.4g}{shown}"
+
+
+def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation: bool) -> list[Line]:
+    """Every budget line of *scenario*, for all 39 parameters at once.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    matrix : (39, S, 6) ndarray
+        The reduction's matrix (:func:`plansim.uncertainty.sensitivities.estimator_matrix`).
+    quantisation_correlation : bool
+        Correlate the quantisation errors of the segments of a channel
+        (:func:`plansim.uncertainty.quantisation.quantisation_covariance`), or keep Appendix A's
+        independent readings.
+
+    Returns
+    -------
+    list of Line
+        In the order table and fixture errors, start angle, unit-to-unit spread, white noise, drift,
+        rate smoothness, quantisation.
+    """
+    lines: list[Line] = []
+    segments = scenario.schedule.segments
+    n_seg = len(segments)
+    samples = np.array([s.samples for s in segments], dtype=float)
+    durations = np.array([s.samples / s.sample_rate for s in segments])
+    dts = np.array([1.0 / s.sample_rate for s in segments])
+    noise = kernel_arguments(scenario)["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
+    offsets = [np.zeros((n_seg, n_seg)) for _ in range(N_CHANNELS)]  # per channel: covariance of the means' offsets
+
+    # table and fixture errors: finite differences of the noise-free means
+    groups = table_groups(scenario)
+    if groups:
+        indices = np.concatenate([np.array(g[2], dtype=np.int64) for g in groups])
+        steps = np.concatenate([np.full(len(g[2]), g[1].standard_uncertainty) for g in groups])
+        first, second = finite_differences(scenario, indices, steps)
+        start = 0
+        for name, error, idx, unit in groups:
+            stop = start + len(idx)
+            u = np.full(len(idx), error.standard_uncertainty)
+            d_means = first[start:stop] * u[:, None, None]  # (K, S, 6)
+            for c in range(N_CHANNELS):
+                offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
+            lines.append(Line(
+                name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
+                u=u, input_unit=unit, columns=np.einsum("psc,ksc->pk", matrix, d_means),
+                note="c by central differences of the noise-free segment means, step u(x)",
+                second_order=np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second[start:stop]))
+                                    * u[None, :] ** 2, axis=1)))
+            start = stop
+
+    # table start angle of the rotating segments: exact variance over the angle
+    rotating = [s for s, seg in enumerate(segments) if seg.rate != 0.0]
+    nominal = noise_free_segment_means(scenario, phase_grid_draws(scenario))  # (J, S, 6)
+    if rotating:
+        centre = nominal.mean(axis=0)
+        deviation = nominal - centre
+        # below 64 ulp of the mean the deviation is rounding, not a start-angle effect
+        deviation[np.abs(deviation) <= 64 * np.finfo(float).eps * np.abs(centre)[None]] = 0.0
+        cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
+        for s in rotating:
+            d = np.einsum("pc,jc->jp", matrix[:, s, :], deviation[:, s, :])  # (J, 39)
+            cov += d.T @ d / PHASE_NODES
+            for c in range(N_CHANNELS):
+                offsets[c][s, s] += float(np.mean(deviation[:, s, c] ** 2))
+        if np.any(np.diag(cov) > 0):
+            lines.append(Line(
+                name="table start angle", category="table", evaluation="B",
+                distribution="uniform on [0, 2π) per rotating segment",
+                u=np.full(len(rotating), math.pi / math.sqrt(3)),
+                input_unit="rad", covariance=cov, linearised=False,
+                note=f"exact variance over {PHASE_NODES} start angles (segments not whole turns)"))
+    nominal = nominal.mean(axis=0)  # (S, 6): expected noise-free means
+
+    # the unit under calibration: dependence of the error on the true parameters
+    spread = np.asarray(scenario.truth_spread, dtype=float)
+    idx = np.flatnonzero(spread > 0)
+    if idx.size:
+        first, second = finite_differences(scenario, idx, spread[idx])
+        d_means = first * spread[idx][:, None, None]
+        for c in range(N_CHANNELS):
+            offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
+        columns = np.einsum("psc,ksc->pk", matrix, d_means)
+        columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
+        lines.append(Line(
+            name="unit-to-unit spread", category="unit", evaluation="B", distribution="normal (mimu.truth_spread)",
+            u=spread[idx], input_unit="SI of each parameter", columns=columns, mixed_units=True,
+            note="∂E/∂Y = R·∂m/∂Y − 1: the error's dependence on the true value",
+            second_order=np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second)) * spread[idx][None, :] ** 2,
+                                axis=1)))
+
+    # white noise of the segment means (type A, ν = n − 1)
+    for label, channels in (("white noise, gyros", _GYROS), ("white noise, accelerometers", _ACCELS)):
+        u = np.array([[noise[c, NOISE_WHITE] / math.sqrt(durations[s]) for c in channels] for s in range(n_seg)])
+        if not np.any(u > 0):
+            continue
+        columns = np.stack([matrix[:, s, c] * u[s, i] for s in range(n_seg) for i, c in enumerate(channels)], axis=1)
+        dof = np.repeat(samples - 1.0, len(channels))
+        dof = np.where(dof > 0, dof, np.inf)
+        unit = "rad/s" if label.endswith("gyros") else "m/s^2"
+        lines.append(Line(
+            name=label, category="repeatability", evaluation="A", distribution="normal, N/√T per segment mean",
+            u=u.ravel(), input_unit=unit, columns=columns, dof=dof,
+            note="u = N/√T (random-walk coefficient N, dwell T); ν = n − 1 samples"))
+
+    # drift: exact covariance of the segment means
+    drift = drift_covariance(scenario)
+    for c in range(N_CHANNELS):
+        offsets[c] += drift[c]
+    for label, channels in (("drift, gyros", _GYROS), ("drift, accelerometers", _ACCELS)):
+        cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
+        for c in channels:
+            if np.any(drift[c] != 0):
+                cov += matrix[:, :, c] @ drift[c] @ matrix[:, :, c].T
+        if np.any(np.diag(cov) > 0):
+            lines.append(Line(
+                name=label, category="repeatability", evaluation="B",
+                distribution="Gauss–Markov / random walk (Allan coefficients)",
+                u=np.sqrt(np.array([drift[c].diagonal().mean() for c in channels])),
+                input_unit="rad/s" if label.endswith("gyros") else "m/s^2", covariance=cov, linearised=True,
+                note="covariance of the segment means derived from the drift model (GUM 5.2.2)"))
+
+    # rate smoothness: jitter of the table rate, common to the channels of a segment
+    smoothness = scenario.turntable.rate_smoothness
+    jitter = np.zeros((n_seg, N_CHANNELS))
+    if smoothness > 0 and rotating:
+        derivative = rate_derivatives(scenario)
+        jitter = smoothness * derivative
+        u = np.array([smoothness / math.sqrt(samples[s]) for s in rotating])
+        columns = np.stack([matrix[:, s, :] @ derivative[s] * u[i] for i, s in enumerate(rotating)], axis=1)
+        lines.append(Line(
+            name="rate smoothness", category="table", evaluation="B", distribution="normal, per sample",
+            u=u, input_unit="1", columns=columns,
+            note="segment mean of the per-sample relative rate jitter, through ∂(outputs)/∂(rate)"))
+
+    # quantisation (Appendix A's rectangular model, with the averaging the noise provides)
+    a = scenario.acquisition
+    if a.bits:
+        for label, channels, step in (("quantisation, gyros", _GYROS, a.gyro_step),
+                                      ("quantisation, accelerometers", _ACCELS, a.accel_step)):
+            cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
+            fractions, u_means = [], []
+            for c in channels:
+                sigma = np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2)
+                if quantisation_correlation:
+                    q_cov = quantisation_covariance(step, nominal[:, c], sigma, samples, offsets[c])
+                else:
+                    q_cov = np.diag([quantisation_variance(step, float(sigma[s]), int(samples[s]))[0]
+                                     for s in range(n_seg)])
+                cov += matrix[:, :, c] @ q_cov @ matrix[:, :, c].T
+                fractions.extend(quantisation_variance(step, float(sigma[s]), int(samples[s]))[1]
+                                 for s in range(n_seg))
+                u_means.extend(np.sqrt(np.diag(q_cov)))
+            worst = max(fractions)
+            regime = ("no dither: rectangular ±q/2 per segment mean" if worst > 1.0 - 1e-6 else
+                      "dithered: q²/12 per sample, averaged" if worst < 1e-6 else
+                      f"partly dithered: up to {worst:.2g} of q²/12 not averaged by the noise")
+            correlation = ("segments correlated through the shared quantiser offset" if quantisation_correlation
+                           else "segment means independent (Appendix A)")
+            lines.append(Line(
+                name=label, category="acquisition", evaluation="B",
+                distribution=f"rectangular, q = {step:.4g}; {regime}",
+                u=np.asarray(u_means), input_unit="rad/s" if label.endswith("gyros") else "m/s^2", covariance=cov,
+                note=f"Appendix A eq. (A.3); {correlation}"))
+    return lines

@@ -1,0 +1,180 @@
+"""The linearised measurement model of a schedule: the reduction's matrix and the sensitivities of the segment means.
+
+The model of every JJF 2003 parameter is ``Ŷ = R(m̄(X))``: the segment means ``m̄`` (eq. (3)) as
+functions of the inputs ``X``, reduced by ``R`` (eq. (4)-(13)).
+
+- :func:`estimator_matrix` — ``R`` is linear in the segment means; its matrix is the estimators'
+  own :func:`plansim.estimate.reduction_matrix`, reshaped per segment and channel;
+- :func:`finite_differences` — ``∂m̄/∂x_i`` and ``∂²m̄/∂x_i²`` of the exact noise-free segment
+  means by central differences with step ``u(x_i)`` (JCGM 100 5.1.3 note 2), averaged over the
+  table start angle;
+- :func:`table_groups` — which components of the simulator's draws vector each table and fixture
+  error occupies (names of :mod:`plansim.kernels.layout`);
+- :func:`rate_derivatives` — the outputs' response to the table rate, for the rate jitter.
+
+The noise-free means are trigonometric polynomials of degree ≤ 3 in the start angle of a rotating
+segment, so averages of them and of their products (degree ≤ 6) over :data:`PHASE_NODES`
+equally spaced angles are exact.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from plansim.config import ErrorDistribution, Scenario
+from plansim.estimate import reduction_matrix
+from plansim.kernels.layout import (
+    FIXTURE,
+    N_CHANNELS,
+    RATE_SYSTEMATIC,
+    SEG_PHASE,
+    SEG_POSITION_ACCURACY,
+    SEG_POSITION_REPEATABILITY,
+    SEG_RATE_ERROR,
+    TILT,
+    perpendicularity_index,
+    segment_base,
+)
+from plansim.model.parameters import N_PARAMETERS
+from plansim.simulate.arguments import noise_free_segment_means, nominal_draws
+
+__all__ = ["PHASE_NODES", "estimator_matrix", "finite_differences", "phase_grid_draws", "rate_derivatives",
+           "table_groups"]
+
+#: Start angles at which the noise-free means are evaluated: the means are trigonometric
+#: polynomials of degree ≤ 3 in the start angle, so averages of their products (degree ≤ 6) over
+#: ≥ 7 equally spaced angles are exact.
+PHASE_NODES = 8
+
+#: Relative step of the table rate for :func:`rate_derivatives`.
+RATE_STEP = 1e-6
+
+
+def estimator_matrix(scenario: Scenario) -> np.ndarray:
+    """The JJF 2003 reduction as a matrix: ``(39, S, 6)`` with ``estimate = Σ M[:, s, c]·mean[s, c]``.
+
+    :func:`plansim.estimate.reduction_matrix` (the reduction applied to the ``6·S`` unit vectors,
+    eq. (5), (7), (10), (12)-(13) being linear least squares and differences), reshaped.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the schedule, the reference gravity and the ω² sign convention.
+
+    Returns
+    -------
+    (39, S, 6) ndarray
+
+    Raises
+    ------
+    TypeError
+        *scenario* is not a Scenario.
+    ValueError
+        The reduction is not linear in the segment means (the law of propagation here needs its matrix).
+    """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
+    r = scenario.reduction
+    matrix = reduction_matrix(scenario.schedule, r.reference_gravity, r.omega_squared_sign)  # (6S, 39)
+    if matrix is None:
+        raise ValueError(f"scenario {scenario.name!r}: the JJF 2003 reduction of this schedule is not linear in the "
+                         "segment means, so it has no matrix to propagate the GUM budget through")
+    return np.ascontiguousarray(matrix.T.reshape(N_PARAMETERS, len(scenario.schedule), N_CHANNELS))
+
+
+def phase_grid_draws(scenario: Scenario, draws: np.ndarray | None = None) -> np.ndarray:
+    """(J, D): *draws* (default nominal) with every segment's start angle at 2πj/J, J = :data:`PHASE_NODES`."""
+    base = nominal_draws(scenario) if draws is None else np.asarray(draws, dtype=float)
+    n_seg = len(scenario.schedule)
+    grid = np.tile(base, (PHASE_NODES, 1))
+    phases = 2.0 * math.pi * np.arange(PHASE_NODES) / PHASE_NODES
+    for s in range(n_seg):
+        grid[:, segment_base(s) + SEG_PHASE] = phases
+    return grid
+
+
+def table_groups(scenario: Scenario) -> list[tuple[str, ErrorDistribution, list[int], str]]:
+    """(name, distribution, draws indices, unit) of each table and fixture error group of JJF 2003 Table 1.
+
+    Only groups with a nonzero standard uncertainty and at least one component in this schedule.
+    """
+    t = scenario.turntable
+    segments = scenario.schedule.segments
+    n_seg = len(segments)
+    accuracy = [segment_base(s) + SEG_POSITION_ACCURACY + 2 * axis for s in range(n_seg) for axis in range(3)]
+    repeatability = [segment_base(s) + SEG_POSITION_REPEATABILITY + 2 * axis for s in range(n_seg) for axis in range(3)]
+    axes = sorted({"xyz".index(s.rate_axis[1]) for s in segments if s.rate != 0.0})
+    perpendicularity = [perpendicularity_index(a, k) for a in axes for k in range(2)]
+    per_point = [segment_base(s) + SEG_RATE_ERROR for s, seg in enumerate(segments) if seg.rate != 0.0]
+    rotating = bool(per_point)
+    groups = [
+        ("position accuracy", t.position_accuracy, accuracy, "rad"),
+        ("position repeatability", t.position_repeatability, repeatability, "rad"),
+        ("axis perpendicularity", t.axis_perpendicularity, perpendicularity, "rad"),
+        ("platform tilt", t.platform_tilt, list(range(TILT.start, TILT.stop)), "rad"),
+        ("fixture perpendicularity", t.fixture_perpendicularity, list(range(FIXTURE.start, FIXTURE.stop)), "rad"),
+        ("rate error, systematic", t.rate_error_systematic, [RATE_SYSTEMATIC] if rotating else [], "1"),
+        ("rate error, per point", t.rate_error_per_point, per_point, "1"),
+    ]
+    return [g for g in groups if g[1].standard_uncertainty > 0 and g[2]]
+
+
+def finite_differences(scenario: Scenario, indices: np.ndarray, steps: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """First and second derivatives (K, S, 6) of the noise-free segment means w.r.t. draws components.
+
+    Central differences with step ``steps[k]`` around the nominal draws (JCGM 100 5.1.3 note 2),
+    averaged over the table start angle (:data:`PHASE_NODES` angles): the derivatives of the
+    expected means.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    indices : (K,) array of int
+        Components of the draws vector (:mod:`plansim.kernels.layout`).
+    steps : (K,) array
+        Step of each component (its standard uncertainty).
+    """
+    grid = phase_grid_draws(scenario)  # (J, D)
+    n_in = len(indices)
+    n_seg = len(scenario.schedule)
+    if n_in == 0:
+        return np.zeros((0, n_seg, N_CHANNELS)), np.zeros((0, n_seg, N_CHANNELS))
+    plus = np.repeat(grid[None, :, :], n_in, axis=0)  # (K, J, D)
+    minus = plus.copy()
+    k = np.arange(n_in)
+    plus[k, :, indices] += steps[:, None]
+    minus[k, :, indices] -= steps[:, None]
+    d = grid.shape[1]
+    shape = (n_in, PHASE_NODES, n_seg, N_CHANNELS)
+    mean_plus = noise_free_segment_means(scenario, plus.reshape(-1, d)).reshape(shape).mean(1)
+    mean_minus = noise_free_segment_means(scenario, minus.reshape(-1, d)).reshape(shape).mean(1)
+    centre = noise_free_segment_means(scenario, grid).mean(axis=0)
+    first = (mean_plus - mean_minus) / (2.0 * steps[:, None, None])
+    second = (mean_plus + mean_minus - 2.0 * centre[None]) / steps[:, None, None] ** 2
+    return first, second
+
+
+def rate_derivatives(scenario: Scenario) -> np.ndarray:
+    """(S, 6): ``rate · ∂(segment mean)/∂(rate)`` of each rotating segment, averaged over the start angle.
+
+    The response of the outputs to the per-sample rate jitter of the table: the gyro input ω·u
+    (and with it P·ω²) follows the rate, the centripetal term of the lever arm does not (the
+    simulator jitters the gyro input only), so the derivative is taken with the lever arm removed,
+    by central differences of the noise-free means in the relative rate error of each point.
+    """
+    without_lever = dataclasses.replace(
+        scenario, effects=dataclasses.replace(scenario.effects, accel_lever_arm=np.zeros((3, 3))))
+    segments = scenario.schedule.segments
+    rotating = [s for s, seg in enumerate(segments) if seg.rate != 0.0]
+    out = np.zeros((len(segments), N_CHANNELS))
+    if not rotating:
+        return out
+    indices = np.array([segment_base(s) + SEG_RATE_ERROR for s in rotating], dtype=np.int64)
+    first, _ = finite_differences(without_lever, indices, np.full(len(rotating), RATE_STEP))
+    for k, s in enumerate(rotating):
+        out[s] = first[k, s]
+    return out
