@@ -5,11 +5,15 @@ Users get the repository and nothing else. So no file under ``docs/``, ``scenari
 source documents) or a path into the ``shared`` folder beside the repository; they cite JJF 2003-2022
 by clause, equation, table or Appendix A item, and ``docs/specification.md`` states what they rely on.
 Every relative link in ``docs/*.md`` and ``README.md`` must point to a file inside the repository,
-and an anchor in a link to a Markdown page must name one of that page's headings.
+and an anchor in a link to a Markdown page must name one of that page's headings. The files and
+Python names the pages quote (``plansim/kernels/physics.py``, ``plansim.config.parse_scenario``,
+``from plansim.io.scenario_file import load_scenario``) must exist, so a page does not send its
+reader to a module that has moved.
 """
 
 from __future__ import annotations
 
+import importlib
 import re
 from pathlib import Path
 
@@ -28,6 +32,11 @@ REFERENCE_DEFINITION = re.compile(r"^\s{0,3}\[[^\]]+\]:\s*<?(\S+?)>?(?:\s+.*)?$"
 FENCE = re.compile(r"^(```|~~~).*?^\1", re.MULTILINE | re.DOTALL)
 INLINE_CODE = re.compile(r"(`+)(?:(?!\1).)+?\1", re.DOTALL)
 HEADING = re.compile(r"^#{1,6}[ \t]+(.+?)[ \t]*#*[ \t]*$", re.MULTILINE)
+CODE_SPAN = re.compile(r"`([^`\n]+)`")
+REPOSITORY_PATH = re.compile(r"(?:plansim|tests|scenarios|benchmarks|docs)/[\w./-]*\w")
+DOTTED_NAME = re.compile(r"(plansim(?:\.[A-Za-z_]\w*)+)(?:\(.*\))?")
+PYTHON_IMPORT = re.compile(r"^\s*(?:>>>\s*)?(?:from\s+(plansim[\w.]*)\s+import\s+([\w, ]+)|import\s+(plansim[\w.]*))"
+                           r"\s*(?:#.*)?$", re.MULTILINE)
 
 
 def text_files(entry: str) -> list[Path]:
@@ -82,6 +91,36 @@ def anchors(markdown: str) -> set[str]:
     return out
 
 
+def python_name_exists(dotted: str) -> bool:
+    """Whether ``plansim.a.b.c`` names a module, or an attribute reached from the longest importable module."""
+    parts = dotted.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            found = importlib.import_module(".".join(parts[:cut]))
+        except ModuleNotFoundError:
+            continue
+        for attribute in parts[cut:]:
+            if not hasattr(found, attribute):
+                return False
+            found = getattr(found, attribute)
+        return True
+    return False
+
+
+def quoted_names(markdown: str) -> tuple[list[str], list[str]]:
+    """The repository paths and the ``plansim`` Python names a page quotes in code spans and Python blocks."""
+    paths, names = [], []
+    for span in CODE_SPAN.findall(FENCE.sub("", markdown)):
+        if REPOSITORY_PATH.fullmatch(span) and "*" not in span:
+            paths.append(span)
+        elif match := DOTTED_NAME.fullmatch(span):
+            names.append(match.group(1))
+    for block in re.findall(r"^```(?:python|pycon)[ \t]*\n(.*?)^```", markdown, re.MULTILINE | re.DOTALL):
+        for module, imported, plain in PYTHON_IMPORT.findall(block):
+            names += [plain] if plain else [f"{module}.{name.strip()}" for name in imported.split(",") if name.strip()]
+    return paths, names
+
+
 def markdown_pages() -> list[Path]:
     return sorted((ROOT / "docs").glob("*.md")) + [ROOT / "README.md"]
 
@@ -107,6 +146,14 @@ def test_the_detectors_catch_what_they_are_for_and_nothing_else():
         "the-calibration-model-jjf-2003-eq-1-and-2"
     assert heading_anchor("## `[reduction]`".lstrip("# ")) == "reduction"
     assert anchors("# A\n## B b\n## B b\n```\n# not a heading\n```\n") == {"a", "b-b", "b-b-1"}
+    paths, names = quoted_names("`plansim/kernels/physics.py` and `plansim.run(scenario)`, `scenarios/*.toml`\n"
+                                "```python\nimport plansim\nfrom plansim.config import parse_scenario, Scenario\n"
+                                "```\n```console\n$ from plansim.x import y\n```\n")
+    assert paths == ["plansim/kernels/physics.py"]
+    assert names == ["plansim.run", "plansim", "plansim.config.parse_scenario", "plansim.config.Scenario"]
+    assert python_name_exists("plansim.config.parse_scenario") and python_name_exists("plansim.kernels.physics")
+    assert not python_name_exists("plansim.scenario.parse_scenario")
+    assert not python_name_exists("plansim.config.no_such_function")
 
 
 # ----------------------------------------------------------------------------- the repository stands alone
@@ -148,3 +195,12 @@ def test_every_anchor_in_a_link_names_a_heading_of_its_page(page):
         if fragment not in anchors(destination.read_text(encoding="utf-8")):
             broken.append(target)
     assert not broken, f"{page_id(page)}: no heading for " + ", ".join(broken)
+
+
+@pytest.mark.parametrize("page", markdown_pages(), ids=page_id)
+def test_every_file_and_python_name_a_page_quotes_exists(page):
+    paths, names = quoted_names(page.read_text(encoding="utf-8"))
+    missing = [path for path in paths if not (ROOT / path).exists()]
+    missing += [name for name in names if not python_name_exists(name)]
+    assert not missing, (f"{page_id(page)} quotes what the repository does not have: "
+                         + ", ".join(dict.fromkeys(missing)))
