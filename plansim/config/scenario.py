@@ -357,8 +357,8 @@ def _parse_schedule(document: dict) -> tuple[Schedule, list[tuple[str, object] |
                 if _same_rate(rate, rates[j]):
                     raise ValueError(f"schedule.rate_points[{i}] = {rate_points[i]!r} repeats "
                                      f"schedule.rate_points[{j}] = {rate_points[j]!r}: each rate point is recorded "
-                                     "once per axis (JJF 2003 §7.2.1: 7 to 11 rate points, including the maximum "
-                                     "rate); remove the repeat")
+                                     "once per axis; JJF 2003 §7.2.1.1 c) asks for 7 to 11 distinct rate points, "
+                                     "including the maximum input rate. Remove the repeat")
         origins = []
         for segment in schedule.segments:
             if not segment.is_rotating:
@@ -383,8 +383,8 @@ def _check_repeated_rate_segments(schedule: Schedule, raw_segments: list[dict]) 
                 raise ValueError(
                     f"schedule.segments[{k}] ({segment.label!r}): rate {raw_segments[k].get('rate', '0 deg/s')!r} "
                     f"repeats schedule.segments[{j}] ({schedule.segments[j].label!r}) of the rate test about "
-                    f"{'xyz'[segment.group]}: each rate point is recorded once per axis (JJF 2003 §7.2.1: 7 to 11 "
-                    "rate points); remove the repeat")
+                    f"{'xyz'[segment.group]}: each rate point is recorded once per axis; JJF 2003 §7.2.1.1 c) asks "
+                    "for 7 to 11 distinct rate points. Remove the repeat")
         seen[segment.group].append(k)
 
 
