@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import plansim
+from plansim.config import parse_scenario
+from plansim.io.scenario_file import builtin_scenarios
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_NAMES
-from plansim.io.scenario_file import builtin_scenarios
-from plansim.config import parse_scenario
 from plansim.simulate.chunks import simulate_recording, simulate_segment_means
 
 
@@ -140,7 +140,8 @@ def test_printed_sign_of_eq_12_returns_minus_p():
 
 
 def test_lever_arm_enters_p_as_minus_the_radius():
-    """An accelerometer at r from the table axis feels −ω² r⊥ (same ω² law as p): p̂_yx − p_yx = −(Ka_yy r_y + Ka_yz r_z)."""
+    """An accelerometer at r from the table axis feels −ω² r⊥ (same ω² law as p):
+    p̂_yx − p_yx = −(Ka_yy r_y + Ka_yz r_z)."""
     r = np.array([0.003, 0.004, 0.002])
     row = [f"{v * 1000} mm" for v in r]
     sc = scenario_with(mimu__effects={"accel_lever_arm": [row, row, row]})
@@ -182,3 +183,27 @@ def test_blas_runs_on_one_thread_while_the_kernels_run_and_is_restored_after():
                                                      path="segment")]
     assert len(during) == 2 and all(threads == [1] * len(before) for threads in during)
     assert blas_threads() == before
+
+
+@pytest.mark.parametrize("chunk_size", [1, 7, 333])
+def test_estimates_are_bit_identical_whatever_the_chunk_size(chunk_size):
+    """The reduction's rounding must not depend on how the trials are chunked (issue 9 §2)."""
+    reference = plansim.run("jjf2003", trials=700, seed=4)
+    chunked = plansim.run("jjf2003", trials=700, seed=4, chunk_size=chunk_size)
+    for variable in ("truth", "estimate", "error"):
+        assert np.array_equal(chunked[variable].values, reference[variable].values), variable
+
+
+def test_a_trial_gives_the_same_bits_whatever_the_number_of_trials():
+    """Trial i is reduced in the same fixed block shape at the same position, however many trials follow it."""
+    many = plansim.run("jjf2003", trials=4100, seed=6)
+    for trials in (1, 2, 4097):
+        few = plansim.run("jjf2003", trials=trials, seed=6)
+        assert np.array_equal(few["estimate"].values, many["estimate"].values[:trials]), trials
+
+
+@pytest.mark.parametrize("trials, exception", [(0, ValueError), (-3, ValueError), (2.5, TypeError),
+                                               (True, TypeError), ("10", TypeError), (10.0, TypeError)])
+def test_run_rejects_a_bad_trial_count_naming_it(trials, exception):
+    with pytest.raises(exception, match=r"trials = "):
+        plansim.run("ideal", trials=trials, seed=1)

@@ -46,9 +46,25 @@ def appendix_a_table(comparisons) -> str:
 
 
 def parameter_summary(results: xr.Dataset) -> list[dict]:
-    """Per parameter: name, SI unit, mean truth, mean error and standard deviation of the error."""
-    err = results["error"]
+    """Per parameter: name, SI unit, mean truth, mean error and standard deviation of the error (ddof = 1;
+    0 with one trial).
+
+    *results* is either a run's per-trial Dataset (:func:`plansim.runner.run`) or its streamed summary
+    (:func:`plansim.runner.run_summary`, recognised by its ``error_mean`` variable).
+    """
     out = []
+    if "error_mean" in results:
+        for k, name in enumerate(results["parameter"].values):
+            std = float(results["error_std"].values[k])
+            out.append({
+                "name": str(name),
+                "unit": str(results["units"].values[k]),
+                "truth": float(results["truth_mean"].values[k]),
+                "mean_error": float(results["error_mean"].values[k]),
+                "std_error": std if int(results.attrs["trials"]) > 1 else 0.0,
+            })
+        return out
+    err = results["error"]
     for name in results["parameter"].values:
         e = err.sel(parameter=name).values
         out.append({

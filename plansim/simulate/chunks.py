@@ -26,11 +26,20 @@ from plansim.simulate.compilation import bound_call, compile_kernels
 ProgressCallback = Callable[[int, int], None]
 
 
+def check_count(name: str, value, minimum: int = 1) -> int:
+    """*value* as an int if it is a whole number >= *minimum*; else TypeError (not an integer, or a bool)
+    or ValueError (too small), naming *name*, the value and what is allowed."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} = {value!r}: expected a whole number (int) >= {minimum}, "
+                        f"got {type(value).__name__}")
+    if value < minimum:
+        raise ValueError(f"{name} = {value!r}: expected a whole number >= {minimum}")
+    return int(value)
+
+
 def _check_run_arguments(trials, chunk_size, path):
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ValueError(f"trials = {trials!r}: expected a whole number >= 1")
-    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
-        raise ValueError(f"chunk_size = {chunk_size!r}: expected a whole number >= 1")
+    check_count("trials", trials)
+    check_count("chunk_size", chunk_size)
     if path not in ("sample", "segment"):
         raise ValueError(f"path = {path!r}; allowed: 'sample', 'segment'")
 
@@ -136,6 +145,46 @@ def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int =
             yield start, stop, means[: stop - start], truth[: stop - start]
             if progress is not None:
                 progress(stop, trials)
+
+
+#: trials per reduction block: results are reduced (and summarised) in fixed blocks of trials
+#: ``[0, B), [B, 2B), …`` whatever the chunk size, so that every trial's rounding is the same in any run
+REDUCTION_BLOCK = 4096
+
+
+def iterate_blocks(scenario: Scenario, trials: int, seed: int, chunk_size: int = 4096, path: str = "sample",
+                   progress: ProgressCallback | None = None, block: int = REDUCTION_BLOCK):
+    """Yield ``(start, stop, means, truth)`` in fixed, trial-aligned blocks ``[k·block, (k+1)·block)`` (the
+    last one shorter), whatever *chunk_size*.
+
+    The simulation runs chunk by chunk (:func:`iterate_chunks`); this regroups the chunks so that what
+    the caller does with a block (a matrix product, a sum) sees the same rows in the same positions for
+    any chunk size: its rounding then depends on the trial indices only. A block that lies inside one
+    chunk is a view of the chunk's buffers, one that spans chunks is copied into a block buffer
+    (``block`` × (S × 6 + 39) × 8 bytes). Either is valid until the next block is asked for. The
+    blocks are yielded while the chunks run (BLAS held to one thread, as in :func:`iterate_chunks`).
+    """
+    _check_run_arguments(trials, chunk_size, path)
+    block = check_count("block", block)
+    means_buffer = truth_buffer = None
+    for start, stop, means, truth in iterate_chunks(scenario, trials, seed, chunk_size, path, progress):
+        position = start
+        while position < stop:
+            first = position - position % block
+            last = min(trials, first + block)
+            end = min(stop, last)
+            if position == first and end == last:  # the whole block is in this chunk
+                yield first, last, means[first - start:last - start], truth[first - start:last - start]
+            else:
+                if means_buffer is None:
+                    size = min(block, trials)
+                    means_buffer = np.empty((size, *means.shape[1:]))
+                    truth_buffer = np.empty((size, truth.shape[1]))
+                means_buffer[position - first:end - first] = means[position - start:end - start]
+                truth_buffer[position - first:end - first] = truth[position - start:end - start]
+                if end == last:
+                    yield first, last, means_buffer[:last - first], truth_buffer[:last - first]
+            position = end
 
 
 def simulate_segment_means(scenario: Scenario, trials: int, seed: int, chunk_size: int = 256,
