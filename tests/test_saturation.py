@@ -18,6 +18,7 @@ import pytest
 
 from plansim.config import parse_scenario, saturation_report
 from plansim.io.scenario_file import load_scenario
+from test_scenario_validation import custom_segments, with_custom_schedule
 
 JJF2003 = Path(__file__).resolve().parent.parent / "scenarios" / "jjf2003.toml"
 with open(JJF2003, "rb") as _fh:
@@ -69,8 +70,6 @@ def test_the_acquisition_full_scale_is_a_limit_only_when_it_quantises(ideal_docu
 
 
 def test_a_custom_segment_beyond_the_range_names_the_segment(ideal_document):
-    from test_scenario_validation import custom_segments, with_custom_schedule
-
     ideal_document["mimu"]["gyro_range"] = "2 rad/s"
     with_custom_schedule(ideal_document, custom_segments(rates_deg=(-50.0, 0.0, 150.0)))
     with pytest.raises(ValueError, match=r"schedule\.segments\[8\]\.rate = '150\.0 deg/s': gyro gx .*"

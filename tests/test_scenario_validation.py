@@ -8,11 +8,11 @@ that names the field (checked with ``pytest.raises(..., match=...)``).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import IDEAL_TOML
 from plansim.config import parse_scenario
 from plansim.io.scenario_file import load_scenario, save_scenario
 from plansim.model.environment import normal_gravity
@@ -378,8 +378,11 @@ def test_segment_that_is_not_a_table_names_its_index(ideal_document):
 # ----------------------------------------------------------------------------- names
 
 
+SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+
+
 def _copy_builtin(tmp_path, builtin, stem, edit=None):
-    text = (IDEAL_TOML.parent / f"{builtin}.toml").read_text(encoding="utf-8")
+    text = (SCENARIOS / f"{builtin}.toml").read_text(encoding="utf-8")
     if edit:
         text = edit(text)
     path = tmp_path / f"{stem}.toml"
@@ -501,7 +504,7 @@ def test_a_garbled_scenario_file_is_a_value_error_naming_the_file(tmp_path, data
 
 def test_a_utf8_byte_order_mark_is_accepted(tmp_path):
     path = tmp_path / "lab.toml"
-    path.write_bytes(b"\xef\xbb\xbf" + (IDEAL_TOML.read_bytes()))
+    path.write_bytes(b"\xef\xbb\xbf" + (SCENARIOS / "ideal.toml").read_bytes())
     assert load_scenario(path).trials == 20
 
 
