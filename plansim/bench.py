@@ -9,7 +9,10 @@ Figures (all per second of wall time, thread count reported):
 - ``calibrations_per_s`` — complete default ``jjf2003`` calibrations (12 positions, every rate
   point, the ω² test, every estimator) on the segment-statistics path, through ``plansim.run``;
 - ``seconds_per_trial`` at 10³, 10⁴, 10⁵ trials (it must not grow with the trial count);
-- ``peak_rss_mb`` of a separate process running the default with 10⁶ trials (results included);
+- ``summary_peak_rss_mb`` of a separate process running ``plansim run``'s summary mode
+  (:func:`plansim.runner.run_summary`: statistics streamed, no per-trial arrays) with 10⁶ trials
+  (the issue's acceptance: under 1 GB), and ``peak_rss_mb`` of one running :func:`plansim.run`
+  with 10⁶ trials (every trial's truth, estimate and error kept: 0.94 GB of arrays);
 - cold start (first ``plansim run`` with an empty kernel cache: compiling) and warm start, both
   for 10⁴ trials, as separate processes.
 
@@ -72,7 +75,8 @@ def _sample_path_run(trials: int):
             trials * sc.schedule.total_samples)
 
 
-def numpy_and_sample_path(normals: int = 10_000_000, trials: int = 64, rounds: int = ROUNDS) -> tuple[float, float, float]:
+def numpy_and_sample_path(normals: int = 10_000_000, trials: int = 64,
+                          rounds: int = ROUNDS) -> tuple[float, float, float]:
     """(numpy normals/s, channel samples/s, 6-channel samples/s), best rounds, measured alternately."""
     draw, drawn = _numpy_draws(normals)
     simulate, imu_samples = _sample_path_run(trials)
@@ -113,8 +117,16 @@ _RSS = "import resource; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrs
 
 
 def peak_rss_mb(trials: int = 1_000_000) -> tuple[float, float]:
-    """(peak RSS in MB, seconds) of a process running the default with *trials* trials."""
+    """(peak RSS in MB, seconds) of a new process running the default with *trials* trials, every trial kept."""
     seconds, rss = _child(f"import plansim; plansim.run({SCENARIO!r}, trials={trials}, seed=1); {_RSS}")
+    return rss, seconds
+
+
+def summary_peak_rss_mb(trials: int = 1_000_000) -> tuple[float, float]:
+    """(peak RSS in MB, seconds) of a new process running the default's summary (``plansim run`` without
+    ``--out``: :func:`plansim.runner.run_summary`, the Appendix A comparison included)."""
+    seconds, rss = _child(f"from plansim.runner import run_summary; run_summary({SCENARIO!r}, trials={trials}, "
+                          f"seed=1); {_RSS}")
     return rss, seconds
 
 
@@ -135,6 +147,7 @@ def measure(quick: bool = False) -> dict:
     normals, channel_samples, imu_samples = numpy_and_sample_path(10_000_000 // scale, 64 // min(scale, 32))
     calibrations = calibrations_per_s(20_000 // scale)
     per_trial = seconds_per_trial((1_000 // scale, 10_000 // scale, 100_000 // scale))
+    summary_rss, summary_seconds = summary_peak_rss_mb(1_000_000 // scale)
     rss, big_seconds = peak_rss_mb(1_000_000 // scale)
     cold, warm = start_times(10_000 // scale)
     counts = sorted(per_trial, key=int)
@@ -154,6 +167,8 @@ def measure(quick: bool = False) -> dict:
         "million_trials": 1_000_000 // scale,
         "million_trials_seconds": big_seconds,
         "peak_rss_mb": rss,
+        "summary_seconds": summary_seconds,
+        "summary_peak_rss_mb": summary_rss,
         "cold_start_s": cold,
         "warm_start_s": warm,
         "start_trials": 10_000 // scale,
@@ -165,13 +180,16 @@ def format_figures(f: dict) -> str:
              f"{' (quick sizes)' if f['quick'] else ''}",
              f"  numpy standard_normal            {f['numpy_normal_per_s']:14,.0f} /s  (reference)",
              f"  sample-level path                {f['samples_per_s']:14,.0f} channel samples/s "
-             f"({f['samples_per_s_over_numpy_normal_per_s']:.2f} × numpy; {f['imu_samples_per_s']:,.0f} 6-channel samples/s)",
+             f"({f['samples_per_s_over_numpy_normal_per_s']:.2f} × numpy; "
+             f"{f['imu_samples_per_s']:,.0f} 6-channel samples/s)",
              f"  segment-statistics path          {f['calibrations_per_s']:14,.0f} calibrations/s (default jjf2003)"]
     for n, s in sorted(f["seconds_per_trial"].items(), key=lambda kv: int(kv[0])):
         lines.append(f"  time per trial at {int(n):>9,} trials {s * 1e6:10.1f} µs")
     lines += [f"  growth of time per trial          {f['seconds_per_trial_growth']:10.2f} × (largest / smallest count)",
-              f"  {f['million_trials']:,} trials: {f['million_trials_seconds']:.1f} s in a new process, "
-              f"peak RSS {f['peak_rss_mb']:,.0f} MB",
+              f"  {f['million_trials']:,} trials, summary (plansim run): {f['summary_seconds']:.1f} s in a new "
+              f"process, peak RSS {f['summary_peak_rss_mb']:,.0f} MB",
+              f"  {f['million_trials']:,} trials, every trial kept (plansim.run): {f['million_trials_seconds']:.1f} s "
+              f"in a new process, peak RSS {f['peak_rss_mb']:,.0f} MB",
               f"  plansim run, {f['start_trials']:,} trials: cold start {f['cold_start_s']:.1f} s (compiling), "
               f"warm {f['warm_start_s']:.1f} s"]
     return "\n".join(lines)
