@@ -306,6 +306,16 @@ def test_verdict_thresholds():
     assert factor == math.inf and verdict.startswith("over-stated")
 
 
+def test_too_few_trials_are_not_called_supported(scenario):
+    """10 trials: A.1 pools 30 errors, A.3 90 — fewer than the 171 a 95 % verdict needs to find an
+    over-statement, so a budget 100× too wide is "too few trials to judge", not "supported" (issue 9 §2)."""
+    truth, estimate = synthetic(scenario, {b.item: b.printed_combined_standard_uncertainty / 100 for b in APPENDIX_A},
+                                10)
+    for r in compare_with_appendix_a(truth, estimate, scenario):
+        assert r.coverage == 1.0 and r.overstatement_factor > 20
+        assert r.verdict == f"too few trials to judge ({r.n} < 171)"
+
+
 def test_as_dict_has_the_cli_keys(scenario):
     truth, estimate = synthetic(scenario, {b.item: b.printed_combined_standard_uncertainty for b in APPENDIX_A}, 50)
     record = compare_with_appendix_a(truth, estimate, scenario)[2].as_dict()

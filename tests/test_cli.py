@@ -113,11 +113,20 @@ def test_a_seed_beyond_32_bits_is_written_to_netcdf(capsys, tmp_path):
 def test_a_custom_segment_without_up_is_an_error_naming_it(tmp_path):
     import tomllib
 
-    from plansim.io.scenario_file import builtin_scenarios
     from plansim.config import parse_scenario
+    from plansim.io.scenario_file import builtin_scenarios
 
     with open(builtin_scenarios()["ideal"], "rb") as fh:
         doc = tomllib.load(fh)
     doc["schedule"] = {"procedure": "custom", "segments": [{"label": "p", "test": "multi_position", "group": 1}]}
     with pytest.raises(ValueError, match=r"schedule\.segments\[0\]\.up is required"):
         parse_scenario(doc)
+
+
+def test_run_with_too_few_trials_does_not_call_a_budget_supported(capsys):
+    code, out, _ = run_cli(capsys, "run", "ideal", "--trials", "3", "--json", "--quiet")
+    assert code == 0
+    verdicts = [a["verdict"] for a in json.loads(out)["appendix_a"]]
+    assert all(v.startswith("too few trials to judge") for v in verdicts), verdicts
+    code, out, _ = run_cli(capsys, "run", "ideal", "--trials", "3", "--quiet")
+    assert code == 0 and "supported" not in out and "too few trials to judge (9 < 171)" in out

@@ -327,6 +327,38 @@ def test_claims_errors_name_the_field(text, error, match, linear):
         parse_claims(tomllib.loads(text), linear, source="c.toml")
 
 
+# ----------------------------------------------------------------------------- nothing to validate
+
+
+def test_a_zero_noise_scenario_has_nothing_to_validate(capsys):
+    """ideal: every GUM u_c is 0, so δ = 0 and the Monte Carlo would run to --max-trials on round-off
+    (issue 9 §2); validate says so before simulating."""
+    with pytest.raises(ValueError, match="nothing to validate"):
+        validate("ideal", trials_per_block=2000, max_trials=4000, seed=SEED)
+    code = main(["validate", "ideal", "--quiet", "--trials-per-block", "2000", "--max-trials", "4000"])
+    _, err = capsys.readouterr()
+    assert code == 2 and "nothing to validate" in err and "ideal" in err
+
+
+def test_outputs_without_uncertainty_do_not_hold_the_monte_carlo(linear):
+    """Gyro white noise only: the accelerometer parameters have u_c = 0 (δ = 0, which round-off never
+    meets); the adaptive procedure stops on the others and still reports every parameter."""
+    import dataclasses
+
+    t = linear.turntable
+    zero = dataclasses.replace(t.position_accuracy, scale=0.0)
+    table = dataclasses.replace(t, **{f.name: zero for f in dataclasses.fields(t) if f.name != "rate_smoothness"},
+                                rate_smoothness=0.0)
+    noise = dataclasses.replace(linear.noise, accel_velocity_random_walk=np.zeros(3))
+    sc = dataclasses.replace(linear, turntable=table, noise=noise, truth_spread=np.zeros_like(linear.truth_spread))
+    r = validate(sc, trials_per_block=2000, max_trials=40_000, seed=SEED, tolerance_fraction=0.5)
+    silent = {p.name for p in r.parameters if p.gum_u == 0.0}
+    assert silent >= {n for n in PARAMETER_NAMES if n[:2] in ("Ka", "Ba") or n[0] == "p"}
+    assert r.mcm.converged and not silent & set(r.mcm.monitored)
+    assert set(r.mcm.monitored) == set(PARAMETER_NAMES) - silent
+    assert len(r.parameters) == 39
+
+
 # ----------------------------------------------------------------------------- the command line
 
 

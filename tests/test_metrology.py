@@ -75,3 +75,22 @@ def test_the_core_imports_only_numpy_scipy_and_the_standard_library():
         outside = {m for m in _imports(path)
                    if m.split(".")[0] not in allowed and not m.startswith("plansim.uncertainty.metrology")}
         assert not outside, f"plansim/uncertainty/metrology/{path.name} imports {sorted(outside)}"
+
+
+def test_a_verdict_with_too_few_trials_says_so():
+    """Below 171 trials a 95 % claim covering every trial is within 3 binomial sd of 95 %: no claim could be
+    found over-stated, so "supported" would say nothing (issue 9 §2)."""
+    from plansim.uncertainty.metrology import coverage_verdict, minimum_trials_to_judge
+
+    assert minimum_trials_to_judge(0.95) == 171
+    verdict, factor = coverage_verdict(1.0, 100, 0.95, 10.0, 1.0)
+    assert verdict == "too few trials to judge (100 < 171)" and factor == 10.0
+    assert coverage_verdict(0.96, 170, 0.95, 1.5, 1.0)[0].startswith("too few trials to judge")
+    # an under-statement is seen with few trials all the same
+    assert coverage_verdict(0.5, 100, 0.95, 0.3, 1.0)[0] == "under-stated ×0.3"
+    # from 171 trials on the verdict is the usual one
+    assert coverage_verdict(1.0, 171, 0.95, 10.0, 1.0)[0] == "over-stated ×10"
+    assert coverage_verdict(0.95, 171, 0.95, 1.0, 1.0)[0] == "supported"
+    # k = 3: p = 99.73 %, over-statement needs 3 sd below 100 %
+    assert minimum_trials_to_judge(0.9973) == math.ceil(9 * 0.9973 / 0.0027 - 1e-9)
+    assert minimum_trials_to_judge(1.0) == 1

@@ -350,8 +350,9 @@ def validate(scenario: Scenario, simulate: Simulate, claims: Mapping[str, Claim]
     joint_parameters : sequence of str
         Outputs checked jointly (JCGM 102; default the nine Kg).
     monitor : sequence of str, optional
-        The outputs whose numerical tolerance stops the Monte Carlo (default all 39; every output
-        is validated, but those not monitored only to the accuracy the run happens to reach).
+        The outputs whose numerical tolerance stops the Monte Carlo (default every parameter whose
+        GUM ``u_c`` is not 0: a tolerance ``δ = 0`` is never met by round-off; every output is
+        validated, but those not monitored only to the accuracy the run happens to reach).
     progress : callable, optional
         ``progress(trials_done, blocks, worst)`` after each block
         (:func:`plansim.uncertainty.metrology.adaptive_monte_carlo`).
@@ -365,7 +366,8 @@ def validate(scenario: Scenario, simulate: Simulate, claims: Mapping[str, Claim]
     TypeError
         *scenario* is not a Scenario, *simulate* is not callable, or *claims* is not a mapping of Claim.
     ValueError
-        A bad tolerance fraction, or a bad argument of the adaptive procedure.
+        A bad tolerance fraction, or a bad argument of the adaptive procedure; a scenario without
+        any uncertain input (every GUM ``u_c`` is 0: nothing to validate, before any simulation).
     """
     if not isinstance(scenario, Scenario):
         raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario (plansim.runner.validate "
@@ -385,7 +387,15 @@ def validate(scenario: Scenario, simulate: Simulate, claims: Mapping[str, Claim]
         claims_source = ", ".join(sources)
 
     gum = evaluate_gum(scenario, coverage_probability)
-    delta_gum = np.asarray(numerical_tolerance(gum.standard_uncertainty, digits))
+    u_gum = gum.standard_uncertainty
+    if not np.any(u_gum > 0):
+        raise ValueError(f"scenario {scenario.name!r}: nothing to validate — none of its inputs is uncertain (no table "
+                         "or fixture error, unit spread, noise, drift, quantisation or rate jitter), so the GUM "
+                         "standard uncertainty of every parameter is 0 and a Monte Carlo would only see round-off; "
+                         "'plansim run' shows its errors")
+    if monitor is None:
+        monitor = [name for name, u in zip(PARAMETER_NAMES, u_gum) if u > 0]
+    delta_gum = np.asarray(numerical_tolerance(u_gum, digits))
     mc = calibration_monte_carlo(simulate, scenario, path=path, digits=digits, trials_per_block=trials_per_block,
                                  max_trials=max_trials, seed=seed, tolerance=tolerance_fraction * delta_gum,
                                  parameters=monitor, coverage_probability=coverage_probability, progress=progress)

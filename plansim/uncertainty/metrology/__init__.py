@@ -18,27 +18,28 @@ and the standard library (import-linter holds it to that). plansim's budget buil
 """
 
 from plansim.uncertainty.metrology.coverage import (
-                                                    COVERAGE_Z,
-                                                    OVERSTATEMENT_FACTOR,
-                                                    coverage_against_truth,
-                                                    coverage_tolerance,
-                                                    coverage_verdict,
+    COVERAGE_Z,
+    OVERSTATEMENT_FACTOR,
+    coverage_against_truth,
+    coverage_tolerance,
+    coverage_verdict,
+    minimum_trials_to_judge,
 )
 from plansim.uncertainty.metrology.intervals import coverage_intervals
 from plansim.uncertainty.metrology.monte_carlo import (
-                                                    DEFAULT_DIGITS,
-                                                    DEFAULT_TRIALS_PER_BLOCK,
-                                                    MonteCarloResult,
-                                                    adaptive_monte_carlo,
-                                                    block_seeds,
-                                                    minimum_block_size,
-                                                    numerical_tolerance,
+    DEFAULT_DIGITS,
+    DEFAULT_TRIALS_PER_BLOCK,
+    MonteCarloResult,
+    adaptive_monte_carlo,
+    block_seeds,
+    minimum_block_size,
+    numerical_tolerance,
 )
 from plansim.uncertainty.metrology.propagation import (
-                                                    DEFAULT_COVERAGE_PROBABILITY,
-                                                    combine,
-                                                    coverage_factor,
-                                                    welch_satterthwaite,
+    DEFAULT_COVERAGE_PROBABILITY,
+    combine,
+    coverage_factor,
+    welch_satterthwaite,
 )
 from plansim.uncertainty.metrology.several_outputs import JointRegionCheck, correlation_matrix, joint_region
 from plansim.uncertainty.metrology.validation import ValidationOutcome, validate_gum
@@ -63,6 +64,7 @@ __all__ = [
     "coverage_verdict",
     "joint_region",
     "minimum_block_size",
+    "minimum_trials_to_judge",
     "numerical_tolerance",
     "validate_gum",
     "welch_satterthwaite",

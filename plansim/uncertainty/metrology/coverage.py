@@ -7,7 +7,8 @@ error of that fraction.
 
 - :func:`coverage_against_truth` — that fraction, per output;
 - :func:`coverage_tolerance` — ``z`` binomial standard deviations of an observed coverage;
-- :func:`coverage_verdict` — under-stated, over-stated by a factor, or supported.
+- :func:`minimum_trials_to_judge` — how many trials a verdict needs before it can tell;
+- :func:`coverage_verdict` — under-stated, over-stated by a factor, supported, or too few trials to judge.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ import numpy as np
 
 from plansim.uncertainty.metrology.checks import check_count
 
-__all__ = ["COVERAGE_Z", "OVERSTATEMENT_FACTOR", "coverage_against_truth", "coverage_tolerance", "coverage_verdict"]
+__all__ = ["COVERAGE_Z", "OVERSTATEMENT_FACTOR", "coverage_against_truth", "coverage_tolerance", "coverage_verdict",
+           "minimum_trials_to_judge"]
 
 #: Binomial standard deviations allowed between an observed coverage and its nominal value in a verdict.
 COVERAGE_Z = 3.0
@@ -70,6 +72,42 @@ def coverage_tolerance(n: int, coverage_probability: float = 0.95, z: float = CO
     return z * math.sqrt(p * (1.0 - p) / n)
 
 
+def _judges_both_ways(n: int, probability: float, z: float) -> bool:
+    """Whether a coverage of 0 could fall below ``p − tol`` and one of 1 reach ``p + tol`` over *n* trials."""
+    tolerance = coverage_tolerance(n, probability, z)
+    return probability - tolerance > 0.0 and probability + tolerance <= 1.0
+
+
+def minimum_trials_to_judge(probability: float = 0.95, z: float = COVERAGE_Z) -> int:
+    """The fewest trials over which :func:`coverage_verdict` can find a statement both under- and over-stated.
+
+    A coverage observed over ``n`` trials lies in [0, 1]; the verdict needs it ``z`` binomial
+    standard deviations from ``p`` (:func:`coverage_tolerance`), which is possible on both sides
+    only once ``z·sqrt(p(1 − p)/n) ≤ min(p, 1 − p)``, i.e. ``n ≥ z²·p(1 − p)/min(p, 1 − p)²``:
+    171 for ``p = 0.95``, ``z = 3`` (below that even a claim covering every trial is not
+    significantly above 95 %). The bound is evaluated with the verdict's own arithmetic.
+
+    Parameters
+    ----------
+    probability : float
+        ``p``, ``0 < p ≤ 1`` (``p = 1``: any ``n``).
+    z : float
+        Binomial standard deviations of the tolerance.
+
+    Returns
+    -------
+    int
+    """
+    coverage_tolerance(1, probability, z)  # validates p
+    margin = min(probability, 1.0 - probability)
+    n = max(1, math.ceil(z * z * probability * (1.0 - probability) / margin**2 - 1e-9)) if margin > 0 else 1
+    while not _judges_both_ways(n, probability, z):
+        n += 1
+    while n > 1 and _judges_both_ways(n - 1, probability, z):
+        n -= 1
+    return n
+
+
 def coverage_verdict(coverage: float, n: int, probability: float, claimed: float, needed: float, *,
                      z: float = COVERAGE_Z, show_understatement_factor: bool = True) -> tuple[str, float]:
     """Verdict on a stated expanded uncertainty from its coverage of the truth over *n* trials.
@@ -80,6 +118,10 @@ def coverage_verdict(coverage: float, n: int, probability: float, claimed: float
 
     - ``"under-stated"`` if ``coverage < p − tol``;
     - ``"over-stated ×F"`` if ``coverage ≥ p + tol`` and ``F >`` :data:`OVERSTATEMENT_FACTOR`;
+    - ``"too few trials to judge (n < N)"`` otherwise when ``n`` is below
+      :func:`minimum_trials_to_judge` ``N`` (171 at 95 %): with so few trials the tolerance reaches
+      past 0 or 1, so one of the two findings above could never be made and "supported" would
+      say nothing;
     - ``"supported"`` otherwise (it includes a statement that is conservative by at most 2×).
 
     Parameters
@@ -113,4 +155,7 @@ def coverage_verdict(coverage: float, n: int, probability: float, claimed: float
         return (f"under-stated ×{factor:.3g}" if show_understatement_factor else "under-stated"), factor
     if coverage >= probability + tolerance and factor > OVERSTATEMENT_FACTOR:
         return f"over-stated ×{factor:.3g}", factor
+    needed_trials = minimum_trials_to_judge(probability, z)
+    if n < needed_trials:
+        return f"too few trials to judge ({n} < {needed_trials})", factor
     return "supported", factor
