@@ -292,26 +292,30 @@ def run_summary(scenario: Scenario | str = "jjf2003", trials: int | None = None,
     budgets = APPENDIX_A if budgets is None else check_budgets(budgets)
     chosen, reasons = choose_path(sc, path)
     check_memory(trials, estimate_memory(sc, trials, chunk_size, keep_trials=False, budgets=budgets))
-    if out is not None and not isinstance(out, ResultsFile):
+    template = results_dataset(sc, np.empty((0, N_PARAMETERS)), np.empty((0, N_PARAMETERS)), seed)
+    template.attrs.update(trials=trials, **_path_attributes(chosen, path, reasons))
+    statistics = RunStatistics(sc, trials, budgets)
+    if out is None or isinstance(out, ResultsFile):
+        _stream(sc, trials, seed, chunk_size, chosen, progress, statistics, template, out)
+    else:
         with ResultsFile(out) as results_file:
-            summary = run_summary(sc, trials, seed, chunk_size, progress, path, results_file, budgets)
+            _stream(sc, trials, seed, chunk_size, chosen, progress, statistics, template, results_file)
             results_file.commit()
-        return summary
-    attrs = results_dataset(sc, np.empty((0, N_PARAMETERS)), np.empty((0, N_PARAMETERS)), seed).attrs
-    attrs.update(trials=trials, **_path_attributes(chosen, path, reasons))
+    summary = statistics.dataset(dict(template.attrs))
+    summary.attrs["title"] = f"plansim Monte Carlo summary of scenario {sc.name!r}"
+    return summary
+
+
+def _stream(sc, trials, seed, chunk_size, chosen, progress, statistics: RunStatistics, template: xr.Dataset,
+            out: ResultsFile | None) -> None:
+    """Feed the reduced blocks to *statistics* and, if given, to the results file *out*."""
     if out is not None:
         out.check_space(trials)
-        template = results_dataset(sc, np.empty((0, N_PARAMETERS)), np.empty((0, N_PARAMETERS)), seed)
-        template.attrs.update(attrs)
         out.start(template, trials)
-    statistics = RunStatistics(sc, trials, budgets)
     for start, _stop, truth, estimate, _means in _reduced_blocks(sc, trials, seed, chunk_size, chosen, progress):
         error = statistics.add(start, truth, estimate)
         if out is not None:
             out.write(start, truth=truth, estimate=estimate, error=error)
-    summary = statistics.dataset(attrs)
-    summary.attrs["title"] = f"plansim Monte Carlo summary of scenario {sc.name!r}"
-    return summary
 
 
 def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed: int,

@@ -79,6 +79,15 @@ def test_the_summary_gives_the_appendix_a_comparison_of_the_trials(scenario, per
             _close(gp.budget_U_si, ep.budget_U_si)
 
 
+def test_few_trials_give_the_same_appendix_a_verdicts(scenario):
+    """With few trials the verdict says so; the summary must say the same."""
+    trials = plansim.run(scenario, trials=20, seed=2)
+    expected = compare_with_appendix_a(trials["truth"].values, trials["estimate"].values, scenario)
+    got = appendix_a_comparisons(runner.run_summary(scenario, trials=20, seed=2, chunk_size=3), scenario)
+    assert [(c.item, c.verdict, c.coverage, c.mc_U95, c.n) for c in got] == \
+        [(c.item, c.verdict, c.coverage, c.mc_U95, c.n) for c in expected]
+
+
 def test_parameter_summary_reads_a_summary_as_it_reads_the_trials(per_trial, summary):
     for a, b in zip(parameter_summary(summary), parameter_summary(per_trial)):
         assert (a["name"], a["unit"]) == (b["name"], b["unit"])
