@@ -31,11 +31,12 @@ def _check_output(path: str | None, suffixes: tuple[str, ...], option: str) -> N
 
 
 def _cmd_run(args) -> int:
-    from plansim.io.files import atomic_write
+    from plansim.io.results import write_results
     from plansim.io.scenario_file import load_scenario
     from plansim.report.progress import stderr_progress
+    from plansim.report.summary import appendix_a_comparisons
     from plansim.report.table import appendix_a_table, header, parameter_summary, parameter_table
-    from plansim.runner import run
+    from plansim.runner import run, run_summary
     from plansim.uncertainty import compare_with_appendix_a
 
     _check_output(args.out, (".nc",), "--out")
@@ -48,13 +49,19 @@ def _cmd_run(args) -> int:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
     progress = None if args.quiet else stderr_progress(f"plansim run {scenario.name}")
     start = time.perf_counter()
-    results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress,
-                  path=args.path)
-    elapsed = time.perf_counter() - start
-    comparisons = compare_with_appendix_a(results["truth"].values, results["estimate"].values, scenario) \
-        if trials >= 2 else []
-    if args.out:
-        atomic_write(args.out, lambda tmp: results.to_netcdf(tmp, engine="scipy"))
+    if args.plot:  # the histograms need every trial's error: keep the trials (run checks the memory)
+        results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress,
+                      path=args.path)
+        elapsed = time.perf_counter() - start
+        comparisons = compare_with_appendix_a(results["truth"].values, results["estimate"].values, scenario) \
+            if trials >= 2 else []
+        if args.out:
+            write_results(results, args.out)
+    else:  # only the statistics, streamed; --out streams every trial to the file
+        results = run_summary(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size,
+                              progress=progress, path=args.path, out=args.out)
+        elapsed = time.perf_counter() - start
+        comparisons = appendix_a_comparisons(results, scenario)
     if args.plot:
         if not comparisons:
             raise ValueError("--plot needs at least 2 trials")

@@ -48,7 +48,7 @@ def test_run_writes_netcdf_and_figure(capsys, tmp_path):
     code, text, _ = run_cli(capsys, "run", "ideal", "--trials", "3", "--out", str(out), "--plot", str(fig), "--quiet")
     assert code == 0
     assert "Appendix A" in text and "Kgxx" in text
-    with xr.open_dataset(out, engine="scipy") as ds:
+    with xr.open_dataset(out) as ds:
         assert ds.attrs["scenario"] == "ideal" and ds.attrs["seed"] == 1 and ds.attrs["trials"] == 3
         assert list(ds["parameter"].values[:2]) == ["Kgxx", "Kgxy"]
         assert np.all(np.isfinite(ds["error"].values))
@@ -106,7 +106,7 @@ def test_a_seed_beyond_32_bits_is_written_to_netcdf(capsys, tmp_path):
     code, _, err = run_cli(capsys, "run", "ideal", "--trials", "2", "--seed", str(2**40 + 3), "--out", str(out),
                            "--quiet")
     assert code == 0, err
-    with xr.open_dataset(out, engine="scipy") as ds:
+    with xr.open_dataset(out) as ds:
         assert int(ds.attrs["seed"]) == 2**40 + 3
 
 

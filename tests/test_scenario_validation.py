@@ -445,7 +445,7 @@ def test_the_run_of_a_copied_builtin_carries_the_files_name(tmp_path, capsys):
     assert main(["run", str(path), "--trials", "2", "--out", str(out), "--quiet"]) == 0
     text = capsys.readouterr().out
     assert "scenario 'lab'" in text and "scenario 'ideal'" not in text
-    with xr.open_dataset(out, engine="scipy") as results:
+    with xr.open_dataset(out) as results:
         assert results.attrs["scenario"] == "lab" and "'lab'" in results.attrs["title"]
 
 

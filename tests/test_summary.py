@@ -257,3 +257,25 @@ def test_a_per_trial_dataset_is_written_in_the_same_layout(tmp_path, per_trial, 
         assert "segment_mean" not in b and "segment" not in b.coords
         a.attrs.pop("created_utc"), b.attrs.pop("created_utc")
         xr.testing.assert_identical(a, b)
+
+
+# ----------------------------------------------------------------------------- plansim run
+
+def test_plansim_run_keeps_no_trial_without_plot(capsys, monkeypatch, tmp_path):
+    """`plansim run` (and `--out`) go through the summary: plansim.run, which keeps every trial, is not called."""
+    from plansim.cli import main
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("plansim run kept every trial")
+
+    monkeypatch.setattr(runner, "run", refuse)
+    out = tmp_path / "r.nc"
+    assert main(["run", "jjf2003", "--trials", "300", "--seed", "5", "--quiet", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "Kgxx" in text and "A.5" in text and "wrote results" in text
+    assert out.read_bytes()[:8] == b"\x89HDF\r\n\x1a\n"  # NetCDF-4, streamed
+    monkeypatch.undo()
+    expected = plansim.run("jjf2003", trials=300, seed=5)
+    with xr.open_dataset(out) as ds:
+        for name in ("truth", "estimate", "error"):
+            assert np.array_equal(ds[name].values, expected[name].values), name
