@@ -58,8 +58,10 @@ KINDS: dict[str, dict[str, float]] = {
     "per_rate": {"1/(rad/s)": 1.0, "1/(deg/s)": 1.0 / DEG, "ppm/(deg/s)": 1e-6 / DEG},
     "per_rate_squared": {"1/(rad/s)^2": 1.0, "1/(deg/s)^2": 1.0 / DEG**2, "ppm/(deg/s)^2": 1e-6 / DEG**2},
     # IEEE Std 952 Allan-variance coefficients
-    "angle_random_walk": {"rad/sqrt(s)": 1.0, "deg/sqrt(h)": DEG / 60.0, "deg/s/sqrt(Hz)": DEG, "deg/h/sqrt(Hz)": DEG / HOUR},
-    "velocity_random_walk": {"m/s/sqrt(s)": 1.0, "m/s/sqrt(h)": 1.0 / 60.0, "ug/sqrt(Hz)": MICRO_G, "m/s^2/sqrt(Hz)": 1.0},
+    "angle_random_walk": {"rad/sqrt(s)": 1.0, "deg/sqrt(h)": DEG / 60.0, "deg/s/sqrt(Hz)": DEG,
+                          "deg/h/sqrt(Hz)": DEG / HOUR},
+    "velocity_random_walk": {"m/s/sqrt(s)": 1.0, "m/s/sqrt(h)": 1.0 / 60.0, "ug/sqrt(Hz)": MICRO_G,
+                             "m/s^2/sqrt(Hz)": 1.0},
     "rate_random_walk": {"rad/s/sqrt(s)": 1.0, "deg/h/sqrt(h)": DEG / HOUR / 60.0, "deg/s/sqrt(s)": DEG},
     "acceleration_random_walk": {"m/s^2/sqrt(s)": 1.0, "ug/sqrt(s)": MICRO_G, "m/s/sqrt(h)/h": 1.0 / 60.0 / HOUR},
     "per_temperature": {"1/degC": 1.0, "ppm/degC": 1e-6},

@@ -30,7 +30,8 @@ def _kernels():
             out[i] = values[i] + offset
 
     values, out = np.arange(3.0), np.empty(3)
-    return [compilation.bound_call(scale, values, 2.0, out=out), compilation.bound_call(shift, values, offset=1, out=out)]
+    return [compilation.bound_call(scale, values, 2.0, out=out),
+            compilation.bound_call(shift, values, offset=1, out=out)]
 
 
 def test_bound_call_puts_keyword_arguments_in_place():

@@ -15,11 +15,19 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plansim.estimate.jjf2003 import (DESIGN_MATRIX_A, check_design, line_fit, multi_position_design,
-                                      multi_position_fit, rate_sensitivity, reduce, reduction_matrix,
-                                      segment_mean)
-from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, pack, unpack
 from plansim.config import parse_scenario
+from plansim.estimate.jjf2003 import (
+    DESIGN_MATRIX_A,
+    check_design,
+    line_fit,
+    multi_position_design,
+    multi_position_fit,
+    rate_sensitivity,
+    reduce,
+    reduction_matrix,
+    segment_mean,
+)
+from plansim.model.parameters import N_PARAMETERS, PARAMETER_NAMES, pack, unpack
 from plansim.schedule import axis_vector, jjf2003
 from plansim.units import DEG, STANDARD_GRAVITY
 

@@ -26,15 +26,20 @@ import pytest
 from scipy import stats
 
 import plansim
-from plansim.model.parameters import PARAMETER_NAMES
-from plansim.io.scenario_file import builtin_scenarios
 from plansim.config import parse_scenario
-from plansim.simulate.paths import choose_path
-from plansim.simulate.chunks import simulate_segment_means
+from plansim.io.scenario_file import builtin_scenarios
 from plansim.kernels.drift import drift_coefficients
-from plansim.kernels.quantiser import (fourier_damping, fourier_terms_needed, moments_from_damping,
-                                       quantised_gaussian_moments, sin_cos_turns)
+from plansim.kernels.quantiser import (
+    fourier_damping,
+    fourier_terms_needed,
+    moments_from_damping,
+    quantised_gaussian_moments,
+    sin_cos_turns,
+)
 from plansim.kernels.segment_path import arc_weights
+from plansim.model.parameters import PARAMETER_NAMES
+from plansim.simulate.chunks import simulate_segment_means
+from plansim.simulate.paths import choose_path
 
 Z = 5.0  # standard errors allowed; two-sided p ≈ 6e-7 per comparison (39 parameters × 3 scenarios)
 
@@ -142,7 +147,8 @@ def test_a_noiseless_quantiser_on_a_turning_table_takes_the_sample_path():
     assert path == "sample"
     assert any("gx is quantised without white noise" in r for r in reasons), reasons
     assert any("ax is quantised without white noise" in r for r in reasons), reasons  # the ω² test turns too
-    doc["mimu"]["noise"] = {"gyro_angle_random_walk": "0.15 deg/sqrt(h)", "accel_velocity_random_walk": "0.012 m/s/sqrt(h)"}
+    doc["mimu"]["noise"] = {"gyro_angle_random_walk": "0.15 deg/sqrt(h)",
+                            "accel_velocity_random_walk": "0.012 m/s/sqrt(h)"}
     assert choose_path(parse_scenario(doc)) == ("segment", [])
 
 
@@ -165,7 +171,7 @@ def test_arc_weights_average_trigonometric_polynomials_exactly(J, delta, n):
     arc_weights(J, delta, n, w)
     for m in range((J - 1) // 2 + 1):
         theta0 = rng.uniform(0, 2 * math.pi)
-        def f(th):
+        def f(th, m=m):
             return np.cos(m * th) + 0.3 * np.sin(m * th)
         exact = f(theta0 + np.arange(n) * delta).mean()
         assert abs(exact - np.sum(w * f(theta0 + 2 * math.pi * np.arange(J) / J))) < 1e-11

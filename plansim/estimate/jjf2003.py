@@ -114,9 +114,10 @@ def multi_position_design(schedule: Schedule) -> tuple[list[int], list[list[int]
 def check_design(schedule: Schedule) -> None:
     """Raise ``ValueError`` if the schedule cannot give every JJF 2003 parameter."""
     groups, _, design = multi_position_design(schedule)
-    if design.shape[1] == 0 or np.linalg.matrix_rank(design) < 4:
+    rank = int(np.linalg.matrix_rank(design)) if design.size else 0
+    if design.shape[1] == 0 or rank < 4:
         raise ValueError(
-            f"schedule: the multi-position groups {groups} give a rank-{np.linalg.matrix_rank(design) if design.size else 0} "
+            f"schedule: the multi-position groups {groups} give a rank-{rank} "
             "design matrix A; eq. (7) needs rank 4 (each axis up and down, e.g. the 6 or 12 positions of Appendix C)")
     for axis in range(3):
         rates = {schedule.segments[k].rate for k in schedule.select("rate") if schedule.segments[k].group == axis}

@@ -14,8 +14,14 @@ import math
 
 import numpy as np
 
-from plansim.kernels.layout import (NOISE_BIAS_INSTABILITY, NOISE_MARKOV, NOISE_RANDOM_WALK, STREAM_NOISE,
-                                    TIME_BIAS_INSTABILITY, TIME_MARKOV)
+from plansim.kernels.layout import (
+    NOISE_BIAS_INSTABILITY,
+    NOISE_MARKOV,
+    NOISE_RANDOM_WALK,
+    STREAM_NOISE,
+    TIME_BIAS_INSTABILITY,
+    TIME_MARKOV,
+)
 from plansim.kernels.options import inline_jit, jit
 from plansim.kernels.random import normal, seed_stream
 
@@ -35,9 +41,11 @@ def drift_transition(interval, noise, noise_times, transitions, k):
     root = math.sqrt(max(interval, 0.0))
     for c in range(6):
         transitions[k, 0, 0, c] = phi_bi
-        transitions[k, 1, 0, c] = noise[c, NOISE_BIAS_INSTABILITY] * math.sqrt(1.0 - phi_bi * phi_bi) if noise[c, NOISE_BIAS_INSTABILITY] > 0.0 else 0.0
+        sigma_bi = noise[c, NOISE_BIAS_INSTABILITY]
+        transitions[k, 1, 0, c] = sigma_bi * math.sqrt(1.0 - phi_bi * phi_bi) if sigma_bi > 0.0 else 0.0
         transitions[k, 0, 1, c] = phi_mk
-        transitions[k, 1, 1, c] = noise[c, NOISE_MARKOV] * math.sqrt(1.0 - phi_mk * phi_mk) if noise[c, NOISE_MARKOV] > 0.0 else 0.0
+        sigma_mk = noise[c, NOISE_MARKOV]
+        transitions[k, 1, 1, c] = sigma_mk * math.sqrt(1.0 - phi_mk * phi_mk) if sigma_mk > 0.0 else 0.0
         transitions[k, 0, 2, c] = 1.0
         transitions[k, 1, 2, c] = noise[c, NOISE_RANDOM_WALK] * root if noise[c, NOISE_RANDOM_WALK] > 0.0 else 0.0
 
@@ -88,7 +96,12 @@ def segment_drift(drift, drift_coeffs, s, noise, stream, mean_out):
     for c in range(6):
         mean_out[c] = 0.0
         for p in range(3):
-            sigma = noise[c, NOISE_BIAS_INSTABILITY] if p == 0 else (noise[c, NOISE_MARKOV] if p == 1 else noise[c, NOISE_RANDOM_WALK])
+            if p == 0:
+                sigma = noise[c, NOISE_BIAS_INSTABILITY]
+            elif p == 1:
+                sigma = noise[c, NOISE_MARKOV]
+            else:
+                sigma = noise[c, NOISE_RANDOM_WALK]
             if sigma <= 0.0:
                 continue
             z1, stream = normal(stream)

@@ -25,14 +25,26 @@ import math
 import numpy as np
 
 from plansim.kernels.drift import advance_drift, drift_transition, noise_stream
-from plansim.kernels.layout import (ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP, N_TRUTH, NOISE_WHITE,
-                                    TIME_DRIFT_UPDATE, draws_length)
+from plansim.kernels.layout import (
+    ACQ_FULL_SCALE,
+    ACQ_RANGE,
+    ACQ_STEP,
+    N_TRUTH,
+    NOISE_WHITE,
+    TIME_DRIFT_UPDATE,
+    draws_length,
+)
 from plansim.kernels.options import jit
-from plansim.kernels.physics import (draw_systematic, geometry_buffers, rotated_inputs, segment_geometry,
-                                     sensor_outputs, unpack_truth)
+from plansim.kernels.physics import (
+    draw_systematic,
+    geometry_buffers,
+    rotated_inputs,
+    segment_geometry,
+    sensor_outputs,
+    unpack_truth,
+)
 from plansim.kernels.quantiser import quantise
 from plansim.kernels.random import normal
-
 
 #: ``record`` argument of :func:`simulate_trial` from the chunk kernel: a numpy bool, not a Python
 #: literal, so that the kernel and :func:`plansim.simulate.chunks.simulate_recording` share one

@@ -50,9 +50,8 @@ import numpy as np
 
 from plansim.kernels.drift import advance_drift, drift_transition, noise_stream, segment_drift
 from plansim.kernels.layout import ACQ_STEP, N_TRUTH, NOISE_WHITE, draws_length
-from plansim.kernels.options import inline_jit, jit
-from plansim.kernels.physics import (draw_systematic, evaluate_outputs, geometry_buffers, segment_geometry,
-                                     unpack_truth)
+from plansim.kernels.options import jit
+from plansim.kernels.physics import draw_systematic, evaluate_outputs, geometry_buffers, segment_geometry, unpack_truth
 from plansim.kernels.quantiser import channel_moments, fourier_damping, fourier_terms_needed
 from plansim.kernels.random import normal
 

@@ -52,7 +52,7 @@ def rate_test(rates, axes: str = "xyz", dwell: float = 30.0, settle: float = 10.
     for axis in axes:
         if axis not in "xyz":
             raise ValueError(f"rate_test(axes={axes!r}): each axis must be one of x, y, z")
-        for k, r in enumerate(rates):
+        for r in rates:
             out.append(Segment(label=f"rate {axis} {math.degrees(r):+.6g} deg/s", test="rate", group="xyz".index(axis),
                                up=f"+{axis}", rate=r, rate_axis=f"+{axis}",
                                **_common(dwell, settle, sample_rate, temperature)))

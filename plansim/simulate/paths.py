@@ -38,7 +38,8 @@ def output_bound(scenario: Scenario) -> np.ndarray:
     f = g + r * r * np.linalg.norm(e.accel_lever_arm, axis=1).max()
     kg_diag = np.diag(m["Kg"])
     gyro = (m["Kg"].sum(1) * r + m["Bg"] + np.abs(e.gyro_bias_temperature_coefficient) * dT + m["G"].sum(1) * f
-            + np.abs(e.gyro_g2_sensitivity).sum(1) * f * f + kg_diag * np.abs(e.gyro_scale_temperature_coefficient) * dT * r
+            + np.abs(e.gyro_g2_sensitivity).sum(1) * f * f
+            + kg_diag * np.abs(e.gyro_scale_temperature_coefficient) * dT * r
             + np.abs(e.gyro_nonlinearity_quadratic) * r**2 + np.abs(e.gyro_nonlinearity_cubic) * r**3
             + 0.5 * np.abs(e.gyro_asymmetry) * kg_diag * r)
     ka_diag = np.diag(m["Ka"])
