@@ -341,6 +341,7 @@ def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed:
         "title": f"plansim Monte Carlo of scenario {sc.name!r}",
         "scenario": sc.name,
         "scenario_description": sc.description,
+        "scenario_source": sc.source or "a Scenario object built in Python",
         "scenario_toml": tomli_w.dumps(sc.document),
         # NetCDF-3 attributes hold 32-bit integers only: larger seeds are kept as text
         "seed": int(seed) if int(seed) <= 2**31 - 1 else str(int(seed)),

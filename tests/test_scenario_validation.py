@@ -447,6 +447,8 @@ def test_the_run_of_a_copied_builtin_carries_the_files_name(tmp_path, capsys):
     assert "scenario 'lab'" in text and "scenario 'ideal'" not in text
     with xr.open_dataset(out) as results:
         assert results.attrs["scenario"] == "lab" and "'lab'" in results.attrs["title"]
+        # where the scenario came from travels with the results (Scenario.source)
+        assert "lab.toml" in results.attrs["scenario_source"] and "ideal" in results.attrs["scenario_source"]
 
 
 # ----------------------------------------------------------------------------- repeated rate points
