@@ -1,33 +1,87 @@
-"""Command line: ``plansim run``, ``plansim scenarios``, ``plansim record``.
+"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``bench``.
 
-Errors in the user's input end with ``plansim: error: …`` and exit status 2, before anything is
-written; output files are written whole or not at all.
+Errors in the user's input end with ``plansim: error: …`` and exit status 2, before any work starts:
+output paths are checked first (:func:`plansim.io.files.check_output_path`). The output files of one
+command are written to temporary files beside their targets and renamed onto them together at the end,
+or not at all (:class:`plansim.io.files.OutputSet`).
+
+Ctrl-C (SIGINT) and SIGTERM end a command with one line on stderr (``plansim: interrupted``,
+``plansim: terminated``) and the exit status 128 + the signal's number (130, 143), after removing its
+temporary files and any compile process. When the reader of the standard output goes away
+(``plansim run | head``), the command ends quietly with the exit status 141 (128 + SIGPIPE), as the
+standard tools killed by SIGPIPE do.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
+import signal
 import sys
+import threading
 import time
-from pathlib import Path
 
+import plansim
+from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
+from plansim.report.progress import end_progress_line
+
+#: exit statuses (besides 0 and 1): bad input, then 128 + the signal's number
+EXIT_BAD_INPUT = 2
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+#: the signals that end a command cleanly, and the word it says
+SIGNAL_WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
 
 
-def _check_output(path: str | None, suffixes: tuple[str, ...], option: str) -> None:
-    """Fail before the (long) run if an output could not be written."""
-    if path is None:
+class Interrupted(KeyboardInterrupt):
+    """Raised in the main thread when SIGINT or SIGTERM arrives, so that every ``finally`` and ``except
+    BaseException`` on the way out runs (temporary files removed, a compile process killed).
+
+    A subclass of KeyboardInterrupt: code that lets Ctrl-C through lets SIGTERM through too.
+    """
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+
+def _raise_interrupted(signum, frame):
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def signals_as_exceptions():
+    """While a command runs, SIGINT and SIGTERM raise :class:`Interrupted` in the main thread.
+
+    A signal the caller ignores (``nohup``, a background job without job control) stays ignored; the
+    previous handlers are restored at the end. Outside the main thread nothing changes (Python runs
+    signal handlers there only).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
         return
-    p = Path(path)
-    if p.suffix.lower() not in suffixes:
-        raise ValueError(f"{option} {path!r}: the file name must end in {' or '.join(suffixes)}")
-    folder = p.parent if str(p.parent) else Path(".")
-    if not folder.is_dir():
-        raise ValueError(f"{option} {path!r}: the folder {str(folder)!r} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise ValueError(f"{option} {path!r}: the folder {str(folder)!r} is not writable")
+    previous = {}
+    try:
+        for signum in SIGNAL_WORDS:
+            if signal.getsignal(signum) is not signal.SIG_IGN:
+                previous[signum] = signal.signal(signum, _raise_interrupted)
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _silence_stdout() -> None:
+    """The reader of stdout is gone: send what is still buffered, and anything later, to /dev/null (so the
+    interpreter's last flush at exit does not fail again)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout without a file descriptor (captured, say)
+        pass
 
 
 def _cmd_run(args) -> int:
@@ -39,35 +93,44 @@ def _cmd_run(args) -> int:
     from plansim.runner import run, run_summary
     from plansim.uncertainty import compare_with_appendix_a
 
-    _check_output(args.out, (".nc",), "--out")
-    _check_output(args.plot, FIGURE_SUFFIXES, "--plot")
+    # every check before any work: the outputs, the scenario, the numbers
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".nc",))
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
     scenario = load_scenario(args.scenario)
     trials = scenario.trials if args.trials is None else args.trials
     if trials < 1:
         raise ValueError(f"--trials {trials}: must be >= 1")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
-    progress = None if args.quiet else stderr_progress(f"plansim run {scenario.name}")
-    start = time.perf_counter()
-    if args.plot:  # the histograms need every trial's error: keep the trials (run checks the memory)
-        results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress,
-                      path=args.path)
-        elapsed = time.perf_counter() - start
-        comparisons = compare_with_appendix_a(results["truth"].values, results["estimate"].values, scenario) \
-            if trials >= 2 else []
-        if args.out:
-            write_results(results, args.out)
-    else:  # only the statistics, streamed; --out streams every trial to the file
-        results = run_summary(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size,
-                              progress=progress, path=args.path, out=args.out)
-        elapsed = time.perf_counter() - start
-        comparisons = appendix_a_comparisons(results, scenario)
-    if args.plot:
-        if not comparisons:
-            raise ValueError("--plot needs at least 2 trials")
-        from plansim.report.plot import appendix_a_histograms
+    if args.plot is not None and trials < 2:
+        raise ValueError(f"--plot {args.plot!r}: the error histograms need at least 2 trials (trials = {trials})")
 
-        appendix_a_histograms(results, scenario, comparisons, args.plot)
+    # the outputs are staged beside their targets and committed together at the end, or not at all
+    with OutputSet() as outputs:
+        out = outputs.stage(args.out, "--out", (".nc",)) if args.out is not None else None
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        progress = None if args.quiet else stderr_progress(f"plansim run {scenario.name}")
+        start = time.perf_counter()
+        if plot is not None:  # the histograms need every trial's error: keep the trials (run checks the memory)
+            results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress,
+                          path=args.path)
+            elapsed = time.perf_counter() - start
+            comparisons = compare_with_appendix_a(results["truth"].values, results["estimate"].values, scenario)
+            if out is not None:
+                write_results(results, out)
+            from plansim.report.plot import appendix_a_histograms
+
+            appendix_a_histograms(results, scenario, comparisons, plot,
+                                  format=os.path.splitext(args.plot)[1].lstrip("."))
+        else:  # only the statistics, streamed; --out streams every trial to the file
+            results = run_summary(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size,
+                                  progress=progress, path=args.path, out=out)
+            elapsed = time.perf_counter() - start
+            comparisons = appendix_a_comparisons(results, scenario)
+        outputs.commit()
+
     if args.json:
         print(json.dumps({
             "scenario": scenario.name, "seed": results.attrs["seed"], "trials": trials,
@@ -94,19 +157,25 @@ def _cmd_scenarios(args) -> int:
 
     from plansim.io.scenario_file import builtin_scenarios
 
+    descriptions = {}
     for name, path in builtin_scenarios().items():
         with open(path, "rb") as fh:
-            description = tomllib.load(fh).get("description", "")
-        print(f"{name:14s} {description}")
+            descriptions[name] = tomllib.load(fh).get("description", "")
+    width = max(map(len, descriptions), default=0)
+    for name, description in descriptions.items():
+        print(f"{name:{width}s}  {description}".rstrip())
     return 0
 
 
 def _cmd_record(args) -> int:
     from plansim.io.recording import write_recording
+    from plansim.io.recording_csv import segment_table_path
     from plansim.io.scenario_file import load_scenario
     from plansim.runner import simulate_and_record
 
-    _check_output(args.out, (".nc", ".csv"), "--out")
+    target = check_output_path(args.out, "--out", (".nc", ".csv"))
+    if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
+        check_output_path(segment_table_path(target), "--out's segment table")
     scenario = load_scenario(args.scenario)
     seed = scenario.seed if args.seed is None else args.seed
     rec = simulate_and_record(scenario, seed=seed, trial=args.trial)
@@ -119,6 +188,7 @@ def _cmd_record(args) -> int:
 def _cmd_validate(args) -> int:
     from plansim.io.claims import load_claims
     from plansim.io.scenario_file import load_scenario
+    from plansim.report.progress import mark_progress_line
     from plansim.report.validation import format_report, stderr_block_progress, validation_json
     from plansim.runner import validate
 
@@ -130,11 +200,17 @@ def _cmd_validate(args) -> int:
             raise ValueError(f"{option} {value}: must be >= {minimum}")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
-    progress = None if (args.quiet or args.json) else stderr_block_progress(f"plansim validate {scenario.name}")
+    progress = None
+    if not (args.quiet or args.json):
+        block_progress = stderr_block_progress(f"plansim validate {scenario.name}")
+
+        def progress(*state) -> None:  # the block progress line is open until the report starts
+            block_progress(*state)
+            mark_progress_line(True)
+
     report = validate(scenario, claims, digits=args.digits, trials_per_block=args.trials_per_block,
                       max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
-    if progress is not None:
-        sys.stderr.write("\n")
+    end_progress_line()
     if args.json:
         print(json.dumps(validation_json(report), indent=2))
     else:
@@ -147,8 +223,9 @@ def _add_validate_command(sub) -> None:
     from plansim.uncertainty.validation import DEFAULT_MAX_TRIALS
 
     p = sub.add_parser(
-        "validate", help="GUM budget from the schedule, validated by adaptive Monte Carlo (JCGM 101/102); "
-                         "checks a claimed budget (default: JJF 2003 Appendix A)")
+        "validate", help="GUM budgets validated by adaptive Monte Carlo",
+        description="GUM budget from the schedule, validated by adaptive Monte Carlo (JCGM 101/102); "
+                    "checks a claimed budget (default: JJF 2003 Appendix A)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
     p.add_argument("--claims", default=None,
@@ -182,14 +259,42 @@ def _cmd_bench(args) -> int:
     return bench_main(json_output=args.json, quick=args.quick)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="plansim", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+#: one line per command in ``plansim --help`` (at most 52 characters: one line in an 80-column terminal)
+COMMANDS = {
+    "run": "Monte Carlo of a calibration vs JJF 2003 Appendix A",
+    "validate": "GUM budgets validated by adaptive Monte Carlo",
+    "scenarios": "list the built-in scenarios",
+    "record": "write one simulated trial's raw samples",
+    "bench": "measure speed and memory on this machine",
+}
 
-    p = sub.add_parser("run", help="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A")
+EPILOG = """exit status: 0 done; 1 failed; 2 bad input (plansim: error: ...); 130 interrupted (Ctrl-C);
+143 terminated (SIGTERM); 141 the reader of the output went away (plansim run | head).
+'plansim COMMAND --help' describes a command's options."""
+
+
+class _TopLevelHelp(argparse.RawDescriptionHelpFormatter):
+    """``plansim --help``: the commands' help in one column wide enough for the longest command name."""
+
+    def __init__(self, prog: str) -> None:
+        super().__init__(prog)
+        # argparse measures the commands with the indent of the group, not their own (two more columns)
+        self._action_max_length = 4 + max(map(len, COMMANDS))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="plansim", formatter_class=_TopLevelHelp, epilog=EPILOG,
+        description="Monte Carlo calibration planning for MEMS IMUs under JJF 2003-2022.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {plansim.__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, title="commands", metavar="COMMAND")
+
+    p = sub.add_parser("run", help=COMMANDS["run"],
+                       description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
-    p.add_argument("--trials", type=int, default=None, help="number of simulated calibrations (default: the scenario's)")
+    p.add_argument("--trials", type=int, default=None,
+                   help="number of simulated calibrations (default: the scenario's)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's)")
     p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
     p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg)")
@@ -201,35 +306,52 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
     p.set_defaults(func=_cmd_run)
 
-    p = sub.add_parser("scenarios", help="list the built-in scenarios")
+    _add_validate_command(sub)
+
+    p = sub.add_parser("scenarios", help=COMMANDS["scenarios"], description="List the built-in scenarios "
+                       "(the folder scenarios/, installed as plansim.scenarios) with their descriptions.")
     p.set_defaults(func=_cmd_scenarios)
 
-    p = sub.add_parser("record", help="write one simulated trial's raw samples as a recording (NetCDF or CSV)")
+    p = sub.add_parser("record", help=COMMANDS["record"],
+                       description="Write one simulated trial's raw samples as a recording (NetCDF or CSV)")
     p.add_argument("scenario", nargs="?", default="jjf2003")
     p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
     p.add_argument("--seed", type=int, default=None)
     p.add_argument("--trial", type=int, default=0, help="which trial of the seed's Monte Carlo to record")
     p.set_defaults(func=_cmd_record)
 
-    p = sub.add_parser("bench", help="measure speed and memory on this machine (takes a few minutes)")
+    p = sub.add_parser("bench", help=COMMANDS["bench"],
+                       description="Measure speed and memory on this machine (takes a few minutes)")
     p.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     p.add_argument("--quick", action="store_true", help="small sizes (seconds): checks the method, not the speed")
     p.add_argument("--threads", type=int, default=None, help="pin the kernel thread count (default: all cores)")
     p.set_defaults(func=_cmd_bench)
-    _add_validate_command(sub)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command of *argv* (default: ``sys.argv[1:]``); return its exit status (see :data:`EPILOG`)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if getattr(args, "chunk_size", 1) < 1:
         parser.error(f"--chunk-size {args.chunk_size}: must be >= 1")
     try:
-        return args.func(args)
+        with signals_as_exceptions():
+            code = args.func(args)
+            sys.stdout.flush()  # a reader gone away is found here, not in the interpreter's last flush
+        return code
     except (ValueError, TypeError, FileNotFoundError) as exc:
+        end_progress_line()
         print(f"plansim: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM as Interrupted
+        signum = getattr(exc, "signum", signal.SIGINT)
+        end_progress_line()
+        print(f"plansim: {SIGNAL_WORDS[signum]}", file=sys.stderr)
+        return 128 + signum
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
 
 
 if __name__ == "__main__":

@@ -12,8 +12,39 @@ from plansim.uncertainty.appendix_a import APPENDIX_A, errors_in_reading_units
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
 
 
-def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLike) -> None:
-    """Histogram of |error| of each Appendix A quantity (in its reading, log axis) with the claimed U and the MC 95 % point."""
+def figure_format(path: str | os.PathLike, format: str | None = None) -> str:
+    """The figure format of *path* (``"png"``, ``"pdf"`` or ``"svg"``): *format* if given, else its suffix.
+
+    Raises
+    ------
+    ValueError
+        The format (or the suffix) is not one of :data:`FIGURE_SUFFIXES`.
+    """
+    chosen = (format if format is not None else os.path.splitext(os.fspath(path))[1]).lower().lstrip(".")
+    if f".{chosen}" not in FIGURE_SUFFIXES:
+        given = f"format = {format!r}" if format is not None else f"figure {os.fspath(path)!r}"
+        raise ValueError(f"{given}: the figure format must be one of {', '.join(s[1:] for s in FIGURE_SUFFIXES)}")
+    return chosen
+
+
+def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLike, format: str | None = None) -> None:
+    """Histogram of |error| of each Appendix A quantity (in its reading, log axis), the claimed U and the MC 95 % point.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        A run's per-trial results (:func:`plansim.runner.run`), at least 2 trials.
+    scenario : plansim.config.Scenario
+        The run's scenario (the readings of A.2, A.3 and A.5 depend on its ranges).
+    comparisons : list of plansim.uncertainty.ItemComparison
+        The Appendix A comparison of the same results.
+    path : str or os.PathLike
+        The figure file, written whole or not at all (:func:`plansim.io.files.atomic_write`).
+    format : {"png", "pdf", "svg"}, optional
+        Default: from the suffix of *path*; give it when *path* is a temporary file
+        (:class:`plansim.io.files.OutputSet`).
+    """
+    chosen = figure_format(path, format)
     import matplotlib
 
     matplotlib.use("Agg")
@@ -43,6 +74,7 @@ def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLik
     np.atleast_1d(axes)[0].legend(fontsize=7, loc="upper left")
     fig.suptitle(f"plansim: {results.attrs['scenario']} — {results.attrs['trials']} trials, seed "
                  f"{results.attrs['seed']}: JJF 2003 Appendix A claims vs Monte Carlo", fontsize=10)
-    suffix = os.path.splitext(str(path))[1].lower()
-    atomic_write(path, lambda tmp: fig.savefig(tmp, format=suffix[1:], dpi=120))
-    plt.close(fig)
+    try:
+        atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=120))
+    finally:
+        plt.close(fig)

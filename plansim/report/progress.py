@@ -1,4 +1,9 @@
-"""Progress lines on stderr for long runs."""
+"""Progress lines on stderr for long runs.
+
+A progress line is redrawn in place (``\\r``) and ends with a line break only when the work is done.
+Whatever else is written to stderr while one is open (an error, ``plansim: interrupted``) must start on
+a new line: :func:`end_progress_line` writes the line break if a progress line is open.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +12,29 @@ import time
 from collections.abc import Callable
 
 ProgressCallback = Callable[[int, int], None]
+
+_line_open = False
+
+
+def mark_progress_line(open_: bool = True) -> None:
+    """Record that a progress line without its line break is (``True``) or is no longer (``False``) on stderr.
+
+    For progress lines drawn elsewhere (``plansim validate``'s block progress)."""
+    global _line_open
+    _line_open = bool(open_)
+
+
+def progress_line_open() -> bool:
+    """True while a progress line without its line break is on stderr."""
+    return _line_open
+
+
+def end_progress_line() -> None:
+    """End an open progress line with its line break (nothing if none is open)."""
+    if _line_open:
+        sys.stderr.write("\n")
+        sys.stderr.flush()
+        mark_progress_line(False)
 
 
 def stderr_progress(label: str = "simulating") -> ProgressCallback:
@@ -20,5 +48,6 @@ def stderr_progress(label: str = "simulating") -> ProgressCallback:
         end = "\n" if done >= total else ""
         sys.stderr.write(f"\r{label}: {done}/{total} trials ({rate:,.0f}/s, {left:4.0f} s left)   {end}")
         sys.stderr.flush()
+        mark_progress_line(done < total)
 
     return report

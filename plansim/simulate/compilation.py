@@ -17,6 +17,9 @@ seconds each — so :func:`compile_kernels` shortens the cold start in two ways:
 If the second process cannot start, fails or hangs (:data:`SECOND_PROCESS_TIMEOUT`), or the
 cache cannot be written, this process compiles the kernel itself (with a :class:`RuntimeWarning`
 in the first three cases): the run goes on either way.
+If this process is interrupted (``KeyboardInterrupt``, or the command line's SIGTERM) or fails
+while compiling or waiting, the second process is killed and reaped before the exception goes on:
+no compile process outlives the run.
 
 Whether a kernel is already cached is asked of numba's cache with the lookup
 ``Dispatcher.compile`` itself makes first (``dispatcher._cache.load_overload``). It is not a
@@ -103,17 +106,24 @@ def compile_kernels(calls: list[tuple[object, tuple]], parallel: bool = COMPILE_
             warnings.warn(f"could not start a second process to compile ({error}); compiling here",
                           RuntimeWarning, stacklevel=2)
             offloaded, pending = [], offloaded + pending
-    with collector_paused():
-        for dispatcher, types in pending:
-            dispatcher.compile(types)
-    if child is None:
-        return
     try:
-        _, errors = child.communicate(timeout=SECOND_PROCESS_TIMEOUT)
-    except subprocess.TimeoutExpired:
-        child.kill()
-        _, errors = child.communicate()
-        errors += f"(no answer after {SECOND_PROCESS_TIMEOUT} s)".encode()
+        with collector_paused():
+            for dispatcher, types in pending:
+                dispatcher.compile(types)
+        if child is None:
+            return
+        try:
+            _, errors = child.communicate(timeout=SECOND_PROCESS_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            _, errors = child.communicate()
+            errors += f"(no answer after {SECOND_PROCESS_TIMEOUT} s)".encode()
+    except BaseException:  # interrupted (Ctrl-C, SIGTERM) or failed here: the second process ends with this one
+        if child is not None:
+            child.kill()
+            child.wait()
+            child.stderr.close()
+        raise
     if child.returncode != 0:
         warnings.warn(f"the second process compiling {offloaded[0][0].__name__} failed (exit {child.returncode}); "
                       f"compiling it here instead:\n{errors.decode(errors='replace')[-2000:]}", RuntimeWarning,
