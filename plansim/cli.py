@@ -91,6 +91,7 @@ def _cmd_run(args) -> int:
     from plansim.report.summary import appendix_a_comparisons
     from plansim.report.table import appendix_a_table, header, parameter_summary, parameter_table
     from plansim.runner import run, run_summary
+    from plansim.config import saturation_report
     from plansim.uncertainty import compare_with_appendix_a
 
     # every check before any work: the outputs, the scenario, the numbers
@@ -99,6 +100,7 @@ def _cmd_run(args) -> int:
     if args.plot is not None:
         check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
     scenario = load_scenario(args.scenario)
+    saturation = saturation_report(scenario)  # empty unless acquisition.allow_saturation let it load
     trials = scenario.trials if args.trials is None else args.trials
     if trials < 1:
         raise ValueError(f"--trials {trials}: must be >= 1")
@@ -138,10 +140,16 @@ def _cmd_run(args) -> int:
             "parameters": [{k: r[k] for k in ("name", "unit", "mean_error", "std_error")}
                            for r in parameter_summary(results)],
             "appendix_a": [c.as_dict() for c in comparisons],
+            "saturation": saturation,
         }, indent=2))
     else:
         print(header(results, elapsed))
         print()
+        if saturation:
+            print("Saturation (acquisition.allow_saturation = true): these outputs clip, and the estimates that "
+                  "use them are biased")
+            print("\n".join(f"  {line}" for line in saturation))
+            print()
         print(parameter_table(results))
         if comparisons:
             print()
