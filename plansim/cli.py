@@ -85,13 +85,13 @@ def _silence_stdout() -> None:
 
 
 def _cmd_run(args) -> int:
+    from plansim.config import saturation_report
     from plansim.io.results import write_results
     from plansim.io.scenario_file import load_scenario
     from plansim.report.progress import stderr_progress
     from plansim.report.summary import appendix_a_comparisons
     from plansim.report.table import appendix_a_table, header, parameter_summary, parameter_table
     from plansim.runner import run, run_summary
-    from plansim.config import saturation_report
     from plansim.uncertainty import compare_with_appendix_a
 
     # every check before any work: the outputs, the scenario, the numbers
