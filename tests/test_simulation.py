@@ -207,3 +207,30 @@ def test_a_trial_gives_the_same_bits_whatever_the_number_of_trials():
 def test_run_rejects_a_bad_trial_count_naming_it(trials, exception):
     with pytest.raises(exception, match=r"trials = "):
         plansim.run("ideal", trials=trials, seed=1)
+
+
+def test_a_run_closed_early_waits_for_one_slice_per_thread_not_a_chunk(monkeypatch):
+    """Ctrl-C (or any early close of the chunk generator) cancels the queued slices of the next chunk and
+    waits only for those already running: at most SLICE_TRIALS trials per thread, not a whole chunk
+    (13.9 s of the sample path on the default scenario before chunks were sliced)."""
+    import time
+
+    from plansim.io.scenario_file import load_scenario
+    from plansim.simulate import chunks
+
+    simulated = []
+
+    def slow_slice(self, first, key, means, truth):
+        time.sleep(0.01)
+        means[...] = 0.0
+        truth[...] = 0.0
+        simulated.append(means.shape[0])
+
+    monkeypatch.setattr(chunks._PathKernels, "run_slice", slow_slice)
+    monkeypatch.setattr(chunks, "compile_kernels", lambda calls: None)
+    generator = chunks.iterate_chunks(load_scenario("ideal"), 3 * 4096, seed=1, chunk_size=4096,
+                                      path="segment")
+    next(generator)  # the first chunk is done and the second one queued
+    generator.close()
+    after_first = sum(simulated) - 4096
+    assert 0 <= after_first <= 2 * numba.get_num_threads() * chunks.SLICE_TRIALS < 4096

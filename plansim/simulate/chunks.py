@@ -101,6 +101,12 @@ class _PathKernels:
                            **self.statistics_args, means_out=means)]
 
 
+#: the most trials one job of the thread pool simulates: a chunk is cut into slices of at most this many,
+#: so that an interrupted run stops after one slice per thread (≈ 1.7 s of the sample path on the default
+#: scenario) rather than a whole chunk; a job of the segment path still lasts milliseconds
+SLICE_TRIALS = 256
+
+
 def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int = 4096, path: str = "sample",
                    progress: ProgressCallback | None = None):
     """Yield ``(start, stop, means, truth)`` chunk by chunk; a chunk's buffers are valid until the next
@@ -125,26 +131,33 @@ def iterate_chunks(scenario: Scenario, trials: int, seed: int, chunk_size: int =
         start = starts[index]
         count = min(trials, start + chunk_size) - start
         means, truth = buffers[index % 2]
-        # contiguous slices, one per thread; each trial's numbers depend on its index only
-        edges = np.linspace(0, count, min(workers, count) + 1).astype(int)
+        # contiguous slices, at least one per thread and at most SLICE_TRIALS trials each (so that an
+        # interrupted run waits for one short slice per thread, not a whole chunk); each trial's numbers
+        # depend on its index only, never on the slicing
+        slices = max(min(workers, count), -(-count // SLICE_TRIALS))
+        edges = np.linspace(0, count, slices + 1).astype(int)
         return [pool.submit(kernels.run_slice, start + int(a), key, means[a:b], truth[a:b])
                 for a, b in zip(edges[:-1], edges[1:])]
 
     # the kernel threads use every core: a multithreaded BLAS (numpy's, in the caller's reduction between
     # chunks) would only compete with them, its idle threads spinning (10-30 % more CPU for the same run,
     # measured). The limit is process-wide and holds until the last chunk has been used.
-    with threadpool_limits(limits=1, user_api="blas"), ThreadPoolExecutor(max_workers=workers) as pool:
-        jobs = submit(pool, 0)
-        for index, start in enumerate(starts):
-            for job in jobs:
-                job.result()
-            if index + 1 < len(starts):
-                jobs = submit(pool, index + 1)  # into the other buffers, while the caller uses these
-            stop = min(trials, start + chunk_size)
-            means, truth = buffers[index % 2]
-            yield start, stop, means[: stop - start], truth[: stop - start]
-            if progress is not None:
-                progress(stop, trials)
+    pool = ThreadPoolExecutor(max_workers=workers)
+    try:
+        with threadpool_limits(limits=1, user_api="blas"):
+            jobs = submit(pool, 0)
+            for index, start in enumerate(starts):
+                for job in jobs:
+                    job.result()
+                if index + 1 < len(starts):
+                    jobs = submit(pool, index + 1)  # into the other buffers, while the caller uses these
+                stop = min(trials, start + chunk_size)
+                means, truth = buffers[index % 2]
+                yield start, stop, means[: stop - start], truth[: stop - start]
+                if progress is not None:
+                    progress(stop, trials)
+    finally:  # on Ctrl-C, an error or an early close: drop the queued slices, wait only for the running ones
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 #: trials per reduction block: results are reduced (and summarised) in fixed blocks of trials
