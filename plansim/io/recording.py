@@ -2,7 +2,8 @@
 
 A :class:`Recording` is the segment table (a :class:`~plansim.schedule.segments.Schedule`) plus every
 raw sample of the six channels ``gx, gy, gz`` (rad/s) and ``ax, ay, az`` (m/s²), concatenated
-segment by segment in schedule order, plus provenance attributes. Simulated recordings come from
+segment by segment in schedule order, plus provenance attributes (and, for measured logs, the site, the
+measured time and a temperature channel). Simulated recordings come from
 :func:`plansim.runner.simulate_and_record`; measured ones are read with :func:`read_recording`. Both go through the
 same validation, so a measured file that reads is one the rest of plansim can use.
 
@@ -24,11 +25,12 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from plansim.io.recording_columns import SEGMENT_FIELDS
+from plansim.io.recording_columns import OPTIONAL_FIELDS, SEGMENT_FIELDS
 from plansim.io.recording_csv import (
     CSV_CHANNEL_COLUMNS,
     CSV_SAMPLE_COLUMNS,
     CSV_SEGMENT_COLUMNS,
+    CSV_TEMPERATURE_COLUMN,
     SEGMENT_TABLE_SUFFIX,
     read_csv,
     segment_table_path,
@@ -40,7 +42,9 @@ from plansim.io.recording_data import (
     CHANNELS,
     FORMAT_NAME,
     FORMAT_VERSION,
+    READABLE_VERSIONS,
     RESERVED_ATTRIBUTES,
+    SITE_ATTRIBUTES,
     SOURCES,
     UNITS_DESCRIPTION,
     Recording,
@@ -48,12 +52,19 @@ from plansim.io.recording_data import (
     plansim_version,
     segment_first_samples,
 )
-from plansim.io.recording_netcdf import dataset_to_recording, read_netcdf, recording_to_dataset, write_netcdf
+from plansim.io.recording_netcdf import (
+    TEMPERATURE_VARIABLE,
+    dataset_to_recording,
+    read_netcdf,
+    recording_to_dataset,
+    write_netcdf,
+)
 
 __all__ = [
     "CHANNELS", "CHANNEL_LONG_NAMES", "CHANNEL_UNITS", "CSV_CHANNEL_COLUMNS", "CSV_SAMPLE_COLUMNS",
-    "CSV_SEGMENT_COLUMNS", "FORMAT_NAME", "FORMAT_VERSION", "RESERVED_ATTRIBUTES", "SEGMENT_FIELDS",
-    "SEGMENT_TABLE_SUFFIX", "SOURCES", "SUFFIXES", "UNITS_DESCRIPTION", "Recording", "dataset_to_recording",
+    "CSV_SEGMENT_COLUMNS", "CSV_TEMPERATURE_COLUMN", "FORMAT_NAME", "FORMAT_VERSION", "OPTIONAL_FIELDS",
+    "READABLE_VERSIONS", "RESERVED_ATTRIBUTES", "SEGMENT_FIELDS", "SEGMENT_TABLE_SUFFIX", "SITE_ATTRIBUTES",
+    "SOURCES", "SUFFIXES", "TEMPERATURE_VARIABLE", "UNITS_DESCRIPTION", "Recording", "dataset_to_recording",
     "nominal_time", "plansim_version", "read_recording", "recording_to_dataset", "segment_first_samples",
     "segment_table_path", "write_recording",
 ]

@@ -12,17 +12,17 @@ import json
 
 import numpy as np
 
-from plansim.io.recording_data import CHANNEL_UNITS, CHANNELS, FORMAT_NAME, FORMAT_VERSION, Recording, nominal_time
-from plansim.schedule.segments import Schedule, Segment
+from plansim.io.recording_data import CHANNEL_UNITS, CHANNELS, FORMAT_NAME, READABLE_VERSIONS, Recording, nominal_time
+from plansim.schedule.segments import ORIENTATIONS, TESTS, Schedule, Segment
 
 #: segment table: field -> (units or None for text, long name); the order of the NetCDF variables
 SEGMENT_FIELDS: dict[str, tuple[str | None, str]] = {
     "label": (None, "segment label"),
-    "test": (None, "JJF 2003 test that uses the segment: multi_position, rate or omega_squared"),
+    "test": (None, "what the segment is: " + ", ".join(TESTS)),
     "group": ("1", "group of the segment within its test (position group or rate-test axis)"),
     "up": (None, "body axis pointing up: +x, -x, +y, -y, +z or -z"),
-    "heading": ("rad", "heading about the vertical, counter-clockwise seen from above"),
-    "rate": ("rad/s", "table angular rate"),
+    "heading": ("rad", "heading about the vertical, counter-clockwise seen from above; NaN: not known"),
+    "rate": ("rad/s", "table angular rate; NaN: not logged"),
     "rate_axis": (None, "body axis on the table rotation axis: +x, -x, +y, -y, +z or -z"),
     "dwell": ("s", "recording time requested for the segment"),
     "settle": ("s", "settling time before recording"),
@@ -30,10 +30,16 @@ SEGMENT_FIELDS: dict[str, tuple[str | None, str]] = {
     "temperature": ("degC", "temperature during the segment"),
     "first_sample": ("1", "index along sample of the segment's first sample"),
     "samples": ("1", "number of samples recorded in the segment"),
+    "orientation": (None, "how well up and heading are known: " + ", ".join(ORIENTATIONS)),
+    "angle": ("rad", "reference angle turned about rate_axis in a rotation segment; NaN: not known"),
 }
-TEXT_FIELDS = ("label", "test", "up", "rate_axis")
+TEXT_FIELDS = ("label", "test", "up", "rate_axis", "orientation")
 INTEGER_FIELDS = ("group", "first_sample", "samples")
-FLOAT_FIELDS = ("heading", "rate", "dwell", "settle", "sample_rate", "temperature")
+FLOAT_FIELDS = ("heading", "rate", "dwell", "settle", "sample_rate", "temperature", "angle")
+#: fields that may be NaN in a file (a value not known); the Segment says where NaN is allowed
+NAN_FIELDS = ("heading", "rate", "angle")
+#: fields added in format version 2: a file without them (version 1, or a lab's table) gets these values
+OPTIONAL_FIELDS = {"orientation": "known", "angle": float("nan")}
 
 
 def schedule_notes_text(schedule: Schedule) -> str:
@@ -64,8 +70,9 @@ def check_format_attributes(attrs: dict, where: str) -> None:
     if name is not None and name != FORMAT_NAME:
         raise ValueError(f"{where}: format = {name!r}; expected {FORMAT_NAME!r}")
     version = attrs.get("format_version")
-    if version is not None and version != FORMAT_VERSION:
-        raise ValueError(f"{where}: format_version = {version!r}; this plansim reads version {FORMAT_VERSION}")
+    if version is not None and (isinstance(version, bool) or version not in READABLE_VERSIONS):
+        raise ValueError(f"{where}: format_version = {version!r}; this plansim reads versions "
+                         f"{', '.join(map(str, READABLE_VERSIONS))}")
 
 
 def schedule_notes(text: object, where: str) -> dict:
@@ -100,15 +107,21 @@ def schedule_from_columns(table: dict, where: str, column_names: dict, procedure
         raise ValueError(f"{where}: the segment table's columns have different lengths")
     if count == 0:
         raise ValueError(f"{where}: the segment table has no segment; a recording needs at least one")
+    table = dict(table)
+    for name, default in OPTIONAL_FIELDS.items():  # absent from version-1 files and from a lab's own table
+        if name not in table:
+            table[name] = [default] * count if name in TEXT_FIELDS else np.full(count, default)
     for name in FLOAT_FIELDS + INTEGER_FIELDS:
         values = np.asarray(table[name])
         column = column_names[name]
         if values.dtype.kind not in "iuf":
             raise ValueError(f"{where}: column {column!r} holds {values.dtype} values; expected numbers")
-        bad = np.flatnonzero(~np.isfinite(values.astype(np.float64)))
+        as_float = values.astype(np.float64)
+        bad = np.flatnonzero(np.isinf(as_float) if name in NAN_FIELDS else ~np.isfinite(as_float))
         if bad.size:
             raise ValueError(f"{where}: column {column!r} is {float(values[bad[0]])!r} in segment {int(bad[0])}; "
-                             f"expected a finite number in {SEGMENT_FIELDS[name][0]}")
+                             f"expected a finite number in {SEGMENT_FIELDS[name][0]}"
+                             + (" or NaN (not known)" if name in NAN_FIELDS else ""))
         if name in INTEGER_FIELDS:
             fractional = np.flatnonzero(values != np.round(values))
             if fractional.size:
@@ -126,7 +139,8 @@ def schedule_from_columns(table: dict, where: str, column_names: dict, procedure
                               up=table["up"][k], heading=float(table["heading"][k]), rate=float(table["rate"][k]),
                               rate_axis=table["rate_axis"][k], dwell=float(table["dwell"][k]),
                               settle=float(table["settle"][k]), sample_rate=float(table["sample_rate"][k]),
-                              temperature=float(table["temperature"][k]))
+                              temperature=float(table["temperature"][k]), orientation=table["orientation"][k],
+                              angle=float(table["angle"][k]))
         except (TypeError, ValueError) as exc:
             raise ValueError(f"{where}: segment {k}: {exc}") from None
         samples = int(table["samples"][k])
@@ -146,10 +160,12 @@ def schedule_from_columns(table: dict, where: str, column_names: dict, procedure
 
 def assemble(schedule: Schedule, samples: np.ndarray, time: np.ndarray, segment_index: np.ndarray, attrs: dict,
              where: str, count_name: str, segment_name: str, time_name: str, table_where: str,
-             channel_names: tuple[str, ...] = CHANNELS, row_offset: int = 0, row_word: str = "sample") -> Recording:
+             channel_names: tuple[str, ...] = CHANNELS, row_offset: int = 0, row_word: str = "sample",
+             temperature: np.ndarray | None = None, temperature_name: str = "temperature") -> Recording:
     """Check the samples against the segment table and build the Recording.
 
-    *row_offset* turns a 0-based sample index into what the file's reader sees (a CSV line number).
+    *row_offset* turns a 0-based sample index into what the file's reader sees (a CSV line number);
+    *temperature* is the per-sample temperature channel (°C) where the file has one.
     """
     rows = samples.shape[0]
     expected = schedule.total_samples
@@ -179,6 +195,12 @@ def assemble(schedule: Schedule, samples: np.ndarray, time: np.ndarray, segment_
         k = int(bad_time[0])
         raise ValueError(f"{where}: {time_name} is {float(time[k])!r} at {row_word} {k + row_offset}; every time "
                          "must be a finite number of seconds")
+    if temperature is not None:
+        bad_temperature = np.flatnonzero(~np.isfinite(temperature))
+        if bad_temperature.size:
+            k = int(bad_temperature[0])
+            raise ValueError(f"{where}: {temperature_name} is {float(temperature[k])!r} at {row_word} "
+                             f"{k + row_offset}; every temperature must be a finite number in degC")
     nominal = nominal_time(schedule)
     # a file written by plansim holds the nominal time exactly; anything else is a measured clock, kept
     timestamps = None if np.array_equal(time, nominal) else time
@@ -190,6 +212,7 @@ def assemble(schedule: Schedule, samples: np.ndarray, time: np.ndarray, segment_
                              f"({float(timestamps[k - 1])!r} s then {float(timestamps[k])!r} s); expected a global "
                              "time axis, never decreasing")
     try:
-        return Recording(samples=samples, schedule=schedule, attrs=attrs, timestamps=timestamps)
+        return Recording(samples=samples, schedule=schedule, attrs=attrs, timestamps=timestamps,
+                         temperature=temperature)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: {exc}") from None

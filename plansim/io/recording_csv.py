@@ -21,6 +21,8 @@ import numpy as np
 from plansim.io.files import atomic_write
 from plansim.io.recording_columns import (
     INTEGER_FIELDS,
+    NAN_FIELDS,
+    OPTIONAL_FIELDS,
     SEGMENT_FIELDS,
     TEXT_FIELDS,
     assemble,
@@ -36,20 +38,31 @@ from plansim.units import DEG
 SEGMENT_TABLE_SUFFIX = ".segments.csv"
 CSV_CHANNEL_COLUMNS = ("gx_rad_s", "gy_rad_s", "gz_rad_s", "ax_m_s2", "ay_m_s2", "az_m_s2")
 CSV_SAMPLE_COLUMNS = ("time_s", "segment") + CSV_CHANNEL_COLUMNS
+#: the samples file's optional temperature channel, degC
+CSV_TEMPERATURE_COLUMN = "temperature_degc"
 
 #: CSV segment table columns, in the order written
 CSV_SEGMENT_COLUMNS = ("segment", "label", "test", "group", "up", "heading_deg", "heading_rad", "rate_deg_s",
                        "rate_rad_s", "rate_axis", "dwell_s", "settle_s", "sample_rate_hz", "temperature_degc",
-                       "first_sample", "samples")
+                       "first_sample", "samples", "orientation", "angle_deg", "angle_rad")
 #: CSV column of each segment field that has a single column (heading and rate have a deg and a rad column)
 _CSV_FIELD_COLUMNS = {"label": "label", "test": "test", "group": "group", "up": "up", "rate_axis": "rate_axis",
                       "dwell": "dwell_s", "settle": "settle_s", "sample_rate": "sample_rate_hz",
-                      "temperature": "temperature_degc", "first_sample": "first_sample", "samples": "samples"}
-#: heading and rate: (rad column, deg column); the rad column is exact, the deg column is for people
-_CSV_ANGLE_COLUMNS = {"heading": ("heading_rad", "heading_deg"), "rate": ("rate_rad_s", "rate_deg_s")}
+                      "temperature": "temperature_degc", "first_sample": "first_sample", "samples": "samples",
+                      "orientation": "orientation"}
+#: heading, rate and angle: (rad column, deg column); the rad column is exact, the deg column is for people
+_CSV_ANGLE_COLUMNS = {"heading": ("heading_rad", "heading_deg"), "rate": ("rate_rad_s", "rate_deg_s"),
+                      "angle": ("angle_rad", "angle_deg")}
 # how far the deg and rad columns may disagree before the file counts as contradictory: far above the
 # rounding of a deg ↔ rad conversion (~1e-16 relative) and far below any table's resolution
 _ANGLE_AGREEMENT = 1e-9
+
+def _disagree(rad: float, deg: float) -> bool:
+    """The rad and deg columns of one value contradict each other (NaN agrees only with NaN)."""
+    if math.isnan(rad) or math.isnan(deg):
+        return math.isnan(rad) != math.isnan(deg)
+    return abs(rad - deg * DEG) > _ANGLE_AGREEMENT * max(1.0, abs(rad))
+
 
 _HEADER_ATTRIBUTE = re.compile(r"^#\s*([A-Za-z_][A-Za-z0-9_.\-]*)\s*:\s*(.*?)\s*$")
 
@@ -73,14 +86,19 @@ def write_csv(recording: Recording, target: Path) -> None:
     # each header value is JSON, so the notes are written as an object, not as JSON text inside JSON
     header_attrs = {"format": FORMAT_NAME, "format_version": FORMAT_VERSION, **recording.attrs,
                     "schedule_procedure": recording.schedule.procedure, "schedule_notes": recording.schedule.notes}
+    columns = CSV_SAMPLE_COLUMNS
     samples_block = np.column_stack([recording.time, recording.segment_index, recording.samples])
     sample_formats = ["%.17g", "%d"] + ["%.17g"] * len(CHANNELS)
+    if recording.temperature is not None:
+        columns = columns + (CSV_TEMPERATURE_COLUMN,)
+        samples_block = np.column_stack([samples_block, recording.temperature])
+        sample_formats.append("%.17g")
 
     def write_samples(tmp: str) -> None:
         with open(tmp, "w", encoding="utf-8", newline="") as fh:
             fh.writelines(_header_lines(f"plansim recording (samples); segment table in {table_target.name}",
                                         header_attrs))
-            fh.write(",".join(CSV_SAMPLE_COLUMNS) + "\n")
+            fh.write(",".join(columns) + "\n")
             np.savetxt(fh, samples_block, fmt=sample_formats, delimiter=",")
 
     def write_table(tmp: str) -> None:
@@ -95,7 +113,8 @@ def write_csv(recording: Recording, target: Path) -> None:
                                  repr(math.degrees(segment.rate)), repr(float(segment.rate)), segment.rate_axis,
                                  repr(float(segment.dwell)), repr(float(segment.settle)),
                                  repr(float(segment.sample_rate)), repr(float(segment.temperature)),
-                                 int(first), segment.samples])
+                                 int(first), segment.samples, segment.orientation,
+                                 repr(math.degrees(segment.angle)), repr(float(segment.angle))])
 
     table_in_place = False
 
@@ -222,10 +241,10 @@ def _read_table_csv(table_target: Path, procedure: str, notes: dict) -> Schedule
         rows = list(csv.reader(fh))
     _check_line_end(table_target, where)
     rows = [row for row in rows if any(cell.strip() for cell in row)]
-    required = ["segment"] + list(_CSV_FIELD_COLUMNS.values())
+    required = ["segment"] + [column for name, column in _CSV_FIELD_COLUMNS.items() if name not in OPTIONAL_FIELDS]
     missing = [name for name in required if name not in columns]
-    for rad_column, deg_column in _CSV_ANGLE_COLUMNS.values():
-        if rad_column not in columns and deg_column not in columns:
+    for name, (rad_column, deg_column) in _CSV_ANGLE_COLUMNS.items():
+        if rad_column not in columns and deg_column not in columns and name not in OPTIONAL_FIELDS:
             missing.append(f"{rad_column} or {deg_column}")
     if missing:
         raise ValueError(f"{where}: column {missing[0]!r} is missing; required: {', '.join(required)}, "
@@ -238,19 +257,23 @@ def _read_table_csv(table_target: Path, procedure: str, notes: dict) -> Schedule
             raise ValueError(f"{where}: segment row {row_number} has no value in column {column!r}")
         return row[index].strip() if strip else row[index]
 
-    def number(row_number: int, row: list[str], column: str, units: str) -> float:
+    def number(row_number: int, row: list[str], column: str, units: str, nan_allowed: bool = False) -> float:
         text = cell(row_number, row, column)
         try:
             value = float(text)
         except ValueError:
             raise ValueError(f"{where}: column {column!r} is {text!r} in segment row {row_number}; expected a "
                              f"number in {units}") from None
-        if not math.isfinite(value):
+        if math.isinf(value) or (math.isnan(value) and not nan_allowed):
             raise ValueError(f"{where}: column {column!r} is {text!r} in segment row {row_number}; expected a "
-                             f"finite number in {units}")
+                             f"finite number in {units}" + (" or nan (not known)" if nan_allowed else ""))
         return value
 
-    table: dict[str, list] = {name: [] for name in SEGMENT_FIELDS}
+    # the optional fields (format version 2) are read where their columns are present
+    present = {name for name, column in _CSV_FIELD_COLUMNS.items() if column in position}
+    present |= {name for name, pair in _CSV_ANGLE_COLUMNS.items() if any(column in position for column in pair)}
+    present |= {"first_sample", "samples"}
+    table: dict[str, list] = {name: [] for name in SEGMENT_FIELDS if name in present}
     for k, row in enumerate(rows):
         index_text = cell(k, row, "segment")
         if index_text != str(k):
@@ -258,16 +281,21 @@ def _read_table_csv(table_target: Path, procedure: str, notes: dict) -> Schedule
                              "(segments numbered from 0 in schedule order)")
         for name in TEXT_FIELDS:
             # a label is free text, kept exactly; the other text columns are codes
-            table[name].append(cell(k, row, _CSV_FIELD_COLUMNS[name], strip=name != "label"))
+            if name in table:
+                table[name].append(cell(k, row, _CSV_FIELD_COLUMNS[name], strip=name != "label"))
         for name in ("dwell", "settle", "sample_rate", "temperature", "group", "first_sample", "samples"):
             column = _CSV_FIELD_COLUMNS[name]
             units = SEGMENT_FIELDS[name][0]
             table[name].append(number(k, row, column, "whole numbers" if name in INTEGER_FIELDS else units))
         for name, (rad_column, deg_column) in _CSV_ANGLE_COLUMNS.items():
+            if name not in table:
+                continue
             units = SEGMENT_FIELDS[name][0]
-            rad = number(k, row, rad_column, units) if rad_column in position else None
-            deg = number(k, row, deg_column, units.replace("rad", "deg")) if deg_column in position else None
-            if rad is not None and deg is not None and abs(rad - deg * DEG) > _ANGLE_AGREEMENT * max(1.0, abs(rad)):
+            nan_allowed = name in NAN_FIELDS
+            rad = number(k, row, rad_column, units, nan_allowed) if rad_column in position else None
+            deg = (number(k, row, deg_column, units.replace("rad", "deg"), nan_allowed) if deg_column in position
+                   else None)
+            if rad is not None and deg is not None and _disagree(rad, deg):
                 raise ValueError(f"{where}: segment row {k}: {deg_column} = {deg!r} and {rad_column} = {rad!r} "
                                  "disagree; give one of them or make them agree")
             # the rad column is exact; the deg column converts the way a scenario file's "deg" does
@@ -288,12 +316,13 @@ def read_csv(target: Path) -> Recording:
         missing = [name for name in CSV_SAMPLE_COLUMNS if name not in columns]
         if missing:
             raise ValueError(f"{where}: column {missing[0]!r} is missing; required: {', '.join(CSV_SAMPLE_COLUMNS)}")
-        use = [columns.index(name) for name in CSV_SAMPLE_COLUMNS]
+        read_columns = CSV_SAMPLE_COLUMNS + ((CSV_TEMPERATURE_COLUMN,) if CSV_TEMPERATURE_COLUMN in columns else ())
+        use = [columns.index(name) for name in read_columns]
         try:
             data = np.loadtxt(fh, delimiter=",", usecols=use, ndmin=2, comments=None, dtype=np.float64)
         except ValueError as exc:
             raise ValueError(f"{where}: {exc} (rows counted after the header, line {header_line}); every value of "
-                             f"{', '.join(CSV_SAMPLE_COLUMNS)} must be a number") from None
+                             f"{', '.join(read_columns)} must be a number") from None
     _check_line_end(target, where)
     check_format_attributes(attrs, where)
     procedure = attrs.pop("schedule_procedure", "custom")
@@ -302,8 +331,11 @@ def read_csv(target: Path) -> Recording:
         attrs.pop(key, None)
     schedule = _read_table_csv(table_target, str(procedure), notes)
     if data.size == 0:
-        data = np.empty((0, len(CSV_SAMPLE_COLUMNS)))
-    return assemble(schedule, data[:, 2:], data[:, 0], data[:, 1], attrs, where=where, count_name="the file",
+        data = np.empty((0, len(read_columns)))
+    channels = slice(2, 2 + len(CSV_CHANNEL_COLUMNS))
+    temperature = data[:, -1] if CSV_TEMPERATURE_COLUMN in read_columns else None
+    return assemble(schedule, data[:, channels], data[:, 0], data[:, 1], attrs, where=where, count_name="the file",
                      segment_name="column 'segment'", time_name="column 'time_s'",
                      table_where=str(table_target), channel_names=tuple(f"column {c!r}" for c in CSV_CHANNEL_COLUMNS),
-                     row_offset=header_line + 1, row_word="line")
+                     row_offset=header_line + 1, row_word="line", temperature=temperature,
+                     temperature_name=f"column {CSV_TEMPERATURE_COLUMN!r}")

@@ -12,7 +12,12 @@ every earlier segment's settle time and recording time plus its own settle time;
 ``start_s + k / sample_rate_s``. A segment records for ``samples / sample_rate`` seconds, which is
 how the simulation kernel advances its drift processes (equal to ``dwell`` whenever
 ``dwell × sample_rate`` is a whole number). A measured recording may carry its own timestamps
-instead (:attr:`Recording.timestamps`).
+instead (:attr:`Recording.timestamps`), and a temperature channel (:attr:`Recording.temperature`).
+
+Format version 2 added what measured logs need (docs/recording.md): the segment fields ``orientation``
+and ``angle``, NaN for a value not known (heading, rate, angle: see
+:class:`~plansim.schedule.segments.Segment`), the site attributes ``site_latitude_deg`` and
+``site_height_m``, and the per-sample temperature channel. Version 1 files read as before.
 """
 
 from __future__ import annotations
@@ -25,8 +30,9 @@ import numpy as np
 from plansim.kernels.layout import CHANNELS
 from plansim.schedule.segments import Schedule
 
-__all__ = ["CHANNELS", "CHANNEL_LONG_NAMES", "CHANNEL_UNITS", "FORMAT_NAME", "FORMAT_VERSION", "RESERVED_ATTRIBUTES",
-           "SOURCES", "UNITS_DESCRIPTION", "Recording", "nominal_time", "plansim_version", "segment_first_samples"]
+__all__ = ["CHANNELS", "CHANNEL_LONG_NAMES", "CHANNEL_UNITS", "FORMAT_NAME", "FORMAT_VERSION", "READABLE_VERSIONS",
+           "RESERVED_ATTRIBUTES", "SITE_ATTRIBUTES", "SOURCES", "UNITS_DESCRIPTION", "Recording", "nominal_time",
+           "plansim_version", "segment_first_samples"]
 
 CHANNEL_UNITS = {"gx": "rad/s", "gy": "rad/s", "gz": "rad/s", "ax": "m/s^2", "ay": "m/s^2", "az": "m/s^2"}
 CHANNEL_LONG_NAMES = {
@@ -40,8 +46,12 @@ CHANNEL_LONG_NAMES = {
 
 SOURCES = ("simulated", "measured")
 FORMAT_NAME = "plansim-recording"
-FORMAT_VERSION = 1
-UNITS_DESCRIPTION = "SI: gx gy gz rad/s; ax ay az m/s^2; time s; heading rad; rate rad/s; temperature degC"
+FORMAT_VERSION = 2
+#: the versions this plansim reads: 1 (before the measured-log fields) and 2
+READABLE_VERSIONS = (1, 2)
+#: the site, where known: attribute -> (unit, lowest, highest); both optional
+SITE_ATTRIBUTES = {"site_latitude_deg": ("deg", -90.0, 90.0), "site_height_m": ("m", -11000.0, 9000.0)}
+UNITS_DESCRIPTION = "SI: gx gy gz rad/s; ax ay az m/s^2; time s; heading, angle rad; rate rad/s; temperature degC"
 
 #: attributes the file formats use themselves; a recording's own attrs may not use these names
 RESERVED_ATTRIBUTES = ("format", "format_version", "schedule_procedure", "schedule_notes",
@@ -111,15 +121,21 @@ class Recording:
     attrs : dict
         Provenance, values ``str``, ``int`` or ``float``: usually ``plansim_version``, ``scenario``,
         ``seed``, ``trial``, ``source`` (``"simulated"`` or ``"measured"``) and ``units``.
+        Where known, the site: ``site_latitude_deg`` (geodetic latitude, deg, −90 to 90) and
+        ``site_height_m`` (height above the ellipsoid, m); both numbers, both optional.
     timestamps : (M,) array of float or None
         Measured time of every sample on a global axis, s, non-decreasing; ``None`` (the default)
         means the nominal time computed from the schedule (:func:`nominal_time`).
+    temperature : (M,) array of float or None
+        Measured temperature of every sample, °C, finite; ``None`` (the default) when the log has no
+        temperature channel (each segment's ``temperature`` is then all there is).
     """
 
     samples: np.ndarray
     schedule: Schedule
     attrs: dict = field(default_factory=dict)
     timestamps: np.ndarray | None = None
+    temperature: np.ndarray | None = None
 
     def __post_init__(self):
         if not isinstance(self.schedule, Schedule):
@@ -144,6 +160,14 @@ class Recording:
         source = attrs.get("source")
         if source is not None and source not in SOURCES:
             raise ValueError(f"recording attrs['source'] = {source!r}; allowed: {', '.join(SOURCES)}")
+        for key, (unit, lowest, highest) in SITE_ATTRIBUTES.items():
+            if key not in attrs:
+                continue
+            value = attrs[key]
+            if isinstance(value, str) or not lowest <= value <= highest:  # NaN fails the comparison
+                raise ValueError(f"recording attrs[{key!r}] = {value!r}; expected a number from {lowest:g} to "
+                                 f"{highest:g} {unit}")
+            attrs[key] = float(value)
         timestamps = self.timestamps
         if timestamps is not None:
             timestamps = np.asarray(timestamps)
@@ -151,9 +175,23 @@ class Recording:
                 raise TypeError(f"recording timestamps: expected real numbers, got dtype {timestamps.dtype}")
             timestamps = timestamps.astype(np.float64, copy=False)
             _check_time(timestamps, expected_rows, "recording timestamps")
+        temperature = self.temperature
+        if temperature is not None:
+            temperature = np.asarray(temperature)
+            if temperature.dtype.kind not in "iuf":
+                raise TypeError(f"recording temperature: expected real numbers (degC), got dtype {temperature.dtype}")
+            temperature = temperature.astype(np.float64, copy=False)
+            if temperature.shape != (expected_rows,):
+                raise ValueError(f"recording temperature: shape {temperature.shape}; expected ({expected_rows},), "
+                                 "one temperature per sample")
+            bad = np.flatnonzero(~np.isfinite(temperature))
+            if bad.size:
+                raise ValueError(f"recording temperature: {float(temperature[bad[0]])!r} at sample {int(bad[0])}; "
+                                 "every temperature must be finite (degC)")
         object.__setattr__(self, "samples", samples)
         object.__setattr__(self, "attrs", attrs)
         object.__setattr__(self, "timestamps", timestamps)
+        object.__setattr__(self, "temperature", temperature)
 
     @property
     def time(self) -> np.ndarray:
@@ -193,14 +231,15 @@ class Recording:
         return means
 
     def __eq__(self, other: object) -> bool:
-        """Exact equality: same samples bit for bit, same schedule, attrs and timestamps."""
+        """Exact equality: same samples bit for bit, same schedule, attrs, timestamps and temperature."""
         if not isinstance(other, Recording):
             return NotImplemented
-        if (self.timestamps is None) != (other.timestamps is None):
-            return False
+        for name in ("timestamps", "temperature"):
+            mine, theirs = getattr(self, name), getattr(other, name)
+            if (mine is None) != (theirs is None) or (mine is not None and not np.array_equal(mine, theirs)):
+                return False
         return (self.schedule == other.schedule and self.attrs == other.attrs
-                and np.array_equal(self.samples, other.samples)
-                and (self.timestamps is None or np.array_equal(self.timestamps, other.timestamps)))
+                and np.array_equal(self.samples, other.samples))
 
     __hash__ = None
 

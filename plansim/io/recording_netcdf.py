@@ -14,6 +14,7 @@ import xarray as xr
 
 from plansim.io.files import atomic_write
 from plansim.io.recording_columns import (
+    OPTIONAL_FIELDS,
     SEGMENT_FIELDS,
     TEXT_FIELDS,
     assemble,
@@ -35,14 +36,17 @@ from plansim.io.recording_data import (
 )
 
 _NETCDF3_INT_MIN, _NETCDF3_INT_MAX = -(2**31), 2**31 - 1
+#: the per-sample temperature channel (the segment table's ``temperature`` is one value per segment)
+TEMPERATURE_VARIABLE = "sample_temperature"
 
 
 def recording_to_dataset(recording: Recording) -> xr.Dataset:
     """The recording as an :class:`xarray.Dataset` with dimensions ``sample`` and ``segment``.
 
     Variables over ``sample``: ``gx gy gz`` (rad/s), ``ax ay az`` (m/s^2); coordinates ``time`` (s, global
-    axis) and ``segment_index``. Over ``segment``: the segment table (``label test group up heading rate
-    rate_axis dwell settle sample_rate temperature first_sample samples``). Every variable has ``units``
+    axis) and ``segment_index``; ``sample_temperature`` (degC) when the recording has a temperature
+    channel. Over ``segment``: the segment table (``label test group up heading rate rate_axis dwell settle
+    sample_rate temperature first_sample samples orientation angle``). Every variable has ``units``
     (numeric ones) and ``long_name`` attributes. Dataset attributes: the recording's ``attrs`` plus
     ``format``, ``format_version``, ``schedule_procedure`` and ``schedule_notes`` (JSON).
     """
@@ -63,6 +67,8 @@ def recording_to_dataset(recording: Recording) -> xr.Dataset:
         "temperature": np.array([s.temperature for s in segments], dtype=np.float64),
         "first_sample": recording.first_sample,
         "samples": np.array([s.samples for s in segments], dtype=np.int64),
+        "orientation": np.array([s.orientation for s in segments], dtype=object),
+        "angle": np.array([s.angle for s in segments], dtype=np.float64),
     }
     data_vars = {}
     for column, name in enumerate(CHANNELS):
@@ -71,6 +77,9 @@ def recording_to_dataset(recording: Recording) -> xr.Dataset:
     for name, (units, long_name) in SEGMENT_FIELDS.items():
         attrs = {"long_name": long_name} if units is None else {"units": units, "long_name": long_name}
         data_vars[name] = ("segment", table[name], attrs)
+    if recording.temperature is not None:
+        data_vars[TEMPERATURE_VARIABLE] = ("sample", recording.temperature,
+                                           {"units": "degC", "long_name": "measured temperature of each sample"})
     coords = {
         "time": ("sample", recording.time,
                  {"units": "s", "long_name": "time from the start of the schedule, settle times included"}),
@@ -117,8 +126,10 @@ def dataset_to_recording(dataset: xr.Dataset, where: str = "dataset") -> Recordi
     for key in RESERVED_ATTRIBUTES:
         attrs.pop(key, None)
 
-    def variable(name: str, dimension: str, units: str | None) -> np.ndarray:
+    def variable(name: str, dimension: str, units: str | None) -> np.ndarray | None:
         if name not in dataset.variables:
+            if name in OPTIONAL_FIELDS or name == TEMPERATURE_VARIABLE:
+                return None
             raise ValueError(f"{where}: variable {name!r} is missing; expected one over dimension {dimension!r}"
                              + (f" in {units}" if units else ""))
         var = dataset.variables[name]
@@ -131,8 +142,10 @@ def dataset_to_recording(dataset: xr.Dataset, where: str = "dataset") -> Recordi
         return np.asarray(var.values)
 
     table = {name: variable(name, "segment", units) for name, (units, _) in SEGMENT_FIELDS.items()}
+    table = {name: values for name, values in table.items() if values is not None}
     for name in TEXT_FIELDS:
-        table[name] = [plain(value, where) for value in table[name]]
+        if name in table:
+            table[name] = [plain(value, where) for value in table[name]]
     schedule = schedule_from_columns(table, where, column_names={name: name for name in SEGMENT_FIELDS},
                                       procedure=procedure, notes=notes)
     channels = []
@@ -141,10 +154,14 @@ def dataset_to_recording(dataset: xr.Dataset, where: str = "dataset") -> Recordi
         channels.append(numeric_column(values, where, f"variable {name!r}", CHANNEL_UNITS[name]))
     segment_index = numeric_column(variable("segment_index", "sample", "1"), where, "variable 'segment_index'", "")
     time = numeric_column(variable("time", "sample", "s"), where, "variable 'time'", "s")
+    temperature = variable(TEMPERATURE_VARIABLE, "sample", "degC")
+    if temperature is not None:
+        temperature = numeric_column(temperature, where, f"variable {TEMPERATURE_VARIABLE!r}", "degC")
     return assemble(schedule, np.column_stack(channels), time, segment_index, attrs,
                      where=where, count_name="dimension 'sample'", segment_name="variable 'segment_index'",
                      time_name="variable 'time'", table_where=where,
-                     channel_names=tuple(f"variable {name!r}" for name in CHANNELS))
+                     channel_names=tuple(f"variable {name!r}" for name in CHANNELS),
+                     temperature=temperature, temperature_name=f"variable {TEMPERATURE_VARIABLE!r}")
 
 
 def _netcdf3_attributes(attrs: dict) -> dict:
