@@ -72,25 +72,33 @@ def _fmt(x, digits: int = 4) -> str:
     return f"{x:.{digits}g}"
 
 
-def _budget_table(budget: ParameterBudget) -> list[str]:
+def _scaled(x, factor: float):
+    return None if x is None else x / factor
+
+
+def _budget_table(budget: ParameterBudget, factor: float = 1.0, unit: str | None = None) -> list[str]:
+    """The budget's lines; the output side (c_i, u_i(y), u_c, U, y, biases) divided by *factor*, i.e. in
+    *unit* (the parameter's display unit; default SI, ``budget.unit``)."""
+    unit = budget.unit if unit is None else unit
     lines = [f"  {'input':30s} {'type':4s} {'u(x_i)':>10s} {'unit':>7s} {'c_i':>10s} {'u_i(y)':>10s} {'share':>6s} "
              f"{'ν_i':>8s}  distribution"]
     uc = budget.combined_standard_uncertainty
     for line in budget.inputs:
         share = (line.contribution / uc) ** 2 if uc > 0 else math.nan
-        unit = line.input_unit if len(line.input_unit) <= 7 else "SI"
+        input_unit = line.input_unit if len(line.input_unit) <= 7 else "SI"
         lines.append(f"  {line.name[:30]:30s} {line.evaluation:4s} {_fmt(line.standard_uncertainty, 3):>10s} "
-                     f"{unit:>7s} {_fmt(line.sensitivity, 3):>10s} {_fmt(line.contribution, 3):>10s} "
+                     f"{input_unit:>7s} {_fmt(_scaled(line.sensitivity, factor), 3):>10s} "
+                     f"{_fmt(_scaled(line.contribution, factor), 3):>10s} "
                      f"{share:>6.1%} {_fmt(line.dof, 3):>8s}  {line.distribution}")
-    lines.append(f"  u_c = {_fmt(uc)} {budget.unit}, ν_eff = {_fmt(budget.effective_dof, 3)}, "
+    lines.append(f"  u_c = {_fmt(uc / factor)} {unit}, ν_eff = {_fmt(budget.effective_dof, 3)}, "
                  f"k({budget.coverage_probability:.0%}) = {budget.coverage_factor:.3f}, "
-                 f"U95 = {_fmt(budget.expanded_uncertainty)} {budget.unit}"
-                 f"   [largest 2nd-order term {_fmt(budget.largest_second_order, 2)}]")
+                 f"U95 = {_fmt(budget.expanded_uncertainty / factor)} {unit}"
+                 f"   [largest 2nd-order term {_fmt(_scaled(budget.largest_second_order, factor), 2)}]")
     if budget.systematic_effects:
-        parts = [f"{e.name} {e.bias:+.3g}" + (f" ({e.bias / uc:+.2g} u_c)" if uc > 0 else "")
+        parts = [f"{e.name} {e.bias / factor:+.3g}" + (f" ({e.bias / uc:+.2g} u_c)" if uc > 0 else "")
                  for e in budget.systematic_effects]
-        lines.append(f"  not corrected (bias; GUM 3.2.4 asks to correct): y = {budget.estimate:+.4g} = "
-                     + "; ".join(parts))
+        lines.append(f"  not corrected (bias; GUM 3.2.4 asks to correct): y = {budget.estimate / factor:+.4g} "
+                     f"{unit} = " + "; ".join(parts))
     return lines
 
 
@@ -103,19 +111,25 @@ def format_report(report: ValidationReport, details: bool = True) -> str:
         f"{mc.blocks} blocks × {mc.trials_per_block} = {mc.trials} trials ({mc.path} path, seed {mc.seed}), "
         f"n_dig = {report.digits}, run to {report.tolerance_fraction:g}·δ of the GUM u_c (JCGM 101 8.2): "
         + ("reached" if mc.converged else "NOT reached (max trials)"),
-        f"Output quantity: the error E = estimate − truth of each parameter (SI). Claims: {report.claims_source}.",
+        f"Output quantity: the error E = estimate − truth of each parameter, in the display units of "
+        f"`plansim run` (JSON: SI). Claims: {report.claims_source}.",
         "",
-        "Summary (JCGM 101 8: validated if d_low and d_high ≤ δ; coverage = fraction of trials with |E| ≤ U)",
-        f"{'name':5s} {'GUM y':>10s} {'GUM u_c':>10s} {'ν_eff':>7s} {'U95':>10s} {'MCM u':>10s} {'MCM low':>11s} "
-        f"{'MCM high':>11s} {'δ':>8s} {'d_low':>8s} {'d_high':>8s} {'valid':>5s} {'cov GUM':>7s} "
-        f"{'claimed U':>10s} {'cov claim':>9s}  claim verdict",
+        "Summary (JCGM 101 8: validated if d_low and d_high ≤ δ; coverage = fraction of trials with |E| ≤ U);",
+        "mean error and std error are the MCM y and u of E, as `plansim run` prints them",
+        f"{'name':6s} {'unit':>14s} {'mean error':>11s} {'std error':>10s} {'GUM y':>10s} {'GUM u_c':>10s} "
+        f"{'ν_eff':>7s} {'GUM U95':>10s} {'MCM low':>11s} {'MCM high':>11s} {'δ':>8s} {'d_low':>8s} {'d_high':>8s} "
+        f"{'valid':>5s} {'cov GUM':>7s} {'claimed U':>10s} {'cov claim':>9s}  claim verdict",
     ]
     for p in report.parameters:
+        spec = parameter(p.name)
+        f = spec.display_factor
+        claimed = None if p.claimed_U is None else p.claimed_U / f
         out.append(
-            f"{p.name:5s} {p.gum_y:>10.3g} {p.gum_u:>10.3g} {_fmt(p.gum_dof, 2):>7s} {p.gum_U95:>10.3g} "
-            f"{p.mcm_u:>10.3g} "
-            f"{p.mcm_low:>11.3g} {p.mcm_high:>11.3g} {p.delta:>8.2g} {p.d_low:>8.2g} {p.d_high:>8.2g} "
-            f"{'yes' if p.validated else 'NO':>5s} {p.coverage_gum:>7.1%} {_fmt(p.claimed_U, 3):>10s} "
+            f"{p.name:6s} {spec.display_unit:>14s} {p.mcm_y / f:>11.3g} {p.mcm_u / f:>10.3g} {p.gum_y / f:>10.3g} "
+            f"{p.gum_u / f:>10.3g} {_fmt(p.gum_dof, 2):>7s} {p.gum_U95 / f:>10.3g} "
+            f"{p.mcm_low / f:>11.3g} {p.mcm_high / f:>11.3g} {p.delta / f:>8.2g} {p.d_low / f:>8.2g} "
+            f"{p.d_high / f:>8.2g} "
+            f"{'yes' if p.validated else 'NO':>5s} {p.coverage_gum:>7.1%} {_fmt(claimed, 3):>10s} "
             f"{'—' if p.coverage_claimed is None else format(p.coverage_claimed, '.1%'):>9s}  "
             f"{p.claim_verdict or '—'}")
     failed = [p for p in report.parameters if not p.validated]
@@ -163,27 +177,30 @@ def format_report(report: ValidationReport, details: bool = True) -> str:
     if details:
         for p, budget in zip(report.parameters, report.gum.budgets):
             spec = parameter(p.name)
-            out += ["", f"== {p.name}: {spec.long_name} [{p.unit}]"
+            f = spec.display_factor
+            out += ["", f"== {p.name}: {spec.long_name} [{spec.display_unit}; SI {p.unit}]"
                     + (f" — Appendix A {p.appendix_item}" if p.appendix_item else "")]
-            out.append("GUM budget (JCGM 100 5.1.2; output: the error E of the parameter)")
-            out += _budget_table(budget)
-            out.append(f"MCM: y = {p.mcm_y:.4g}, u = {p.mcm_u:.4g}, {mc.coverage_probability:.0%} interval "
-                       f"[{p.mcm_low:.4g}, {p.mcm_high:.4g}] "
-                       f"(shortest [{p.mcm_shortest_low:.4g}, {p.mcm_shortest_high:.4g}])")
-            out.append(f"Validation (JCGM 101 8): δ = {p.delta:.2g}, d_low = {p.d_low:.2g}, "
-                       f"d_high = {p.d_high:.2g} → "
+            out.append(f"GUM budget (JCGM 100 5.1.2; output: the error E of the parameter, in {spec.display_unit}; "
+                       "c_i in that unit per unit of x_i)")
+            out += _budget_table(budget, f, spec.display_unit)
+            out.append(f"MCM: y = {p.mcm_y / f:.4g}, u = {p.mcm_u / f:.4g}, {mc.coverage_probability:.0%} interval "
+                       f"[{p.mcm_low / f:.4g}, {p.mcm_high / f:.4g}] "
+                       f"(shortest [{p.mcm_shortest_low / f:.4g}, {p.mcm_shortest_high / f:.4g}]) {spec.display_unit}")
+            out.append(f"Validation (JCGM 101 8): δ = {p.delta / f:.2g}, d_low = {p.d_low / f:.2g}, "
+                       f"d_high = {p.d_high / f:.2g} {spec.display_unit} → "
                        f"GUM framework validated: {'yes' if p.validated else 'no'}")
             for reason in p.reasons:
                 out.append(f"    because {reason}")
             line = f"Coverage of the truth: GUM U95 {p.coverage_gum:.2%}"
             if p.claimed_U is not None:
-                line += (f"; claimed U = {p.claimed_U:.4g} ({p.claim_source}) {p.coverage_claimed:.2%} → "
-                         f"{p.claim_verdict} (U needed for {p.claim_probability:.0%}: "
-                         f"{p.claimed_U / p.claim_factor:.3g})")
+                line += (f"; claimed U = {p.claimed_U / f:.4g} {spec.display_unit} ({p.claim_source}) "
+                         f"{p.coverage_claimed:.2%} → {p.claim_verdict} (U needed for {p.claim_probability:.0%}: "
+                         f"{p.claimed_U / p.claim_factor / f:.3g} {spec.display_unit})")
             out.append(line)
             if budget.appendix_a is not None:
                 a = budget.appendix_a
-                out.append(f"Appendix A {a.item} in its reading unit (1 unit = {a.reading_unit_si:.4g} {p.unit}): "
+                out.append(f"Appendix A {a.item} in its reading unit (1 unit = {a.reading_unit_si / f:.4g} "
+                           f"{spec.display_unit}): "
                            f"printed u1 {a.printed_u[0]:g}, u2 {a.printed_u[1]:g}, u3 {a.printed_u[2]:g} → "
                            f"u_c {a.printed_uc:g}, "
                            f"U {a.printed_U:g} (same inputs by the GUM: U {a.same_inputs_gum_U:.3g}); this schedule: "
