@@ -17,13 +17,17 @@ parameter, in SI:
   order statistic of the tail where it was) and handed to :func:`numpy.quantile`, so the figure is
   numpy's own, not an approximation;
 - the Appendix A comparison (:func:`plansim.uncertainty.compare_with_appendix_a`): per budget and
-  parameter, the errors in the budget's reading unit (``errors_in_reading_units``), their moments,
-  the 95 % point of their magnitude (kept as above, per parameter and pooled over the budget's
-  parameters), and the count of ``|error| ≤ U`` (the printed U), so the same numbers come out.
+  parameter, the errors in the budget's primary reading unit (``errors_in_reading_units``), their
+  moments, the 95 % point of their magnitude (kept as above, per parameter and pooled over the
+  budget's parameters), and the count of ``|error| ≤ U`` (the printed U); and for every other
+  reading of the budget's unit (``AppendixABudget.readings``) the errors converted in that reading
+  block by block, exactly as the per-trial comparison converts them, with their pooled 95 % point
+  (a kept tail) and their count of ``|error| ≤ U``. So the same numbers come out, in every reading.
 
 Memory: the kept tails hold ``(2.5 % + 2.5 % + 5 %) × n × 39`` values for the parameters plus
-``2 × 5 % × n`` per parameter of the Appendix A budgets (27 of them), 8 bytes each, and at most as much
-again waiting to be merged: about 110 MB at n = 10⁶ (:func:`summary_memory_bytes`).
+``2 × 5 % × n`` per parameter of the Appendix A budgets (27 of them) and ``5 % × n`` per parameter
+for each further reading (A.1: 1, A.2: 1, A.3: 2, A.5: 2), 8 bytes each, and at most as much again
+waiting to be merged: about 150 MB at n = 10⁶ (:func:`summary_memory_bytes`).
 """
 
 from __future__ import annotations
@@ -44,6 +48,8 @@ from plansim.uncertainty import (
     reading_unit_description,
     reading_unit_in_si,
 )
+from plansim.uncertainty.appendix_a import Reading
+from plansim.uncertainty.appendix_a_comparison import item_comparison, reading_comparison
 
 #: quantiles of the error kept for every parameter (the central 95 % interval)
 ERROR_QUANTILES = (0.025, 0.975)
@@ -148,8 +154,31 @@ class _Moments:
         return np.sqrt(self.m2 / (self.n - 1))
 
 
+class _ReadingStatistics:
+    """A further reading of one Appendix A budget: the pooled |error| tail and the count of |error| ≤ U."""
+
+    def __init__(self, budget: AppendixABudget, reading: Reading, scenario, trials: int):
+        self.reading = reading
+        count = len(budget.parameters)
+        self.largest = _Largest(tail_size(trials * count, ABS_ERROR_QUANTILE, True), 1)
+        self.covered = 0
+        # a constant unit is the scenario's; the relative one (|truth|) is averaged over the trials
+        self.units = None if reading.constant else _Moments(count)
+        self.constant_units = (np.array([float(reading_unit_in_si(budget, name, scenario, reading=reading))
+                                         for name in budget.parameters]) if reading.constant else None)
+
+    def add(self, magnitude: np.ndarray, units: np.ndarray | None, expanded: float) -> None:
+        self.largest.add(magnitude.reshape(-1, 1))
+        self.covered += int(np.count_nonzero(magnitude <= expanded))
+        if self.units is not None:
+            self.units.add(units)
+
+    def unit_in_si(self) -> np.ndarray:
+        return self.constant_units if self.units is None else self.units.mean
+
+
 class _BudgetStatistics:
-    """One Appendix A budget: its parameters' errors in the budget's reading unit, streamed."""
+    """One Appendix A budget: its parameters' errors in the budget's reading units, streamed."""
 
     def __init__(self, budget: AppendixABudget, scenario, trials: int):
         self.budget = budget
@@ -160,15 +189,20 @@ class _BudgetStatistics:
         self.expanded = budget.printed_expanded_uncertainty
         self.moments = _Moments(count)
         self.pooled = _Moments(1)
-        self.units = _Moments(count)
+        # one unit's SI size: the scenario's for a constant reading, averaged over the trials for the relative one
+        primary = budget.readings[0]
+        self.units = None if primary.constant else _Moments(count)
+        self.constant_units = (np.array([float(reading_unit_in_si(budget, name, scenario)) for name in self.names])
+                               if primary.constant else None)
         self.largest = _Largest(tail_size(trials, ABS_ERROR_QUANTILE, True), count)
         self.pooled_largest = _Largest(tail_size(trials * count, ABS_ERROR_QUANTILE, True), 1)
         self.covered = np.zeros(count, dtype=np.int64)
+        self.readings = [_ReadingStatistics(budget, reading, scenario, trials) for reading in budget.readings[1:]]
 
     def add(self, start: int, truth: np.ndarray, estimate: np.ndarray, error: np.ndarray) -> None:
         rows = truth.shape[0]
         reading = np.empty((rows, len(self.names)))
-        units = np.empty((rows, len(self.names)))
+        units = None if self.units is None else np.empty((rows, len(self.names)))
         for j, (name, k) in enumerate(zip(self.names, self.columns)):
             finite = np.isfinite(truth[:, k]) & np.isfinite(estimate[:, k])
             if not np.all(finite):
@@ -176,14 +210,38 @@ class _BudgetStatistics:
                 raise ValueError(f"parameter {name}: trial {start + bad} has truth {truth[bad, k]!r} and estimate "
                                  f"{estimate[bad, k]!r}; every value must be finite")
             reading[:, j] = errors_in_reading_units(self.budget, name, error[:, k], self.scenario, truth[:, k])
-            units[:, j] = reading_unit_in_si(self.budget, name, self.scenario, truth[:, k])
+            if units is not None:
+                units[:, j] = reading_unit_in_si(self.budget, name, self.scenario, truth[:, k])
         magnitude = np.abs(reading)
         self.moments.add(reading)
         self.pooled.add(reading.reshape(-1, 1))
-        self.units.add(units)
+        if self.units is not None:
+            self.units.add(units)
         self.largest.add(magnitude)
         self.pooled_largest.add(magnitude.reshape(-1, 1))
         self.covered += np.count_nonzero(magnitude <= self.expanded, axis=0)
+        for statistics in self.readings:
+            other = np.empty((rows, len(self.names)))
+            other_units = None if statistics.units is None else np.empty((rows, len(self.names)))
+            for j, (name, k) in enumerate(zip(self.names, self.columns)):
+                other[:, j] = errors_in_reading_units(self.budget, name, error[:, k], self.scenario, truth[:, k],
+                                                      statistics.reading)
+                if other_units is not None:
+                    other_units[:, j] = reading_unit_in_si(self.budget, name, self.scenario, truth[:, k],
+                                                           statistics.reading)
+            statistics.add(np.abs(other), other_units, self.expanded)
+
+    def reading_results(self, trials: int, primary: dict) -> list[dict]:
+        """Per reading (the primary one first, from *primary* = :meth:`results`): its name, the pooled 95 %
+        point of |error|, the count of |error| ≤ U and the SI size of one unit per parameter."""
+        out = [{"reading": self.budget.readings[0].name, "U95": primary["U95"], "covered": primary["covered"],
+                "unit_in_si": primary["reading_unit_in_si"]}]
+        n = trials * len(self.names)
+        for statistics in self.readings:
+            out.append({"reading": statistics.reading.name,
+                        "U95": _quantile_from_upper_tail(statistics.largest.values()[0], n, ABS_ERROR_QUANTILE),
+                        "covered": statistics.covered, "unit_in_si": statistics.unit_in_si()})
+        return out
 
     def results(self, trials: int) -> dict:
         largest = self.largest.values()
@@ -199,7 +257,7 @@ class _BudgetStatistics:
             "parameter_U95": np.array([_quantile_from_upper_tail(largest[j], trials, ABS_ERROR_QUANTILE)
                                        for j in range(len(self.names))]),
             "parameter_covered": self.covered.copy(),
-            "reading_unit_in_si": self.units.mean,
+            "reading_unit_in_si": self.constant_units if self.units is None else self.units.mean,
         }
 
 
@@ -231,7 +289,7 @@ def summary_memory_bytes(trials: int, budgets: Iterable[AppendixABudget] = APPEN
         count = len(budget.parameters)
         widest = max(widest, count)
         tails.append((rows(tail_size(trials, ABS_ERROR_QUANTILE, True)), count))
-        tails.append((rows(tail_size(trials * count, ABS_ERROR_QUANTILE, True)), 1))
+        tails.extend([(rows(tail_size(trials * count, ABS_ERROR_QUANTILE, True)), 1)] * len(budget.readings))
     held = sum(r * c for r, c in tails)
     transient = max(max(r * c for r, c in tails), trials * widest)
     return 8 * (held + transient)
@@ -320,8 +378,11 @@ class RunStatistics:
         per = {key: np.full(shape, np.nan) for key in ("mean", "std", "U95", "reading_unit_in_si")}
         covered = np.full(shape, -1, dtype=np.int64)
         pooled = {key: [] for key in ("n", "mean", "std", "U95", "covered")}
+        readings = []
         for i, statistics in enumerate(self.budgets):
             r = statistics.results(self.trials)
+            readings += [(statistics.budget.item, statistics.columns, entry)
+                         for entry in statistics.reading_results(self.trials, r)]
             for key in pooled:
                 pooled[key].append(r[key])
             for j, k in enumerate(statistics.columns):
@@ -355,12 +416,38 @@ class RunStatistics:
             "appendix_a_reading_unit_in_si": (("item", "parameter"), per["reading_unit_in_si"],
                                               {"long_name": "mean SI size of one reading unit"}),
         })
+        # every reading of every item (the primary one first): the pooled 95 % point and coverage count
+        units = np.full((len(readings), N_PARAMETERS), np.nan)
+        for r, (_, columns, entry) in enumerate(readings):
+            units[r, columns] = entry["unit_in_si"]
+        of_the_reading = "units of the reading (see appendix_a_readings_unit)"
+        coords["appendix_a_readings_item"] = ("appendix_a_readings", [item for item, _, _ in readings],
+                                              {"long_name": "the Appendix A item read"})
+        coords["appendix_a_readings_name"] = ("appendix_a_readings", [e["reading"] for _, _, e in readings],
+                                              {"long_name": "name of the reading of the item's unit "
+                                                            "(the item's first: its primary reading)"})
+        budgets = {b.budget.item: b for b in self.budgets}
+        coords["appendix_a_readings_unit"] = ("appendix_a_readings", [
+            reading_unit_description(budgets[item].budget, budgets[item].scenario, e["reading"])
+            for item, _, e in readings])
+        data.update({
+            "appendix_a_readings_U95": ("appendix_a_readings", np.array([e["U95"] for _, _, e in readings]),
+                                        {"units": of_the_reading,
+                                         "long_name": "95th percentile of the pooled |error| (exact)"}),
+            "appendix_a_readings_covered": ("appendix_a_readings",
+                                            np.array([e["covered"] for _, _, e in readings], dtype=np.int64),
+                                            {"long_name": "pooled errors with |error| <= U in the reading"}),
+            "appendix_a_readings_unit_in_si": (("appendix_a_readings", "parameter"), units,
+                                               {"long_name": "mean SI size of one unit of the reading "
+                                                             "(NaN: not in the item)"}),
+        })
 
 
 def appendix_a_comparisons(summary: xr.Dataset, scenario, budgets: Iterable[AppendixABudget] = APPENDIX_A
                            ) -> list[ItemComparison]:
     """The Appendix A comparison of a summary run, the same numbers as
-    :func:`plansim.uncertainty.compare_with_appendix_a` gives on the run's per-trial arrays.
+    :func:`plansim.uncertainty.compare_with_appendix_a` gives on the run's per-trial arrays, in
+    every reading of each budget's unit.
 
     Parameters
     ----------
@@ -380,13 +467,15 @@ def appendix_a_comparisons(summary: xr.Dataset, scenario, budgets: Iterable[Appe
         return []
     by_item = {b.item: b for b in budgets}
     trials = int(summary.attrs["trials"])
+    reading_items = [str(v) for v in summary["appendix_a_readings_item"].values]
+    reading_names = [str(v) for v in summary["appendix_a_readings_name"].values]
     comparisons = []
     for i, item in enumerate(summary["item"].values):
         budget = by_item[str(item)]
         expanded = budget.printed_expanded_uncertainty
+        columns = [PARAMETER_INDEX[name] for name in budget.parameters]
         per_parameter = []
-        for name in budget.parameters:
-            k = PARAMETER_INDEX[name]
+        for name, k in zip(budget.parameters, columns):
             unit = float(summary["appendix_a_reading_unit_in_si"].values[i, k])
             per_parameter.append(ParameterComparison(
                 name=name, mean=float(summary["appendix_a_parameter_mean"].values[i, k]),
@@ -395,30 +484,14 @@ def appendix_a_comparisons(summary: xr.Dataset, scenario, budgets: Iterable[Appe
                 coverage=int(summary["appendix_a_parameter_covered"].values[i, k]) / trials,
                 reading_unit_in_si=unit, budget_U_si=expanded * unit))
         n = int(summary["appendix_a_n"].values[i])
-        comparisons.append(_item_comparison(
+        readings = tuple(
+            reading_comparison(budget, budget.reading_named(reading_names[r]), scenario, n,
+                               int(summary["appendix_a_readings_covered"].values[r]) / n,
+                               float(summary["appendix_a_readings_U95"].values[r]),
+                               summary["appendix_a_readings_unit_in_si"].values[r, columns])
+            for r in range(len(reading_items)) if reading_items[r] == str(item))
+        comparisons.append(item_comparison(
             budget, scenario, n, float(summary["appendix_a_mean"].values[i]),
             float(summary["appendix_a_std"].values[i]), float(summary["appendix_a_U95"].values[i]),
-            int(summary["appendix_a_covered"].values[i]) / n, tuple(per_parameter)))
+            int(summary["appendix_a_covered"].values[i]) / n, tuple(per_parameter), readings))
     return comparisons
-
-
-def _item_comparison(budget, scenario, n, mean, std, u95, coverage, per_parameter) -> ItemComparison:
-    """An :class:`ItemComparison` from the pooled statistics, assembled as compare_with_appendix_a does."""
-    from plansim.uncertainty import NOMINAL_COVERAGE
-    from plansim.uncertainty.metrology.coverage import coverage_tolerance, coverage_verdict
-
-    expanded = budget.printed_expanded_uncertainty
-    verdict, factor = coverage_verdict(coverage, n, NOMINAL_COVERAGE, expanded, u95,
-                                       show_understatement_factor=False)
-    return ItemComparison(
-        item=budget.item, quantity=budget.quantity, reading=budget.reading,
-        reading_unit=reading_unit_description(budget, scenario), parameters=tuple(budget.parameters), n=n,
-        budget_uc=budget.printed_combined_standard_uncertainty, budget_U=expanded,
-        coverage_factor=budget.coverage_factor,
-        arithmetic_uc=budget.recomputed_combined_standard_uncertainty(),
-        arithmetic_U=budget.recomputed_expanded_uncertainty(),
-        mc_bias=mean, mc_u=std, mc_U95=u95, coverage=coverage,
-        ratio=std / budget.printed_combined_standard_uncertainty,
-        tolerance=coverage_tolerance(n, NOMINAL_COVERAGE), overstatement_factor=factor, verdict=verdict,
-        per_parameter=per_parameter,
-    )

@@ -42,6 +42,36 @@ def appendix_a_table(comparisons) -> str:
         lines.append(f"{c.item:4s} {c.quantity[:28]:28s} {c.budget_uc:>11.3g} {c.budget_U:>10.3g} {c.mc_u:>10.3g} "
                      f"{c.mc_U95:>10.3g} {c.mc_bias:>10.3g} {c.coverage:>8.1%}  {c.verdict}")
     lines.append("readings: " + "; ".join(f"{c.item} {c.reading_unit}" for c in comparisons))
+    by_reading = verdict_by_reading_table(comparisons)
+    if by_reading:
+        lines += ["", by_reading]
+    return "\n".join(lines)
+
+
+def verdict_by_reading_table(comparisons) -> str:
+    """The verdict of each Appendix A item under every defensible reading of its unit, and whether it holds.
+
+    One row per reading (``ItemComparison.readings``): the printed U read in that unit and the Monte
+    Carlo U95, both converted to the parameters' display unit, and the verdict; the last column, on
+    an item's first row, says ``holds: <kind>`` when every reading gives the same kind of verdict and
+    ``DEPENDS on the reading`` otherwise. Empty when no comparison carries readings.
+    """
+    rows = [c for c in comparisons if c.readings]
+    if not rows:
+        return ""
+    lines = ["Verdict by reading — the printed U is one number; read in each defensible unit it is a different "
+             "amount (claimed U and MC U95 in display units)",
+             f"{'item':4s} {'reading':18s} {'claimed U':>10s} {'MC U95':>10s} {'unit':12s} {'verdict':22s} "
+             "every reading"]
+    for c in rows:
+        spec = parameter(c.parameters[0])
+        f = spec.display_factor
+        mark = (f"holds: {c.readings[0].verdict_kind}" if c.holds_under_every_reading
+                else "DEPENDS on the reading")
+        for i, r in enumerate(c.readings):
+            lines.append(f"{c.item if i == 0 else '':4s} {r.reading:18s} {_g(r.mean_budget_U_si / f, 4):>10s} "
+                         f"{_g(r.mc_U95_si / f, 4):>10s} {spec.display_unit:12s} {r.verdict:22s} "
+                         f"{mark if i == 0 else ''}".rstrip())
     return "\n".join(lines)
 
 

@@ -149,6 +149,17 @@ def format_report(report: ValidationReport, details: bool = True) -> str:
             out.append(f"    achieved by this schedule: GUM U95 {gum_list}")
             out.append(f"                               MCM U95 {mcm_list}")
             out.append(f"    claimed U {c.claimed_U:g} covers the truth in {c.coverage:.2%} of the trials: {c.verdict}")
+            if len(c.readings) == 1:
+                out.append(f"    {c.item} has one reading of its unit ({c.readings[0].reading}): the verdict holds")
+            elif c.readings:
+                spec = parameter(c.parameters[0])
+                display = "dimensionless" if spec.display_unit == "1" else f"in {spec.display_unit}"
+                out.append(f"    the number {c.claimed_U:g} in each reading of its unit ({c.reading_dependence}; "
+                           f"U and the MCM's |E| quantile {display}):")
+                for r in c.readings:
+                    out.append(f"        {r.reading:18s} U = {_fmt(r.mean_budget_U_si / spec.display_factor, 4):>9s}, "
+                               f"MCM {_fmt(r.mc_U95_si / spec.display_factor, 4):>9s}: covers {r.coverage:.2%}, "
+                               f"{r.verdict}")
 
     j = report.joint
     out += ["", f"Several outputs at once (JCGM 102): {', '.join(j.parameters)}",

@@ -36,38 +36,46 @@ Slips in the printed arithmetic (see ``tests/test_appendix_a.py``):
   difference (1, eq. (A.10)); the GUM law of propagation for independent readings (GUM 5.1.2)
   gives ``√6·3.41e-5/6 = 1.39e-5``, ``√2·2.51e-3/2 = 1.77e-3`` and ``√2·2.51e-3 = 3.55e-3``.
 
-Reading of the units (our documented choice)
---------------------------------------------
+Readings of the units
+---------------------
 Appendix A never states units: ``u1`` is a relative rate error (Table 1), ``u2`` a fraction of the
 acquisition full-scale range (eq. (A.3)) and ``u3`` is in unstated output units, and they are added
-without sensitivity coefficients. To compare the budgets with simulated errors plansim *reads*
-each budget in the unit that makes its three components commensurable with the model:
+without sensitivity coefficients. To compare a budget with simulated errors its number has to be
+*read* in some unit, and more than one reading is defensible. Each budget carries a tuple of
+:class:`Reading` (``AppendixABudget.readings``); the first is the **primary** reading, the one in
+which the budget's three components are commensurable with the model (``reading_kind``):
 
-``A.1`` — ``"relative"``
-    The relative error of the scale factor, ``(K̂ − K)/K`` (dimensionless). ``u1`` is the relative
-    rate error of the table and ``u2`` the quantisation relative to full scale, which the maximum
-    rate point (required by §7.2.1 a)) approaches.
+``A.1`` — ``"relative"`` (primary), ``"absolute"``
+    The relative error of the scale factor, ``(K̂ − K)/K``: ``u1`` is the relative rate error of
+    the table and ``u2`` the quantisation relative to full scale, which the maximum rate point
+    (required by §7.2.1.1 c)) approaches. The absolute error ``K̂ − K`` is the same number within
+    ``|K| − 1`` (2·10⁻³ in the default unit); it is kept so that the report *shows* that no
+    verdict hinges on the difference.
+``A.2`` — ``"FS_g"`` (primary), ``"deg/s"``
+    A fraction of the gyro full scale (``scenario.acquisition.gyro_full_scale``, rad/s): the
+    outputs ``U_gxi``, and ``u2``, are fractions of the acquisition's full scale. Or °/s, the unit
+    of the specification's rates (clause 1, §7.2.1.1).
+``A.3`` — ``"FS_g/g"`` (primary), ``"deg/s/g"``, ``"deg/h/g"``
+    A fraction of the gyro full scale per g, ``FS_g/g_ref`` (rad/s per m/s²), since eq. (A.6)
+    divides outputs (fractions of FS_g) by the 2 g span of the matrix A of eq. (6); or °/s per g
+    (outputs in °/s); or °/h per g, the unit of MEMS data sheets. ``g_ref`` is the value of 1 g
+    the laboratory uses in matrix A (``scenario.reduction.reference_gravity``), in every reading.
 ``A.4`` — ``"absolute"``
     The absolute error of the dimensionless cross-coupling coefficient, ``K̂gxy − Kgxy``
     (A.4.1: "the same model as the scale factor"; a relative error of a coefficient near zero is
-    meaningless).
-``A.2`` — ``"gyro_full_scale"``
-    A fraction of the gyro full scale: ``U_abs = U × FS_g`` in rad/s
-    (``scenario.acquisition.gyro_full_scale``).
-``A.3`` — ``"gyro_full_scale_per_reference_gravity"``
-    A fraction of the gyro full scale per g: ``U_abs = U × FS_g / g_ref`` in rad/s per m/s², since
-    eq. (A.6) divides outputs (fractions of FS_g) by the 2 g span of the matrix A of eq. (6), and
-    ``g_ref`` is the value of 1 g the laboratory uses there (``scenario.reduction.reference_gravity``).
-``A.5`` — ``"accel_full_scale_per_rate_squared"``
-    A fraction of the accelerometer full scale per squared test rate:
-    ``U_abs = U × FS_a / ω²`` in m/s² per (rad/s)², since eq. (A.10) divides outputs (fractions of
-    FS_a) by ω²; ω is the rate of the rotating ("U8") ``omega_squared`` segment of the schedule
-    about the parameter's input axis (column *j* of P is measured with axis *j* up, §7.2.5).
+    meaningless). The only reading.
+``A.5`` — ``"FS_a/omega^2"`` (primary), ``"g/(rad/s)^2"``, ``"(m/s^2)/(rad/s)^2"``
+    A fraction of the accelerometer full scale per squared test rate, ``FS_a/ω²``
+    ((m/s²)/(rad/s)²), since eq. (A.10) divides outputs (fractions of FS_a) by ω²; ω is the rate
+    of the rotating ("U8") ``omega_squared`` segment of the schedule about the parameter's input
+    axis (column *j* of P is measured with axis *j* up, §7.2.5). Or g per (rad/s)² (outputs in g,
+    ``g = g_ref``), or the SI unit of p.
 
-:func:`reading_unit_in_si` gives the SI size of one reading unit and :func:`errors_in_reading_units`
-converts errors; :func:`printed_arithmetic_slips` lists the slips in words.
+:func:`reading_unit_in_si` gives the SI size of one unit of a reading (the primary one unless
+``reading=`` names another) and :func:`errors_in_reading_units` converts errors;
+:func:`printed_arithmetic_slips` lists the slips in words.
 :func:`plansim.uncertainty.appendix_a_comparison.compare_with_appendix_a` compares Monte Carlo errors
-with each budget.
+with each budget, under every reading.
 """
 
 from __future__ import annotations
@@ -79,6 +87,7 @@ from decimal import Decimal
 import numpy as np
 
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, parameter
+from plansim.units import DEG, HOUR
 
 __all__ = [
     "ACQUISITION_BITS",
@@ -88,6 +97,7 @@ __all__ = [
     "TABLE_COVERAGE_FACTOR",
     "TABLE_EXPANDED_UNCERTAINTY",
     "AppendixABudget",
+    "Reading",
     "UncertaintyComponent",
     "acquisition_quantisation_uncertainty",
     "appendix_a_budget",
@@ -95,6 +105,7 @@ __all__ = [
     "expanded_uncertainty_in_si",
     "omega_squared_test_rate",
     "printed_arithmetic_slips",
+    "reading_si_unit",
     "reading_unit_description",
     "reading_unit_in_si",
 ]
@@ -109,23 +120,69 @@ ACQUISITION_BITS = 12
 #: ``"single"``: one value; ``"linear_sum"``: ``u = Σ u(U_i) = count × value`` (A.2.2.3, A.3.2.3, A.5.2.3).
 COMBINATION_RULES = ("single", "linear_sum")
 
-#: The unit readings of the budgets (see the module docstring).
+#: How the SI size of one unit of a reading is obtained (module docstring; :func:`reading_unit_in_si`):
+#: ``|truth|``, 1, ``FS_g``, ``FS_g/g_ref``, ``FS_a/ω²``, 1 (the parameter's SI unit), ``π/180``,
+#: ``(π/180)/g_ref``, ``(π/180/3600)/g_ref`` and ``g_ref``.
 READING_KINDS = (
     "relative",
     "absolute",
     "gyro_full_scale",
     "gyro_full_scale_per_reference_gravity",
     "accel_full_scale_per_rate_squared",
+    "si",
+    "degree_per_second",
+    "degree_per_second_per_reference_gravity",
+    "degree_per_hour_per_reference_gravity",
+    "reference_gravity_per_rate_squared",
 )
 
-#: Display unit of each reading, for reports.
-_READING_UNIT_SYMBOL = {
-    "relative": "1 (relative error, error / true value)",
-    "absolute": "1 (absolute error of the dimensionless coefficient)",
-    "gyro_full_scale": "FS_g (gyro full scale)",
-    "gyro_full_scale_per_reference_gravity": "FS_g/g_ref (gyro full scale per reference g)",
-    "accel_full_scale_per_rate_squared": "FS_a/ω² (accelerometer full scale per squared test rate)",
+#: SI unit of one reading unit, by kind (None: dimensionless).
+_READING_SI_UNIT = {
+    "relative": None,
+    "absolute": None,
+    "gyro_full_scale": "rad/s",
+    "gyro_full_scale_per_reference_gravity": "rad/s per m/s^2",
+    "accel_full_scale_per_rate_squared": "(m/s^2)/(rad/s)^2",
+    "si": None,
+    "degree_per_second": "rad/s",
+    "degree_per_second_per_reference_gravity": "rad/s per m/s^2",
+    "degree_per_hour_per_reference_gravity": "rad/s per m/s^2",
+    "reference_gravity_per_rate_squared": "(m/s^2)/(rad/s)^2",
 }
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One reading of the unit in which an Appendix A budget's numbers are taken.
+
+    Attributes
+    ----------
+    name : str
+        Short name used in reports and JSON: ``"relative"``, ``"FS_g"``, ``"deg/s"``, ``"deg/h/g"``, …
+    kind : str
+        How the SI size of one unit is obtained, one of :data:`READING_KINDS`.
+    unit : str
+        The unit in words, for reports.
+    why : str
+        Why the reading is defensible.
+    """
+
+    name: str
+    kind: str
+    unit: str
+    why: str = ""
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"reading name = {self.name!r}: expected a non-empty string")
+        if self.kind not in READING_KINDS:
+            raise ValueError(f"reading {self.name!r}: kind = {self.kind!r}; "
+                             f"allowed: {', '.join(map(repr, READING_KINDS))}")
+
+    @property
+    def constant(self) -> bool:
+        """Whether one unit has the same SI size in every trial (all but ``"relative"``, which is ``|truth|``)."""
+        return self.kind != "relative"
 
 
 def acquisition_quantisation_uncertainty(bits: int = ACQUISITION_BITS) -> float:
@@ -252,9 +309,13 @@ class AppendixABudget:
     coverage_factor : float
         ``k`` (2 in every budget).
     reading_kind : str
-        The unit reading plansim uses (one of :data:`READING_KINDS`; module docstring).
+        The kind of the primary reading (one of :data:`READING_KINDS`; module docstring): the one
+        plansim's single-reading figures use.
     reading : str
-        The reading in words.
+        The primary reading in words.
+    readings : tuple of Reading
+        Every defensible reading of the budget's unit; the first is the primary one (its kind is
+        ``reading_kind``). Names are unique.
     """
 
     item: str
@@ -267,6 +328,7 @@ class AppendixABudget:
     coverage_factor: float
     reading_kind: str
     reading: str
+    readings: tuple[Reading, ...]
 
     def __post_init__(self):
         where = f"budget {self.item!r}"
@@ -282,6 +344,15 @@ class AppendixABudget:
         if self.reading_kind not in READING_KINDS:
             raise ValueError(f"{where}: reading_kind = {self.reading_kind!r}; "
                              f"allowed: {', '.join(map(repr, READING_KINDS))}")
+        if not isinstance(self.readings, tuple) or not self.readings \
+                or not all(isinstance(r, Reading) for r in self.readings):
+            raise TypeError(f"{where}: readings = {self.readings!r}; expected a non-empty tuple of Reading")
+        if self.readings[0].kind != self.reading_kind:
+            raise ValueError(f"{where}: readings[0] is {self.readings[0].name!r} of kind {self.readings[0].kind!r}; "
+                             f"the first reading is the primary one and must have reading_kind {self.reading_kind!r}")
+        names = [r.name for r in self.readings]
+        if len(set(names)) != len(names):
+            raise ValueError(f"{where}: readings {names!r} repeat a name")
         for name in ("printed_combined_standard_uncertainty", "printed_expanded_uncertainty", "coverage_factor"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -296,6 +367,19 @@ class AppendixABudget:
                 return c
         raise ValueError(f"budget {self.item!r} has no component {symbol!r}; "
                          f"it has {', '.join(repr(c.symbol) for c in self.components)}")
+
+    @property
+    def primary_reading(self) -> Reading:
+        """The first of :attr:`readings`: the reading of ``reading_kind``."""
+        return self.readings[0]
+
+    def reading_named(self, name: str) -> Reading:
+        """The reading called *name* (e.g. ``"deg/s"``); ValueError listing the budget's readings otherwise."""
+        for r in self.readings:
+            if r.name == name:
+                return r
+        raise ValueError(f"budget {self.item!r} has no reading {name!r}; "
+                         f"its readings: {', '.join(repr(r.name) for r in self.readings)}")
 
     def recomputed_combined_standard_uncertainty(self) -> float:
         """``u_c = sqrt(u1² + u2² + u3²)`` from the printed components (A.1.3 … A.5.3).
@@ -336,6 +420,42 @@ def _scale_factor_repeatability_component(clause: str) -> UncertaintyComponent:
     )
 
 
+_RELATIVE = Reading(
+    "relative", "relative", "1 (relative error, error / true value)",
+    "u1 is the table's relative rate error and u2 a fraction of full scale, which the maximum rate point "
+    "(§7.2.1.1 c)) approaches: the three components are relative errors of K")
+_K_ABSOLUTE = Reading(
+    "absolute", "absolute", "1 (absolute error of the dimensionless scale factor)",
+    "K is dimensionless and close to 1, so K̂ − K is the relative error times |K|; kept so that the report "
+    "shows that no verdict hinges on |K| − 1")
+_COEFFICIENT_ABSOLUTE = Reading(
+    "absolute", "absolute", "1 (absolute error of the dimensionless coefficient)",
+    "A.4.1 propagates as the scale factor; a relative error of a coefficient near 0 means nothing")
+_GYRO_READINGS = {
+    "FS_g": Reading("FS_g", "gyro_full_scale", "FS_g (gyro full scale)",
+                    "the outputs U_gxi, and u2 of eq. (A.3), are fractions of the acquisition full scale"),
+    "deg/s": Reading("deg/s", "degree_per_second", "°/s",
+                     "the outputs in °/s, the unit of the specification's rates (clause 1, §7.2.1.1)"),
+}
+_G_SENSITIVITY_READINGS = (
+    Reading("FS_g/g", "gyro_full_scale_per_reference_gravity", "FS_g/g_ref (gyro full scale per reference g)",
+            "eq. (A.6) divides outputs (fractions of FS_g) by the 2 g span of matrix A, eq. (6)"),
+    Reading("deg/s/g", "degree_per_second_per_reference_gravity", "°/s per g (g = g_ref)",
+            "outputs in °/s divided by the 2 g span of matrix A"),
+    Reading("deg/h/g", "degree_per_hour_per_reference_gravity", "°/h per g (g = g_ref)",
+            "the unit in which MEMS data sheets (and plansim's tables) give a g-sensitivity"),
+)
+_RATE_SENSITIVITY_READINGS = (
+    Reading("FS_a/omega^2", "accel_full_scale_per_rate_squared",
+            "FS_a/ω² (accelerometer full scale per squared test rate)",
+            "eq. (A.10) divides outputs (fractions of FS_a) by ω²"),
+    Reading("g/(rad/s)^2", "reference_gravity_per_rate_squared", "g per (rad/s)² (g = g_ref)",
+            "outputs in g divided by ω² in (rad/s)²"),
+    Reading("(m/s^2)/(rad/s)^2", "si", "(m/s²)/(rad/s)² (the SI unit of p)",
+            "outputs in m/s² divided by ω² in (rad/s)²"),
+)
+
+
 #: The five budgets of JJF 2003-2022 Appendix A, as printed.
 APPENDIX_A: tuple[AppendixABudget, ...] = (
     AppendixABudget(
@@ -353,6 +473,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         coverage_factor=2.0,
         reading_kind="relative",
         reading="relative error of the scale factor, (estimate − truth)/truth (dimensionless)",
+        readings=(_RELATIVE, _K_ABSOLUTE),
     ),
     AppendixABudget(
         item="A.2",
@@ -374,6 +495,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         coverage_factor=2.0,
         reading_kind="gyro_full_scale",
         reading="gyro bias error as a fraction of the gyro full scale (U_abs = U × FS_g, rad/s)",
+        readings=(_GYRO_READINGS["FS_g"], _GYRO_READINGS["deg/s"]),
     ),
     AppendixABudget(
         item="A.3",
@@ -396,6 +518,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         reading_kind="gyro_full_scale_per_reference_gravity",
         reading="g-sensitivity error as a fraction of the gyro full scale per g "
                 "(U_abs = U × FS_g / g_ref, rad/s per m/s²)",
+        readings=_G_SENSITIVITY_READINGS,
     ),
     AppendixABudget(
         item="A.4",
@@ -412,6 +535,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         coverage_factor=2.0,
         reading_kind="absolute",
         reading="absolute error of the dimensionless cross-coupling coefficient, estimate − truth",
+        readings=(_COEFFICIENT_ABSOLUTE,),
     ),
     AppendixABudget(
         item="A.5",
@@ -435,6 +559,7 @@ APPENDIX_A: tuple[AppendixABudget, ...] = (
         reading_kind="accel_full_scale_per_rate_squared",
         reading="rate-sensitivity error as a fraction of the accelerometer full scale per squared test rate "
                 "(U_abs = U × FS_a / ω², (m/s²)/(rad/s)²)",
+        readings=_RATE_SENSITIVITY_READINGS,
     ),
 )
 
@@ -493,31 +618,55 @@ def _budget_for(budget: AppendixABudget, parameter_name: str) -> int:
     return PARAMETER_INDEX[parameter_name]
 
 
-def reading_unit_in_si(budget: AppendixABudget, parameter_name: str, scenario, truth=None):
-    """The SI size of one unit of the budget's reading, for one parameter.
+def _reading_of(budget: AppendixABudget, reading) -> Reading:
+    """*reading* of *budget*: None (the primary one), a :class:`Reading` of the budget, or its name."""
+    if reading is None:
+        return budget.primary_reading
+    if isinstance(reading, Reading):
+        if reading not in budget.readings:
+            raise ValueError(f"reading {reading.name!r} is not a reading of budget {budget.item}; its readings: "
+                             f"{', '.join(repr(r.name) for r in budget.readings)}")
+        return reading
+    if isinstance(reading, str):
+        return budget.reading_named(reading)
+    raise TypeError(f"reading = {reading!r}: expected None (the primary reading), a Reading of budget "
+                    f"{budget.item} or its name ({', '.join(repr(r.name) for r in budget.readings)})")
+
+
+def _reference_gravity(scenario, budget: AppendixABudget) -> float:
+    return _positive(scenario.reduction.reference_gravity, "reduction.reference_gravity",
+                     f"to read {budget.item} per g")
+
+
+def reading_unit_in_si(budget: AppendixABudget, parameter_name: str, scenario, truth=None, reading=None):
+    """The SI size of one unit of a reading of the budget, for one parameter.
 
     Parameters
     ----------
     budget : AppendixABudget
-        The budget (its ``reading_kind`` selects the reading, module docstring).
+        The budget.
     parameter_name : str
         One of ``budget.parameters``.
     scenario : plansim.config.Scenario
-        Supplies ``acquisition.gyro_full_scale`` (A.2, A.3), ``reduction.reference_gravity`` (A.3),
-        ``acquisition.accel_full_scale`` and the ω² test rate (A.5).
+        Supplies ``acquisition.gyro_full_scale`` (FS_g readings), ``reduction.reference_gravity``
+        (readings per g or in g), ``acquisition.accel_full_scale`` and the ω² test rate (FS_a/ω²).
     truth : float or array, optional
         True value(s) of the parameter, needed only by the relative reading (A.1); default the
         scenario's nominal truth.
+    reading : None, Reading or str, optional
+        Which of ``budget.readings`` (default the primary one, ``budget.readings[0]``).
 
     Returns
     -------
     float or ndarray
-        ``|truth|`` (A.1), 1 (A.4), ``FS_g`` rad/s (A.2), ``FS_g/g_ref`` rad/s per m/s² (A.3) or
-        ``FS_a/ω²`` (m/s²)/(rad/s)² (A.5): an error of ``e`` reading units is ``e × this`` in SI.
+        By the reading's kind: ``|truth|`` (relative), 1 (absolute, si), ``FS_g`` rad/s,
+        ``FS_g/g_ref`` rad/s per m/s², ``FS_a/ω²`` (m/s²)/(rad/s)², ``π/180`` rad/s (°/s),
+        ``(π/180)/g_ref`` and ``(π/180/3600)/g_ref`` rad/s per m/s² (°/s/g, °/h/g), ``g_ref``
+        (m/s²)/(rad/s)² (g/(rad/s)²): an error of ``e`` reading units is ``e × this`` in SI.
     """
     index = _budget_for(budget, parameter_name)
-    kind = budget.reading_kind
-    if kind == "absolute":
+    kind = _reading_of(budget, reading).kind
+    if kind in ("absolute", "si"):
         return 1.0
     if kind == "relative":
         value = scenario.truth_nominal[index] if truth is None else truth
@@ -526,15 +675,21 @@ def reading_unit_in_si(budget: AppendixABudget, parameter_name: str, scenario, t
             raise ValueError(f"truth of {parameter_name} = {value!r}: the relative reading of {budget.item} "
                              "divides by the true value, which must be finite and non-zero")
         return float(magnitude) if magnitude.ndim == 0 else magnitude
+    if kind == "degree_per_second":
+        return DEG
+    if kind == "degree_per_second_per_reference_gravity":
+        return DEG / _reference_gravity(scenario, budget)
+    if kind == "degree_per_hour_per_reference_gravity":
+        return DEG / HOUR / _reference_gravity(scenario, budget)
+    if kind == "reference_gravity_per_rate_squared":
+        return _reference_gravity(scenario, budget)
     if kind == "gyro_full_scale":
         return _positive(scenario.acquisition.gyro_full_scale, "acquisition.gyro_full_scale",
                          f"to read {budget.item} as a fraction of the gyro full scale")
     if kind == "gyro_full_scale_per_reference_gravity":
         fs = _positive(scenario.acquisition.gyro_full_scale, "acquisition.gyro_full_scale",
                        f"to read {budget.item} as a fraction of the gyro full scale per g")
-        g = _positive(scenario.reduction.reference_gravity, "reduction.reference_gravity",
-                      f"to read {budget.item} per g")
-        return fs / g
+        return fs / _reference_gravity(scenario, budget)
     # accel_full_scale_per_rate_squared
     fs = _positive(scenario.acquisition.accel_full_scale, "acquisition.accel_full_scale",
                    f"to read {budget.item} as a fraction of the accelerometer full scale per ω²")
@@ -542,49 +697,57 @@ def reading_unit_in_si(budget: AppendixABudget, parameter_name: str, scenario, t
     return fs / omega**2
 
 
-def errors_in_reading_units(budget: AppendixABudget, parameter_name: str, error, scenario, truth=None) -> np.ndarray:
-    """Convert SI errors ``estimate − truth`` of one parameter into the budget's reading units.
+def errors_in_reading_units(budget: AppendixABudget, parameter_name: str, error, scenario, truth=None,
+                            reading=None) -> np.ndarray:
+    """Convert SI errors ``estimate − truth`` of one parameter into the units of a reading of the budget.
 
     Parameters
     ----------
-    budget, parameter_name, scenario, truth
-        As in :func:`reading_unit_in_si` (*truth* broadcasts against *error* for A.1).
+    budget, parameter_name, scenario, truth, reading
+        As in :func:`reading_unit_in_si` (*truth* broadcasts against *error* for the relative reading).
     error : array_like
         Errors in SI (:mod:`plansim.model.parameters` units).
 
     Returns
     -------
     ndarray
-        ``error / reading_unit_in_si(...)``: relative error (A.1), absolute error (A.4), fraction of
-        ``FS_g`` (A.2), of ``FS_g/g_ref`` (A.3), of ``FS_a/ω²`` (A.5).
+        ``error / reading_unit_in_si(...)``: e.g. the relative error (A.1), a fraction of ``FS_g``
+        (A.2, primary) or °/s (A.2, ``reading="deg/s"``).
     """
     error = np.asarray(error, dtype=float)
-    return error / reading_unit_in_si(budget, parameter_name, scenario, truth)
+    return error / reading_unit_in_si(budget, parameter_name, scenario, truth, reading)
 
 
-def expanded_uncertainty_in_si(budget: AppendixABudget, parameter_name: str, scenario, truth=None):
-    """The printed ``U`` of *budget* expressed in SI for one parameter: ``U × reading_unit_in_si``.
+def expanded_uncertainty_in_si(budget: AppendixABudget, parameter_name: str, scenario, truth=None, reading=None):
+    """The printed ``U`` of *budget* in SI for one parameter, in one reading: ``U × reading_unit_in_si``.
 
-    For A.1 (relative) the result scales with the true scale factor (default: the scenario's nominal truth).
+    For the relative reading (A.1) the result scales with the true scale factor (default: the
+    scenario's nominal truth).
     """
-    return budget.printed_expanded_uncertainty * reading_unit_in_si(budget, parameter_name, scenario, truth)
+    return budget.printed_expanded_uncertainty * reading_unit_in_si(budget, parameter_name, scenario, truth, reading)
 
 
-def reading_unit_description(budget: AppendixABudget, scenario) -> str:
-    """The unit of the budget's reading in words, with its SI size in *scenario* where it has one."""
+def reading_si_unit(budget: AppendixABudget, reading=None) -> str | None:
+    """The SI unit of one unit of a reading (``"rad/s"``, …), None for a dimensionless one (relative, absolute, si)."""
     if not isinstance(budget, AppendixABudget):
         raise TypeError(f"budget = {budget!r}: expected an AppendixABudget")
-    symbol = _READING_UNIT_SYMBOL[budget.reading_kind]
-    kind = budget.reading_kind
-    if kind in ("relative", "absolute"):
-        return symbol
-    sizes = {reading_unit_in_si(budget, name, scenario) for name in budget.parameters}
-    si = {"gyro_full_scale": "rad/s", "gyro_full_scale_per_reference_gravity": "rad/s per m/s^2",
-          "accel_full_scale_per_rate_squared": "(m/s^2)/(rad/s)^2"}[kind]
+    return _READING_SI_UNIT[_reading_of(budget, reading).kind]
+
+
+def reading_unit_description(budget: AppendixABudget, scenario, reading=None) -> str:
+    """The unit of a reading in words (default the primary one), with its SI size in *scenario* where it has one."""
+    if not isinstance(budget, AppendixABudget):
+        raise TypeError(f"budget = {budget!r}: expected an AppendixABudget")
+    chosen = _reading_of(budget, reading)
+    si = _READING_SI_UNIT[chosen.kind]
+    if si is None:
+        return chosen.unit
+    sizes = {reading_unit_in_si(budget, name, scenario, reading=chosen) for name in budget.parameters}
     if len(sizes) == 1:
-        return f"{symbol} = {sizes.pop():.6g} {si}"
-    listing = ", ".join(f"{name}: {reading_unit_in_si(budget, name, scenario):.6g}" for name in budget.parameters)
-    return f"{symbol}, in {si} per parameter ({listing})"
+        return f"{chosen.unit} = {sizes.pop():.6g} {si}"
+    listing = ", ".join(f"{name}: {reading_unit_in_si(budget, name, scenario, reading=chosen):.6g}"
+                        for name in budget.parameters)
+    return f"{chosen.unit}, in {si} per parameter ({listing})"
 
 
 # ----------------------------------------------------------------------------- the printed arithmetic, in words

@@ -16,7 +16,10 @@
    (default: the Appendix A budgets as printed, :mod:`plansim.uncertainty.claims`), with the
    verdict of :func:`plansim.uncertainty.metrology.coverage_verdict`;
 5. for Appendix A items A.1–A.5: the printed, recomputed and GUM-recombined budgets (the slips of
-   :func:`plansim.uncertainty.appendix_a.printed_arithmetic_slips`) next to what this schedule achieves;
+   :func:`plansim.uncertainty.appendix_a.printed_arithmetic_slips`) next to what this schedule achieves,
+   and — where the item's claim is a bare number (Appendix A as printed, or a claims file's
+   ``[items."A.x"]``) — its coverage and verdict under every reading of the item's unit
+   (``AppendixABudget.readings``), with whether the verdict holds under every reading;
 6. JCGM 102: the correlation matrix of the estimated parameters and the joint 95 % region of the
    3×3 Kg against the box of its nine marginal ``k = 2`` intervals.
 
@@ -34,13 +37,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from plansim.config import Scenario
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, parameter
 from plansim.uncertainty.appendix_a import (
     APPENDIX_A,
     printed_arithmetic_slips,
     reading_unit_description,
     reading_unit_in_si,
 )
+from plansim.uncertainty.appendix_a_comparison import HOLDS_UNDER_EVERY_READING, ReadingComparison, reading_dependence
 from plansim.uncertainty.budget import GumEvaluation, ParameterBudget
 from plansim.uncertainty.claims import Claim, appendix_a_claims
 from plansim.uncertainty.gum import evaluate_gum
@@ -130,7 +134,13 @@ class ParameterValidation:
 class AppendixItemCheck:
     """An Appendix A budget: as printed, recomputed, recombined by the GUM, and achieved by this schedule.
 
-    All uncertainties in the item's reading unit (``reading_unit``).
+    All uncertainties in the item's primary reading unit (``reading_unit``). ``readings`` judges the
+    claimed number in every reading of the item's unit (the first is the primary one, whose
+    coverage and verdict are ``coverage`` and ``verdict``): ``budget_U_si`` is the claimed number in
+    that reading converted to SI, ``mc_U95`` the Monte Carlo's ``|E|`` quantile at the claim's
+    probability in the reading, and the verdict is :func:`plansim.uncertainty.metrology.coverage_verdict`'s.
+    Empty when the claim states its unit (a claims file's ``[parameters.<name>]``): there is no
+    reading to choose then.
     """
 
     item: str
@@ -148,11 +158,19 @@ class AppendixItemCheck:
     mcm_U95: tuple[float, ...]
     coverage: float
     verdict: str
+    readings: tuple[ReadingComparison, ...] = ()
+
+    @property
+    def reading_dependence(self) -> str:
+        """``"holds under every reading"`` or ``"depends on the reading"`` (one reading, or none: holds)."""
+        return reading_dependence(r.verdict for r in self.readings) if self.readings else HOLDS_UNDER_EVERY_READING
 
     def as_dict(self) -> dict:
         d = dataclasses.asdict(self)
         for key in ("parameters", "slips", "gum_U95", "mcm_U95"):
             d[key] = list(d[key])
+        d["readings"] = [r.as_dict() for r in self.readings]
+        d["reading_dependence"] = self.reading_dependence
         return d
 
 
@@ -302,6 +320,10 @@ def _appendix_item_checks(scenario: Scenario, gum: GumEvaluation, errors: np.nda
         probability = probabilities.pop()
         needed = float(np.quantile(pooled, probability))
         verdict, _ = coverage_verdict(covered, pooled.size, probability, claimed_U, needed)
+        readings = ()
+        if all(_claim_is_a_bare_number(c, budget.item) for c in item_claims):
+            readings = tuple(_reading_check(budget, reading, scenario, abs_errors, idx, claimed_U, probability)
+                             for reading in budget.readings)
         same = math.sqrt(sum(c.gum_standard_uncertainty**2 for c in budget.components))
         items.append(AppendixItemCheck(
             item=budget.item, quantity=budget.quantity, reading_unit=reading_unit_description(budget, scenario),
@@ -311,8 +333,30 @@ def _appendix_item_checks(scenario: Scenario, gum: GumEvaluation, errors: np.nda
             slips=printed_arithmetic_slips(budget), claimed_U=claimed_U,
             gum_U95=tuple(float(gum.budgets[k].expanded_uncertainty / u) for k, u in zip(idx, units)),
             mcm_U95=tuple(float(np.quantile(abs_errors[:, k], coverage_probability) / u) for k, u in zip(idx, units)),
-            coverage=covered, verdict=verdict))
+            coverage=covered, verdict=verdict, readings=readings))
     return tuple(items)
+
+
+def _claim_is_a_bare_number(claim: Claim, item: str) -> bool:
+    """Whether *claim* is a number without a unit for *item*: Appendix A as printed
+    (:func:`plansim.uncertainty.claims.appendix_a_claims`) or a claims file's ``[items."A.x"]``
+    (:func:`plansim.uncertainty.claims.parse_claims`), as their ``source`` says."""
+    return claim.source == f"Appendix A {item} (printed)" or f"[items.{item}]" in claim.source
+
+
+def _reading_check(budget, reading, scenario: Scenario, abs_errors: np.ndarray, idx, claimed: float,
+                   probability: float) -> ReadingComparison:
+    """The claimed number *claimed* of one item read in *reading*: its coverage of the truth and the verdict."""
+    units = np.array([float(reading_unit_in_si(budget, name, scenario, reading=reading)) for name in budget.parameters])
+    pooled = np.concatenate([abs_errors[:, k] / u for k, u in zip(idx, units)])
+    covered = float(np.mean(pooled <= claimed))
+    needed = float(np.quantile(pooled, probability))
+    verdict, factor = coverage_verdict(covered, pooled.size, probability, claimed, needed)
+    return ReadingComparison(
+        reading=reading.name, unit=reading_unit_description(budget, scenario, reading),
+        si_unit=parameter(budget.parameters[0]).si_unit, unit_in_si=tuple(float(u) for u in units),
+        budget_U_si=tuple(float(claimed * u) for u in units), coverage=covered, mc_U95=needed,
+        mc_U95_si=needed * float(np.mean(units)), overstatement_factor=factor, verdict=verdict)
 
 
 def validate(scenario: Scenario, simulate: Simulate, claims: Mapping[str, Claim] | None = None, *,
