@@ -1,4 +1,4 @@
-"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``bench``.
+"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``import``, ``bench``.
 
 Errors in the user's input end with ``plansim: error: …`` and exit status 2, before any work starts:
 output paths are checked first (:func:`plansim.io.files.check_output_path`). The output files of one
@@ -193,6 +193,62 @@ def _cmd_record(args) -> int:
     return 0
 
 
+def _cmd_import(args) -> int:
+    from plansim.io.log_import import format_summary, import_log
+    from plansim.io.recording import write_recording
+    from plansim.io.recording_csv import segment_table_path
+
+    target = check_output_path(args.out, "--out", (".nc", ".csv"))
+    outputs = [target]
+    if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
+        outputs.append(check_output_path(segment_table_path(target), "--out's segment table"))
+    if any(os.path.exists(args.log) and os.path.exists(out) and os.path.samefile(args.log, out) for out in outputs):
+        raise ValueError(f"--out {args.out!r} would overwrite the log {args.log!r}; write the recording elsewhere")
+    columns = None if args.columns is None else tuple(name.strip() for name in args.columns.split(","))
+    options = {name: getattr(args, name) for name in ("window", "min_static") if getattr(args, name) is not None}
+    result = import_log(args.log, columns=columns, time_column=args.time, time_unit=args.time_unit,
+                        units=args.units, scale=args.scale, sample_rate=args.sample_rate,
+                        temperature_column=args.temperature_column, temperature=args.temperature,
+                        latitude=args.latitude, height=args.height, **options)
+    write_recording(result.recording, args.out)  # whole or not at all
+    print(format_summary(result))
+    print(f"\nwrote recording: {args.out} (review its segment table: docs/measured-data.md)")
+    return 0
+
+
+def _add_import_command(sub) -> None:
+    p = sub.add_parser(
+        "import", help=COMMANDS["import"],
+        description="Read a plain CSV log (six channels; a time column or a sample rate) and write a recording "
+                    "whose segment table (static poses, rotations, moves) is found from the data, for you to "
+                    "review (docs/measured-data.md)")
+    p.add_argument("log", help="the CSV log: a header line of column names, one row per sample")
+    p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
+    p.add_argument("--time", default=None, metavar="COL", help="the time column (default: none; give --sample-rate)")
+    p.add_argument("--time-unit", default="s", choices=("s", "ms", "us", "ns", "samples"),
+                   help="unit of the time column (samples: a sample counter, with --sample-rate); default s")
+    p.add_argument("--columns", default=None, metavar="GX,GY,GZ,AX,AY,AZ",
+                   help="the six channel columns in this order (default gx,gy,gz,ax,ay,az); other columns are "
+                        "then ignored")
+    p.add_argument("--units", default=None,
+                   help="the channels' units: gyro,accelerometer (e.g. deg/s,m/s^2) or one per channel; with "
+                        "--scale, the unit the counts are per; default rad/s,m/s^2")
+    p.add_argument("--scale", default=None,
+                   help="counts per unit, gyro,accelerometer or one per channel (e.g. 16.4,2048 with --units deg/s,g)")
+    p.add_argument("--sample-rate", type=float, default=None, metavar="HZ",
+                   help="sample rate; required without --time (default: from the time column)")
+    p.add_argument("--temperature-column", default=None, metavar="COL", help="a temperature column in degC")
+    p.add_argument("--temperature", type=float, default=None, metavar="DEGC",
+                   help="the lab's temperature, for a log without a temperature column (default 20, noted as assumed)")
+    p.add_argument("--latitude", type=float, default=None, metavar="DEG", help="site latitude (site_latitude_deg)")
+    p.add_argument("--height", type=float, default=None, metavar="M", help="site height (site_height_m)")
+    p.add_argument("--window", type=float, default=None, metavar="S",
+                   help="window of the rest detector (default 0.5 s)")
+    p.add_argument("--min-static", type=float, default=None, metavar="S",
+                   help="shortest static pose kept (default 1 s)")
+    p.set_defaults(func=_cmd_import)
+
+
 def _cmd_validate(args) -> int:
     from plansim.io.claims import load_claims
     from plansim.io.scenario_file import load_scenario
@@ -273,6 +329,7 @@ COMMANDS = {
     "validate": "GUM budgets validated by adaptive Monte Carlo",
     "scenarios": "list the built-in scenarios",
     "record": "write one simulated trial's raw samples",
+    "import": "a plain CSV log to a recording with segments",
     "bench": "measure speed and memory on this machine",
 }
 
@@ -327,6 +384,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None)
     p.add_argument("--trial", type=int, default=0, help="which trial of the seed's Monte Carlo to record")
     p.set_defaults(func=_cmd_record)
+
+    _add_import_command(sub)
 
     p = sub.add_parser("bench", help=COMMANDS["bench"],
                        description="Measure speed and memory on this machine (takes a few minutes)")

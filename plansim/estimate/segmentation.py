@@ -1,0 +1,598 @@
+"""Static poses and the motion between them, found in a raw IMU log from the data alone.
+
+A plain log is a stream of six channels (gyros in rad/s, accelerometers in m/s²) with no segment
+table. :func:`segment_log` finds where the unit was at rest and what happened in between, with
+thresholds set by the log's own noise, so the same settings serve a consumer MEMS unit and a tactical
+one (docs/measured-data.md describes the method and how its false alarms were calibrated).
+
+The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES``; *h* = w // 2):
+
+1. **Moving statistics.** The mean and variance of every channel over a window of *w* samples centred
+   on each sample (truncated at the ends of the log).
+2. **Resolution.** Each channel's step: the smallest non-zero difference between two consecutive
+   samples. A quantised channel cannot show noise below step/√12, so that is its noise floor.
+3. **Quietest stretch.** ``Q``, the stretch of ``max(min_static, 4 windows)`` without a time gap where
+   the sum over the channels of (moving variance / that channel's median moving variance over the log)
+   is smallest. It is taken to be at rest.
+4. **Noise.** In ``Q``: per channel σ = √(median of the moving variance / median of χ²(w−1)/w) (the
+   robust standard deviation of one sample, at least the quantisation floor; the MAD of the samples would
+   be 0 for a channel quantised to about its noise), the gyro bias b (the mean of the clipped samples, see
+   below) and the noise of a *w*-sample gyro
+   mean, s = 1.4826 · MAD(m(t + w) − m(t)) / √2 (a robust overlapping Allan deviation at τ = *w*
+   samples; at least σ/√w, which it equals for white noise, and larger for correlated noise).
+5. **Quiet samples.** A sample is quiet when, over its window, Σ_accel var/σ² ≤ ``VARIANCE_FACTOR`` × 3
+   and Σ_gyro var/σ² ≤ ``VARIANCE_FACTOR`` × 3 (3 is the expected sum at rest), and no time gap lies
+   within *h* samples. Runs of at least ``min_static`` seconds of quiet samples are kept if they hold one
+   pose: the mean specific force of their first and last windows differ by at most ``RATE_FACTOR`` √2
+   times the noise of a window mean plus ``POSE_TOLERANCE`` (0.5°) of gravity on each axis (a unit
+   tumbling smoothly can be as quiet as its own quietest stretch, but its gravity turns).
+6. **At rest or turning steadily?** A quiet run is at rest unless its mean gyro output differs from b by
+   more than ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to
+   ±Ω_E on any axis, depending on its pose); otherwise it is a *steady turn* (a rate table holding a
+   rate), and belongs to the motion around it. A turn slower than that threshold cannot be told from
+   rest by any detector without a reference; the threshold is reported.
+7. **Poses.** Each static span's up axis is the body axis nearest its mean specific force; the tilt is
+   the angle between the two. The heading cannot be told without a heading reference: it is not
+   reported.
+8. **Motion.** Between two static spans, the gyro output less the bias (interpolated linearly in time
+   between the two spans' mean gyro outputs) is integrated over time. The motion is a *rotation* when
+   (a) the integral lies along one body axis (the other two components together at most
+   ``OFF_AXIS_FRACTION`` of it), (b) it is within ``10° + 5 %`` of a whole number of quarter turns (the
+   nominal angle, not zero), (c) the unit ends with the same axis up as it started, and (d) the turn is
+   about the vertical (the axis within 20° of the mean specific force) or is a whole number of full
+   turns. Anything else is a *move*: the unit was carried from one pose to another and no reference
+   says by how much. A motion that holds a time gap or a saturated sample is a move too: its integral
+   is not known.
+9. **Steady rate.** Where a rotation holds one steady turn (step 6) of at least half its duration, its
+   measured rate is reported.
+10. **Saturation.** Two or more equal consecutive samples at a channel's largest or smallest value in the
+    log, outside the static spans, entered or left by a step of more than ``SATURATION_STEP`` σ, at a value
+    more than ``SATURATION_STEP`` σ + one step away from every level the channel holds while quiet (at
+    rest or turning steadily): a stretch stuck at a rail. A rate held beyond the range for a whole steady
+    turn reads as a steady turn at the rail value; no detector can tell it from the data alone.
+
+Every threshold is a multiple of the log's own noise; the multiples are module constants, chosen by
+simulation (tests/test_segmentation.py measures their false alarms on static noise of several kinds).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from plansim.model.environment import EARTH_RATE
+
+#: default window of the moving statistics, s
+DEFAULT_WINDOW = 0.5
+#: default shortest static span, s
+DEFAULT_MIN_STATIC = 1.0
+#: a window is quiet when its summed variance ratio (3 channels) is at most this many times its expected 3
+VARIANCE_FACTOR = 4.0
+#: ... or the quietest stretch's median variance ratio plus this many robust standard deviations of it, if larger
+SPREAD_FACTOR = 8.0
+#: samples are clipped to this many σ about the moving mean before the variances are taken (spikes)
+CLIP = 4.0
+#: a quiet run is a steady turn when its gyro output differs from the bias by more than this many
+#: window-mean noise standard deviations (plus twice the Earth rate)
+RATE_FACTOR = 6.0
+#: a window holds at least this many samples (fewer make the variance test too noisy)
+MIN_WINDOW_SAMPLES = 10
+#: a quiet run is one pose when its gravity direction turns by less than this from its first to its last window
+POSE_TOLERANCE = math.radians(0.5)
+#: the quietest stretch holds at least this many windows
+QUIET_WINDOWS = 8
+#: a rotation's integral lies along one body axis: the other two components at most this fraction of it
+OFF_AXIS_FRACTION = 0.1
+#: a rotation's integral is within this of its nominal angle: ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION × nominal
+ANGLE_TOLERANCE_RAD = math.radians(10.0)
+ANGLE_TOLERANCE_FRACTION = 0.05
+#: a rotation about the vertical: the axis within this angle of the mean specific force
+VERTICAL_AXIS_TOLERANCE = math.radians(20.0)
+#: a static pose is "approximate" (near a nominal pose) when its tilt from the nearest axis is at most this
+APPROXIMATE_TILT = math.radians(15.0)
+#: a time step longer than this many sample periods is a gap (at least one sample missing)
+GAP_FACTOR = 1.5
+#: a saturated stretch is entered or left by a step of more than this many σ
+SATURATION_STEP = 5.0
+#: robust standard deviation from the median absolute deviation of a normal distribution
+MAD_TO_SIGMA = 1.482602218505602
+
+AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class TimeReport:
+    """What a log's time axis says about its sampling.
+
+    Attributes
+    ----------
+    sample_rate : float
+        The nominal sample rate used, Hz (given, or estimated).
+    estimated_rate : float
+        1 / median time step, Hz (NaN without a time column).
+    jitter_rms, jitter_max : float
+        RMS and largest deviation of a time step from 1 / sample_rate, gaps excluded, s.
+    gaps : tuple of (int, float)
+        ``(k, dt)``: a gap of dt seconds before sample k (dt > GAP_FACTOR / sample_rate).
+    missing_samples : int
+        Samples missing in the gaps: Σ round(dt × sample_rate) − 1.
+    repeated : int
+        Time steps of exactly zero.
+    """
+
+    sample_rate: float
+    estimated_rate: float
+    jitter_rms: float
+    jitter_max: float
+    gaps: tuple[tuple[int, float], ...]
+    missing_samples: int
+    repeated: int
+
+    @property
+    def gap_starts(self) -> np.ndarray:
+        """Index of the first sample after each gap."""
+        return np.array([k for k, _ in self.gaps], dtype=np.int64)
+
+
+def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | None = None) -> TimeReport:
+    """The sample rate, jitter and gaps of a time axis (s, never decreasing), or of a given sample rate.
+
+    Parameters
+    ----------
+    time : (N,) array or None
+        Time of every sample, s; ``None``: a log without a time column (``sample_rate`` is then required).
+    samples : int
+        N, the number of samples.
+    sample_rate : float or None
+        The nominal rate, Hz; ``None``: 1 / the median time step.
+    """
+    if time is None:
+        if sample_rate is None:
+            raise ValueError("sample rate: a log without a time column needs the sample rate (Hz)")
+        return TimeReport(float(sample_rate), math.nan, 0.0, 0.0, (), 0, 0)
+    dt = np.diff(np.asarray(time, dtype=np.float64))
+    if dt.size and dt.min() < 0:
+        k = int(np.argmax(dt < 0)) + 1
+        raise ValueError(f"time decreases at sample {k} ({time[k - 1]!r} s then {time[k]!r} s)")
+    positive = dt[dt > 0]
+    if positive.size == 0:
+        raise ValueError("time: the time never advances; give the time column in seconds or the sample rate")
+    estimated = 1.0 / float(np.median(positive))
+    nominal = estimated if sample_rate is None else float(sample_rate)
+    period = 1.0 / nominal
+    gap = dt > GAP_FACTOR * period
+    gaps = tuple((int(k) + 1, float(dt[k])) for k in np.flatnonzero(gap))
+    missing = int(sum(max(round(d * nominal) - 1, 1) for _, d in gaps))
+    regular = dt[~gap] - period
+    jitter_rms = float(np.sqrt(np.mean(regular**2))) if regular.size else 0.0
+    jitter_max = float(np.max(np.abs(regular))) if regular.size else 0.0
+    return TimeReport(nominal, estimated, jitter_rms, jitter_max, gaps, missing, int(np.count_nonzero(dt == 0)))
+
+
+@dataclass(frozen=True)
+class NoiseFloor:
+    """The log's own noise, measured in its quietest stretch ``[start, stop)``.
+
+    ``sigma`` (6,): per-sample standard deviation (√ median moving variance, at least the quantisation floor), SI;
+    ``resolution`` (6,): each channel's smallest step, SI (0 if none); ``gyro_bias`` (3,): mean gyro
+    output (clipped samples), rad/s; ``window_sigma`` (3,): noise of a window's gyro mean, rad/s.
+    """
+
+    start: int
+    stop: int
+    sigma: np.ndarray
+    resolution: np.ndarray
+    gyro_bias: np.ndarray
+    window_sigma: np.ndarray
+
+
+@dataclass(frozen=True)
+class Span:
+    """One stretch ``[start, stop)`` of the log: ``kind`` is ``"static"``, ``"rotation"`` or ``"move"``.
+
+    Attributes
+    ----------
+    mean : (6,) array
+        Mean output over the span, SI.
+    up : str
+        Static: the body axis nearest the mean specific force. Motion: the up axis of the static span
+        before it (``""`` when there is none).
+    tilt : float
+        Static: angle between the mean specific force and ``up``, rad (NaN for motion).
+    integrated : (3,) array
+        Motion: ∫ (gyro − bias) dt over the span, rad (NaN when not known: a gap, a saturated sample, or no
+        static span on either side).
+    axis : int
+        Motion: the body axis (0, 1, 2) of the largest integrated component (−1 when not known).
+    angle : float
+        Rotation: the nominal angle about ``+axis``, rad, a whole number of quarter turns; NaN otherwise.
+    orientation : str
+        ``"approximate"`` (static: tilt ≤ APPROXIMATE_TILT; rotation: about the vertical) or ``"unknown"``.
+    steady_rate : float
+        Rotation: the measured steady rate about ``+axis``, rad/s; NaN when the turn is not steady.
+    reason : str
+        Why a motion is a move (empty for the others).
+    """
+
+    kind: str
+    start: int
+    stop: int
+    mean: np.ndarray
+    up: str = ""
+    tilt: float = math.nan
+    integrated: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
+    axis: int = -1
+    angle: float = math.nan
+    orientation: str = "unknown"
+    steady_rate: float = math.nan
+    reason: str = ""
+
+    @property
+    def samples(self) -> int:
+        return self.stop - self.start
+
+
+@dataclass(frozen=True)
+class Saturation:
+    """Channel ``channel`` (0–5) stuck at ``value`` (SI) over samples ``[start, stop)``."""
+
+    channel: int
+    start: int
+    stop: int
+    value: float
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """The result of :func:`segment_log`.
+
+    ``spans`` cover every sample of the log in order; ``noise`` is the noise floor; ``window`` and
+    ``min_static`` are in samples; ``variance_threshold`` the bounds on the summed variance ratios
+    (accelerometers, gyros) and
+    ``rate_threshold`` (3,) the gyro offset, rad/s, beyond which a quiet run is a steady turn;
+    ``saturation`` lists the stuck stretches; ``steady_turns`` the quiet runs that were steady turns.
+    """
+
+    spans: tuple[Span, ...]
+    noise: NoiseFloor
+    window: int
+    min_static: int
+    variance_threshold: tuple[float, float]
+    rate_threshold: np.ndarray
+    saturation: tuple[Saturation, ...]
+    steady_turns: tuple[tuple[int, int], ...]
+
+    def of_kind(self, kind: str) -> list[Span]:
+        return [span for span in self.spans if span.kind == kind]
+
+
+def moving_mean_variance(x: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and (population) variance of each column of *x* over *window* samples centred on each row.
+
+    At the ends of the log the window is truncated to the samples that exist. Returns two (N, C) arrays.
+    """
+    n = x.shape[0]
+    half = window // 2
+    lo = np.clip(np.arange(n) - half, 0, n)
+    hi = np.clip(np.arange(n) - half + window, 0, n)
+    centre = np.median(x, axis=0)
+    y = x - centre  # small numbers: the running sums keep their precision
+    s1 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(y, axis=0)])
+    s2 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(y * y, axis=0)])
+    count = (hi - lo)[:, None].astype(np.float64)
+    mean = (s1[hi] - s1[lo]) / count
+    variance = np.maximum((s2[hi] - s2[lo]) / count - mean * mean, 0.0)
+    return mean + centre, variance
+
+
+def resolution(x: np.ndarray) -> np.ndarray:
+    """Each column's smallest non-zero step between consecutive samples (0 when there is none)."""
+    steps = np.abs(np.diff(x, axis=0))
+    scale = np.max(np.abs(x), axis=0) + 1.0
+    out = np.zeros(x.shape[1])
+    for c in range(x.shape[1]):
+        nonzero = steps[:, c][steps[:, c] > 1e-12 * scale[c]]
+        out[c] = nonzero.min() if nonzero.size else 0.0
+    return out
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """``[start, stop)`` of every run of True in *mask*."""
+    edges = np.diff(np.concatenate(([0], mask.astype(np.int8), [0])))
+    return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
+
+
+def nearest_axis(vector: np.ndarray) -> tuple[str, float]:
+    """The signed body axis nearest *vector* (``"+x"`` …) and the angle between them, rad."""
+    j = int(np.argmax(np.abs(vector)))
+    norm = float(np.linalg.norm(vector))
+    tilt = math.acos(min(1.0, abs(float(vector[j])) / norm)) if norm > 0 else math.nan
+    return ("+" if vector[j] >= 0 else "-") + AXES[j], tilt
+
+
+def _rotate(vector: np.ndarray, axis: int, angle: float) -> np.ndarray:
+    """*vector* (body frame) seen after the body turns by *angle* about body axis *axis*."""
+    c, s = math.cos(angle), math.sin(angle)
+    i, k = (axis + 1) % 3, (axis + 2) % 3
+    out = vector.copy()
+    # the body turns by +angle, so a fixed vector turns by -angle in body coordinates
+    out[i] = c * vector[i] + s * vector[k]
+    out[k] = -s * vector[i] + c * vector[k]
+    return out
+
+
+def _quiet_stretch(ratio: np.ndarray, length: int, blocked: np.ndarray) -> int:
+    """Start of the *length*-sample stretch with the smallest summed *ratio*, avoiding *blocked* samples."""
+    n = ratio.shape[0]
+    score = np.where(blocked, np.inf, ratio)
+    finite = np.where(np.isfinite(score), score, 0.0)
+    sums = np.concatenate(([0.0], np.cumsum(finite)))
+    bad = np.concatenate(([0], np.cumsum(~np.isfinite(score))))
+    starts = np.arange(n - length + 1)
+    total = sums[starts + length] - sums[starts]
+    total[(bad[starts + length] - bad[starts]) > 0] = np.inf
+    best = int(np.argmin(total))
+    if not np.isfinite(total[best]):
+        raise ValueError(f"too few static samples: no stretch of {length} samples without a time gap to measure "
+                         "the noise in")
+    return best
+
+
+def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float, *,
+                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
+                gap_starts: np.ndarray | None = None) -> Segmentation:
+    """Find the static spans of a log and classify the motion between them (see the module docstring).
+
+    Parameters
+    ----------
+    samples : (N, 6) array
+        ``gx gy gz`` in rad/s, ``ax ay az`` in m/s², finite.
+    time : (N,) array or None
+        Time of every sample, s (never decreasing); ``None``: sample k at k / sample_rate.
+    sample_rate : float
+        Nominal sample rate, Hz.
+    window : float
+        Window of the moving statistics, s (at least MIN_WINDOW_SAMPLES samples are used).
+    min_static : float
+        Shortest static span, s.
+    gap_starts : (G,) int array or None
+        Samples that follow a gap in the time axis (:func:`analyse_time`); windows do not reach across them.
+
+    Returns
+    -------
+    Segmentation
+
+    Raises
+    ------
+    ValueError
+        Too few samples or no static span (too few static samples), naming what was looked for.
+    """
+    x = np.asarray(samples, dtype=np.float64)
+    if x.ndim != 2 or x.shape[1] != 6:
+        raise ValueError(f"samples: shape {x.shape}; expected (N, 6): gx gy gz (rad/s), ax ay az (m/s^2)")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("samples: every value must be finite")
+    if not (sample_rate > 0 and math.isfinite(sample_rate)):
+        raise ValueError(f"sample_rate = {sample_rate!r} Hz; expected a positive number")
+    for name, value in (("window", window), ("min_static", min_static)):
+        if not (value > 0 and math.isfinite(value)):
+            raise ValueError(f"{name} = {value!r} s; expected a positive number of seconds")
+    n = x.shape[0]
+    w = max(MIN_WINDOW_SAMPLES, int(round(window * sample_rate)))
+    half = w // 2
+    n_min = max(1, int(round(min_static * sample_rate)))
+    quiet_length = max(n_min, QUIET_WINDOWS * w)
+    if n < quiet_length:
+        raise ValueError(f"too few samples: the log has {n}; the noise is measured over a quiet stretch of "
+                         f"{quiet_length} samples ({quiet_length / sample_rate:.3g} s: max(min_static, "
+                         f"{QUIET_WINDOWS} windows of {window:g} s))")
+    times = np.arange(n) / sample_rate if time is None else np.asarray(time, dtype=np.float64)
+    gap_starts = np.zeros(0, dtype=np.int64) if gap_starts is None else np.asarray(gap_starts, dtype=np.int64)
+
+    # 1-2. moving statistics and resolution
+    mean, var = moving_mean_variance(x, w)
+    step = resolution(x)
+    floor = step / math.sqrt(12.0)
+    near_gap = np.zeros(n, dtype=bool)
+    for k in gap_starts:
+        near_gap[max(0, k - half - 1):min(n, k + half + 1)] = True
+
+    # 3. the quietest stretch
+    typical = np.maximum(np.median(var, axis=0), floor**2)
+    typical = np.where(typical > 0, typical, 1.0)
+    start = _quiet_stretch(np.sum(var / typical, axis=1), quiet_length, near_gap)
+    quiet = slice(start, start + quiet_length)
+
+    # 4. the noise in it; then once more with each sample clipped to CLIP σ about the nearer of the means of
+    # the w samples before it and the w samples after it, so that an isolated spike cannot make a window look
+    # like motion, while a step (near one of the two means) is not smeared and a ramp (the means follow it)
+    # still shows
+    sigma = _sigma(var[quiet], w, floor)
+    reference = _one_sided_reference(x, w)
+    clipped = np.clip(x, reference - CLIP * sigma, reference + CLIP * sigma)
+    mean, var = moving_mean_variance(clipped, w)
+    sigma = _sigma(var[quiet], w, floor)
+    # means, not medians: the median of a quantised channel jumps by whole steps
+    bias = clipped[quiet, :3].mean(axis=0)
+    lagged = mean[quiet][w:, :3] - mean[quiet][:-w, :3]
+    allan = MAD_TO_SIGMA * np.median(np.abs(lagged - np.median(lagged, axis=0)), axis=0) / math.sqrt(2.0)
+    window_sigma = np.maximum(allan, sigma[:3] / math.sqrt(w))
+    noise = NoiseFloor(start, start + quiet_length, sigma, step, bias, window_sigma)
+
+    # 5. quiet samples and runs: the threshold is VARIANCE_FACTOR × 3, or the quiet stretch's median ratio
+    # plus SPREAD_FACTOR robust standard deviations of it if larger (correlated or heavy-tailed noise)
+    thresholds = []
+    for group in (slice(3, 6), slice(0, 3)):
+        ratio = np.sum(var[:, group] / sigma[group] ** 2, axis=1)
+        in_quiet = ratio[quiet]
+        spread = MAD_TO_SIGMA * np.median(np.abs(in_quiet - np.median(in_quiet)))
+        thresholds.append((ratio, max(VARIANCE_FACTOR * 3.0, float(np.median(in_quiet) + SPREAD_FACTOR * spread))))
+    quiet_mask = ~near_gap
+    for ratio, threshold in thresholds:
+        quiet_mask &= ratio <= threshold
+    variance_threshold = (thresholds[0][1], thresholds[1][1])
+    runs = [(a, b) for a, b in _runs(quiet_mask) if b - a >= n_min]
+    # one pose from end to end: the specific force of the first and the last window agree (a unit tumbling
+    # smoothly can be as quiet as its own quietest stretch, but its gravity turns)
+    accel_window = sigma[3:] / math.sqrt(w)
+    one_pose = []
+    for a, b in runs:
+        first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
+        allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
+        one_pose.append(bool(np.all(np.abs(last - first) <= allowed)))
+    runs = [run for run, ok in zip(runs, one_pose) if ok]
+
+    # 6. rest or steady turn: each run against the nearest run at rest, outwards from the quiet stretch (a
+    # slow drift of the bias over a long log is not a turn)
+    rate_threshold = RATE_FACTOR * window_sigma + 2.0 * EARTH_RATE
+    medians = [clipped[a:b, :3].mean(axis=0) for a, b in runs]
+    at_rest = [False] * len(runs)
+    if runs:
+        first = min(range(len(runs)), key=lambda i: 0 if runs[i][0] <= start < runs[i][1]
+                    else min(abs(runs[i][0] - start), abs(runs[i][1] - start)))
+        # the run that holds the quiet stretch is at rest by assumption (step 3)
+        holds_quiet = runs[first][0] <= start and start + quiet_length <= runs[first][1]
+        at_rest[first] = holds_quiet or bool(np.all(np.abs(medians[first] - bias) <= rate_threshold))
+        for order in (range(first + 1, len(runs)), range(first - 1, -1, -1)):
+            reference = medians[first] if at_rest[first] else bias
+            for i in order:
+                at_rest[i] = bool(np.all(np.abs(medians[i] - reference) <= rate_threshold))
+                if at_rest[i]:
+                    reference = medians[i]
+    static_runs = [run for run, rest in zip(runs, at_rest) if rest]
+    steady = [run for run, rest in zip(runs, at_rest) if not rest]
+    if not static_runs:
+        longest = max((b - a for a, b in _runs(quiet_mask)), default=0)
+        raise ValueError(f"too few static samples: no span at rest of at least {min_static:g} s ({n_min} samples) "
+                         f"was found; the longest quiet stretch has {longest} samples ({longest / sample_rate:.3g} "
+                         f"s). Quiet: summed variance ratios <= {variance_threshold[0]:.3g} (accelerometers) and "
+                         f"{variance_threshold[1]:.3g} (gyros) over windows of {w} samples "
+                         "and the gyro output within the rest threshold (docs/measured-data.md)")
+
+    # 7-10. poses, motion, steady rates, saturation
+    statics = []
+    for a, b in static_runs:
+        m = x[a:b].mean(axis=0)
+        up, tilt = nearest_axis(m[3:])
+        statics.append(Span("static", a, b, m, up=up, tilt=tilt,
+                            orientation="approximate" if tilt <= APPROXIMATE_TILT else "unknown"))
+    saturation = _saturation(x, statics, steady, sigma, step)
+    spans: list[Span] = []
+    previous = None
+    for span in statics + [None]:
+        lo = 0 if previous is None else previous.stop
+        hi = n if span is None else span.start
+        if hi > lo:
+            spans.append(_motion(x, times, lo, hi, previous, span, gap_starts, saturation, steady))
+        if span is not None:
+            spans.append(span)
+        previous = span
+    return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
+                        tuple(steady))
+
+
+def _one_sided_reference(x: np.ndarray, w: int) -> np.ndarray:
+    """Per sample, whichever of the mean of the *w* samples before it and of the *w* after it is nearer it."""
+    n = x.shape[0]
+    centre = np.median(x, axis=0)
+    sums = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x - centre, axis=0)])
+    k = np.arange(n)
+    lo, hi = np.maximum(k - w, 0), np.minimum(k + 1 + w, n)
+    before = np.where((k > 0)[:, None], (sums[k] - sums[lo]) / np.maximum(k - lo, 1)[:, None], np.inf) + centre
+    after = np.where((k < n - 1)[:, None], (sums[hi] - sums[k + 1]) / np.maximum(hi - k - 1, 1)[:, None],
+                     np.inf) + centre
+    return np.where(np.abs(x - before) <= np.abs(x - after), before, after)
+
+
+def _sigma(variance: np.ndarray, w: int, floor: np.ndarray) -> np.ndarray:
+    """Per-sample noise from the moving variances of a stretch at rest: a window's variance is σ² χ²(w−1)/w,
+    so σ² = median variance / median of χ²(w−1)/w (Wilson–Hilferty); at least the quantisation floor."""
+    dof = w - 1
+    median_ratio = dof * (1.0 - 2.0 / (9.0 * dof)) ** 3 / w
+    sigma = np.maximum(np.sqrt(np.median(variance, axis=0) / median_ratio), floor)
+    return np.where(sigma > 0, sigma, np.finfo(float).tiny ** 0.25)  # a perfectly constant channel
+
+
+def _saturation(x: np.ndarray, statics: list[Span], steady: list[tuple[int, int]], sigma: np.ndarray,
+                step: np.ndarray) -> list[Saturation]:
+    """Stretches stuck at a rail: see step 10 of the module docstring."""
+    n = x.shape[0]
+    at_rest = np.zeros(n, dtype=bool)
+    for span in statics:
+        at_rest[span.start:span.stop] = True
+    found = []
+    for c in range(6):
+        # the levels the channel holds while quiet (at rest or turning steadily) are not rails
+        levels = np.array([span.mean[c] for span in statics] + [float(x[a:b, c].mean()) for a, b in steady])
+        margin = SATURATION_STEP * sigma[c] + step[c]
+        for value in (x[:, c].max(), x[:, c].min()):
+            if np.any(np.abs(levels - value) <= margin):
+                continue
+            for a, b in _runs(x[:, c] == value):
+                if b - a < 2 or at_rest[a:b].any():
+                    continue
+                entry = abs(x[a - 1, c] - value) if a > 0 else 0.0
+                leave = abs(x[b, c] - value) if b < n else 0.0
+                if max(entry, leave) > SATURATION_STEP * sigma[c]:
+                    found.append(Saturation(c, a, b, float(value)))
+    return sorted(found, key=lambda s: (s.start, s.channel))
+
+
+def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,
+            gap_starts: np.ndarray, saturation: list[Saturation], steady: list[tuple[int, int]]) -> Span:
+    """Classify the motion ``[lo, hi)`` between the static spans *before* and *after* (either may be None)."""
+    mean = x[lo:hi].mean(axis=0)
+    up = before.up if before is not None else (after.up if after is not None else "")
+
+    def move(reason: str, integrated: np.ndarray | None = None, axis: int = -1) -> Span:
+        return Span("move", lo, hi, mean, up=up, integrated=np.full(3, np.nan) if integrated is None else integrated,
+                    axis=axis, reason=reason)
+
+    if before is None or after is None:
+        return move("no static span on both sides: the bias cannot be removed and no pose closes the motion")
+    if np.any((gap_starts > lo) & (gap_starts <= hi)):
+        return move("a time gap inside: the turn cannot be integrated")
+    if any(s.start < hi and s.stop > lo for s in saturation):
+        return move("a saturated sample inside: the turn cannot be integrated")
+    # the bias, linear in time between the two static spans' mean gyro outputs
+    t_before = times[before.start:before.stop].mean()
+    t_after = times[after.start:after.stop].mean()
+    weight = (times[lo:hi] - t_before) / (t_after - t_before) if t_after > t_before else np.full(hi - lo, 0.5)
+    bias = before.mean[:3] + np.outer(weight, after.mean[:3] - before.mean[:3])
+    # each sample's rate held from it to the next sample (the last one to the start of the next span)
+    dt = np.diff(times[lo:hi + 1]) if hi < times.shape[0] else np.append(np.diff(times[lo:hi]), 0.0)
+    integrated = np.sum((x[lo:hi, :3] - bias) * dt[:, None], axis=0)
+    axis = int(np.argmax(np.abs(integrated)))
+    main = float(integrated[axis])
+    off = float(np.hypot(*np.delete(integrated, axis)))
+    if abs(main) < math.pi / 4:
+        return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: less than 45 deg", integrated, axis)
+    if off > OFF_AXIS_FRACTION * abs(main):
+        return move(f"not about one body axis: the other axes turned {math.degrees(off):.1f} deg against "
+                    f"{math.degrees(main):+.1f} deg about {AXES[axis]}", integrated, axis)
+    nominal = (math.pi / 2) * round(main / (math.pi / 2))
+    if abs(main - nominal) > ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal):
+        return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: not near a whole number of quarter "
+                    "turns", integrated, axis)
+    if before.up != after.up:
+        return move(f"the pose changed from {before.up} up to {after.up} up: no reference for the angle",
+                    integrated, axis)
+    g = before.mean[3:]
+    vertical = math.acos(min(1.0, abs(float(g[axis])) / float(np.linalg.norm(g)))) <= VERTICAL_AXIS_TOLERANCE
+    full_turns = abs(nominal) % (2 * math.pi) < 1e-9
+    if not vertical and not full_turns:
+        return move(f"turned {math.degrees(main):+.1f} deg about the horizontal axis {AXES[axis]} without "
+                    "coming back to the same pose", integrated, axis)
+    expected = _rotate(g, axis, nominal)
+    if float(np.dot(expected, after.mean[3:])) < math.cos(VERTICAL_AXIS_TOLERANCE) * float(
+            np.linalg.norm(expected) * np.linalg.norm(after.mean[3:])):
+        return move("the gravity direction after the turn does not match the turn", integrated, axis)
+    steady_rate = math.nan
+    inside = [(a, b) for a, b in steady if a >= lo and b <= hi]
+    if len(inside) == 1 and (inside[0][1] - inside[0][0]) >= 0.5 * (hi - lo):
+        a, b = inside[0]
+        steady_rate = float(x[a:b, axis].mean() - bias[(a + b) // 2 - lo, axis])
+    return Span("rotation", lo, hi, mean, up=before.up, integrated=integrated, axis=axis, angle=nominal,
+                orientation="approximate" if vertical else "unknown", steady_rate=steady_rate)

@@ -1,0 +1,546 @@
+"""From a plain IMU log (CSV) to a recording with a segment table for the user to review.
+
+A plain log is one CSV table: a header line of column names, then one row per sample with six
+channels (three gyros, three accelerometers) in counts or in physical units, and perhaps a time
+column, a sample counter, a temperature and labels. :func:`import_log` reads it, converts the
+channels to SI, checks the time axis (sample rate, jitter, gaps), finds the static poses and the
+motion between them (:func:`plansim.estimate.segmentation.segment_log`) and returns a
+:class:`~plansim.io.recording_data.Recording` holding **every** sample of the log, cut into
+``static``, ``rotation`` and ``move`` segments (docs/recording.md), with what it found in the
+attributes and the schedule notes. ``plansim import`` writes it (docs/measured-data.md).
+
+Every problem with the log is a ``ValueError`` naming the file, the line and the column; what the
+log may still be used for despite a flaw (a gap, a saturated stretch, timing jitter) is a named
+:class:`LogWarning`.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from plansim.estimate.segmentation import (
+    AXES,
+    DEFAULT_MIN_STATIC,
+    DEFAULT_WINDOW,
+    Segmentation,
+    Span,
+    TimeReport,
+    analyse_time,
+    segment_log,
+)
+from plansim.io.recording_csv import _check_line_end, _text_file
+from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
+from plansim.schedule.segments import Schedule, Segment
+from plansim.units import KINDS, STANDARD_GRAVITY
+
+#: default names of the six channel columns, in the order gx gy gz ax ay az
+DEFAULT_COLUMNS = CHANNELS
+#: units of the time column -> seconds per unit ("samples": a sample counter, needs the sample rate)
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "samples": math.nan}
+#: the delimiters a log may use; the one that splits the header line into the most columns is taken
+DELIMITERS = (",", ";", "\t")
+#: a static span's mean specific force must be within this fraction of standard gravity (units check)
+GRAVITY_TOLERANCE = 0.3
+#: timing jitter (RMS) beyond this fraction of the sample period is a warning
+JITTER_WARNING = 0.1
+#: a given sample rate that differs from the time column's by more than this fraction is a warning
+RATE_MISMATCH_WARNING = 0.01
+#: the temperature assumed for each segment when the log has no temperature channel, degC
+DEFAULT_TEMPERATURE = 20.0
+
+WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
+                 "unclosed_motion")
+
+
+@dataclass(frozen=True)
+class LogWarning:
+    """A flaw of the log that does not stop the import: ``name`` (one of :data:`WARNING_NAMES`) and text."""
+
+    name: str
+    message: str
+
+
+@dataclass(frozen=True)
+class LogTable:
+    """The columns read from a plain log, in the file's units.
+
+    ``channels`` (N, 6) in the order gx gy gz ax ay az; ``time`` (N,) in the time column's unit or None;
+    ``temperature`` (N,) degC or None; ``names`` the six channel column names; ``ignored`` the columns
+    not used; ``first_line`` the file line of the first sample (1-based).
+    """
+
+    path: Path
+    channels: np.ndarray
+    names: tuple[str, ...]
+    time: np.ndarray | None
+    time_column: str | None
+    temperature: np.ndarray | None
+    temperature_column: str | None
+    ignored: tuple[str, ...]
+    first_line: int
+    lines: np.ndarray = field(repr=False, default=None)  # the file line of every sample
+
+
+@dataclass(frozen=True)
+class ImportResult:
+    """What :func:`import_log` gives: the recording, the detector's findings and the warnings."""
+
+    recording: Recording
+    table: LogTable
+    timing: TimeReport
+    segmentation: Segmentation
+    units: tuple[str, ...]
+    scale: tuple[float, ...] | None
+    warnings: tuple[LogWarning, ...]
+
+
+def _split_list(text: str, option: str) -> list[str]:
+    items = [item.strip() for item in str(text).split(",")]
+    if not items or any(not item for item in items):
+        raise ValueError(f"{option} {text!r}: expected a comma-separated list without empty entries")
+    return items
+
+
+def parse_units(text: str | None) -> tuple[str, ...]:
+    """The unit of each of the six channels from ``--units``: two entries (gyros, accelerometers) or six.
+
+    Gyro units are those of :data:`plansim.units.KINDS` ``angular_rate`` (rad/s, deg/s, deg/h), accelerometer
+    units those of ``acceleration`` (m/s^2, g, mg, ug). ``None``: SI (rad/s, m/s^2).
+    """
+    if text is None:
+        return ("rad/s",) * 3 + ("m/s^2",) * 3
+    items = _split_list(text, "--units")
+    if len(items) == 2:
+        items = [items[0]] * 3 + [items[1]] * 3
+    if len(items) != 6:
+        raise ValueError(f"--units {text!r}: {len(items)} entries; expected 2 (gyro unit, accelerometer unit) or 6 "
+                         f"(one per channel {', '.join(CHANNELS)})")
+    for k, unit in enumerate(items):
+        kind = "angular_rate" if k < 3 else "acceleration"
+        if unit not in KINDS[kind]:
+            raise ValueError(f"--units {text!r}: {unit!r} for channel {CHANNELS[k]}; allowed: "
+                             f"{', '.join(u for u in KINDS[kind] if u)}")
+    return tuple(items)
+
+
+def parse_scale(text: str | None) -> tuple[float, ...] | None:
+    """Counts per unit from ``--scale``: two entries (gyros, accelerometers) or six; ``None``: not counts."""
+    if text is None:
+        return None
+    items = _split_list(text, "--scale")
+    if len(items) == 2:
+        items = [items[0]] * 3 + [items[1]] * 3
+    if len(items) != 6:
+        raise ValueError(f"--scale {text!r}: {len(items)} entries; expected 2 (counts per gyro unit, counts per "
+                         "accelerometer unit) or 6 (one per channel)")
+    values = []
+    for k, item in enumerate(items):
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"--scale {text!r}: {item!r} for channel {CHANNELS[k]} is not a number") from None
+        if not (value > 0 and math.isfinite(value)):
+            raise ValueError(f"--scale {text!r}: {item!r} for channel {CHANNELS[k]}; expected a positive number of "
+                             "counts per unit")
+        values.append(value)
+    return tuple(values)
+
+
+def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, time_column: str | None = None,
+             temperature_column: str | None = None) -> LogTable:
+    """Read the columns of a plain CSV log, checking every row.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The log: UTF-8 text, optional ``#`` comment lines, a header line of column names, one row per sample;
+        comma-, semicolon- or tab-separated.
+    columns : tuple of 6 str or None
+        The column names of gx gy gz ax ay az; columns not named (and not the time or temperature column)
+        are ignored. ``None``: the columns must be named ``gx gy gz ax ay az`` and the log may hold no other.
+    time_column, temperature_column : str or None
+        Names of the time and temperature columns, if any.
+
+    Raises
+    ------
+    ValueError
+        The file is missing or not text; a column is missing, named twice or not expected; a row has more
+        or fewer values than the header; a value is not a finite number. The message names the file, the
+        line and the column.
+    """
+    target = Path(path)
+    where = f"log {str(target)!r}"
+    if not target.is_file():
+        raise ValueError(f"{where} does not exist")
+    names = DEFAULT_COLUMNS if columns is None else tuple(columns)
+    if len(names) != 6:
+        raise ValueError(f"--columns {','.join(names)!r}: {len(names)} names; expected 6, in the order "
+                         f"{', '.join(CHANNELS)}")
+    wanted = list(names) + [c for c in (time_column, temperature_column) if c is not None]
+    repeated = sorted({name for name in wanted if wanted.count(name) > 1})
+    if repeated:
+        raise ValueError(f"{where}: column {repeated[0]!r} is named for two uses (channels, --time, "
+                         "--temperature-column)")
+    with _text_file(target, where) as fh:
+        header_line = 0
+        header = None
+        for line in fh:
+            header_line += 1
+            stripped = line.strip()
+            if stripped and not stripped.startswith("#"):
+                header = line
+                break
+        if header is None:
+            raise ValueError(f"{where}: no header line; expected a line of column names, then one row per sample")
+        delimiter = max(DELIMITERS, key=lambda d: len(next(csv.reader([header], delimiter=d))))
+        header_names = [name.strip() for name in next(csv.reader([header], delimiter=delimiter))]
+        duplicates = sorted({name for name in header_names if header_names.count(name) > 1})
+        if duplicates:
+            raise ValueError(f"{where}: column {duplicates[0]!r} appears more than once in the header "
+                             f"(line {header_line})")
+        missing = [name for name in wanted if name not in header_names]
+        if missing:
+            hint = "" if columns is not None else (" (name the six channel columns with --columns GX,GY,GZ,AX,AY,AZ)")
+            raise ValueError(f"{where}: column {missing[0]!r} is missing; the header (line {header_line}) has "
+                             f"{', '.join(header_names)}{hint}")
+        ignored = tuple(name for name in header_names if name not in wanted)
+        if columns is None and ignored:
+            raise ValueError(f"{where}: column {ignored[0]!r} is not expected: without --columns the log holds "
+                             f"exactly the channels {', '.join(CHANNELS)} (and the --time and --temperature-column "
+                             "columns if given); name the six channel columns with --columns (the other columns "
+                             "are then ignored)")
+        index = [header_names.index(name) for name in wanted]
+        width = len(header_names)
+        values: list[list[str]] = []
+        lines: list[int] = []
+        line_number = header_line
+        for row in csv.reader(fh, delimiter=delimiter):
+            line_number += 1
+            if not row or all(not cell.strip() for cell in row):
+                continue
+            if row[0].lstrip().startswith("#"):
+                continue
+            if len(row) != width:
+                word = "more" if len(row) > width else "fewer"
+                raise ValueError(f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
+                                 f"of the header (line {header_line}); every row holds one value per column")
+            values.append([row[k] for k in index])
+            lines.append(line_number)
+    _check_line_end(target, where)
+    if not values:
+        raise ValueError(f"{where}: no sample after the header (line {header_line})")
+    data = np.empty((len(values), len(wanted)))
+    for j, name in enumerate(wanted):
+        column = [row[j] for row in values]
+        try:
+            data[:, j] = np.array(column, dtype=np.float64)
+        except ValueError:
+            k = next(k for k, text in enumerate(column) if not _is_number(text))
+            raise ValueError(f"{where}: column {name!r} is {column[k].strip()!r} at line {lines[k]}; expected a "
+                             "number") from None
+        bad = np.flatnonzero(~np.isfinite(data[:, j]))
+        if bad.size:
+            k = int(bad[0])
+            raise ValueError(f"{where}: column {name!r} is {column[k].strip()!r} at line {lines[k]}; every value "
+                             "must be a finite number (a sample lost by the logger? cut the log before or after it)")
+    time = data[:, 6] if time_column is not None else None
+    temperature = data[:, -1] if temperature_column is not None else None
+    return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
+                    lines[0], np.array(lines, dtype=np.int64))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = None, time_column: str | None = None,
+               time_unit: str = "s", units: str | None = None, scale: str | None = None,
+               sample_rate: float | None = None, temperature_column: str | None = None,
+               temperature: float | None = None, latitude: float | None = None, height: float | None = None,
+               window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC) -> ImportResult:
+    """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV log.
+    columns : tuple of 6 str or None
+        Channel column names in the order gx gy gz ax ay az (default: those names).
+    time_column : str or None
+        The time column; ``None``: the log has none and ``sample_rate`` is required.
+    time_unit : str
+        Unit of the time column: ``s``, ``ms``, ``us``, ``ns`` or ``samples`` (a sample counter; needs
+        ``sample_rate``).
+    units : str or None
+        ``--units``: the channels' units (or, with ``scale``, the unit the counts are per); default SI.
+    scale : str or None
+        ``--scale``: counts per unit, two or six entries; ``None``: the channels are in ``units``.
+    sample_rate : float or None
+        Hz. Without a time column, required; with one, the nominal rate (default: estimated from it).
+    temperature_column : str or None
+        A temperature column in degC, kept as the recording's temperature channel.
+    temperature : float or None
+        The lab's temperature, degC, for the segment table when the log has no temperature column
+        (default 20 degC, noted in the attributes as assumed).
+    latitude, height : float or None
+        The site, deg and m, written as ``site_latitude_deg`` and ``site_height_m``.
+    window, min_static : float
+        The detector's window and shortest static span, s.
+
+    Raises
+    ------
+    ValueError
+        A bad log (see :func:`read_log`), a bad option (naming it, the value and what is allowed), time
+        going backwards, no static span (too few static samples), or accelerometer outputs at rest far from
+        1 g (wrong units or scale).
+    """
+    unit_names = parse_units(units)
+    counts_per_unit = parse_scale(scale)
+    if counts_per_unit is not None and units is None:
+        raise ValueError(f"--scale {scale!r} needs --units: say which unit the counts are per (e.g. --units "
+                         "deg/s,g)")
+    if time_unit not in TIME_UNITS:
+        raise ValueError(f"--time-unit {time_unit!r}; allowed: {', '.join(TIME_UNITS)}")
+    if sample_rate is not None and not (sample_rate > 0 and math.isfinite(sample_rate)):
+        raise ValueError(f"--sample-rate {sample_rate!r}: expected a positive number of Hz")
+    if time_column is None and sample_rate is None:
+        raise ValueError("the log's sample rate is not known: give --time COLUMN (the time of each sample) or "
+                         "--sample-rate HZ")
+    if time_unit == "samples" and sample_rate is None:
+        raise ValueError("--time-unit samples: a sample counter needs --sample-rate HZ")
+    if temperature_column is not None and temperature is not None:
+        raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
+                         "temperature)")
+    if temperature is not None and not math.isfinite(temperature):
+        raise ValueError(f"--temperature {temperature!r}: expected a finite number of degC")
+    site = {}
+    for key, value, option in (("site_latitude_deg", latitude, "--latitude"), ("site_height_m", height, "--height")):
+        if value is None:
+            continue
+        unit, lowest, highest = SITE_ATTRIBUTES[key]
+        if not lowest <= value <= highest:
+            raise ValueError(f"{option} {value!r}: expected a number from {lowest:g} to {highest:g} {unit}")
+        site[key] = float(value)
+
+    table = read_log(path, columns, time_column, temperature_column)
+    where = f"log {str(table.path)!r}"
+    n = table.channels.shape[0]
+    factors = np.array([KINDS["angular_rate" if k < 3 else "acceleration"][u] for k, u in enumerate(unit_names)])
+    divisors = np.ones(6) if counts_per_unit is None else np.array(counts_per_unit)
+    samples = table.channels / divisors * factors
+
+    warnings: list[LogWarning] = []
+    time_s = None
+    if table.time is not None:
+        seconds = (1.0 / sample_rate) if time_unit == "samples" else TIME_UNITS[time_unit]
+        time_s = table.time * seconds
+        backwards = np.flatnonzero(np.diff(time_s) < 0)
+        if backwards.size:
+            k = int(backwards[0]) + 1
+            raise ValueError(f"{where}: column {table.time_column!r} goes backwards at line {table.lines[k]} "
+                             f"({float(table.time[k - 1])!r} then {float(table.time[k])!r} {time_unit}, line "
+                             f"{table.lines[k - 1]} "
+                             "then this one); the time of a log never decreases (rows out of order, or two logs "
+                             "pasted together?)")
+    try:
+        timing = analyse_time(time_s, n, sample_rate)
+    except ValueError as exc:
+        raise ValueError(f"{where}: column {table.time_column!r}: {exc}") from None
+    period = 1.0 / timing.sample_rate
+    if timing.gaps:
+        k, dt = max(timing.gaps, key=lambda g: g[1])
+        warnings.append(LogWarning("gap", f"{len(timing.gaps)} gap(s) in the time column, {timing.missing_samples} "
+                                          f"sample(s) missing; the largest, {dt:.6g} s, before line {table.lines[k]}. "
+                                          "No static span holds a gap, and a turn across one has no angle"))
+    if timing.repeated:
+        warnings.append(LogWarning("repeated_time", f"{timing.repeated} time step(s) of exactly 0 s: the time "
+                                                    "column's resolution is coarser than the sample period?"))
+    if timing.jitter_rms > JITTER_WARNING * period:
+        warnings.append(LogWarning("jitter", f"timing jitter {timing.jitter_rms:.3g} s RMS (largest "
+                                             f"{timing.jitter_max:.3g} s) is more than {JITTER_WARNING:.0%} of the "
+                                             f"sample period {period:.6g} s"))
+    if sample_rate is not None and time_s is not None and math.isfinite(timing.estimated_rate) and time_unit != \
+            "samples" and abs(timing.estimated_rate / sample_rate - 1.0) > RATE_MISMATCH_WARNING:
+        warnings.append(LogWarning("sample_rate_mismatch", f"--sample-rate {sample_rate:g} Hz but the time column "
+                                                           f"gives {timing.estimated_rate:.6g} Hz"))
+
+    segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
+                               gap_starts=timing.gap_starts)
+    statics = segmentation.of_kind("static")
+    at_rest = float(np.median([np.linalg.norm(span.mean[3:]) for span in statics]))
+    if abs(at_rest / STANDARD_GRAVITY - 1.0) > GRAVITY_TOLERANCE:
+        unit_text = ", ".join(dict.fromkeys(unit_names[3:]))
+        if counts_per_unit is not None:
+            unit_text += f" at {', '.join(f'{c:g}' for c in counts_per_unit[3:])} counts per unit"
+        raise ValueError(f"{where}: at rest the accelerometers read {at_rest:.3f} m/s^2 (median over "
+                         f"{len(statics)} static span(s)); expected about {STANDARD_GRAVITY} m/s^2 (1 g). Are the "
+                         f"accelerometer columns, units or scale right? (read as {unit_text})")
+    for s in segmentation.saturation:
+        first, last = table.lines[s.start], table.lines[s.stop - 1]
+        shown = s.value / factors[s.channel] * divisors[s.channel]
+        warnings.append(LogWarning("saturated", f"channel {CHANNELS[s.channel]} ({table.names[s.channel]}) stuck at "
+                                                f"{shown:.6g} (its extreme) on lines {first}-{last}: a rail? A turn "
+                                                "over it has no angle"))
+    for span in statics:
+        if span.orientation == "unknown":
+            warnings.append(LogWarning("tilted_pose", f"the static span on lines {table.lines[span.start]}-"
+                                                      f"{table.lines[span.stop - 1]} is tilted "
+                                                      f"{math.degrees(span.tilt):.1f} deg from {span.up}: orientation "
+                                                      "'unknown'"))
+    for span in segmentation.spans:
+        if span.kind == "move" and span.reason.startswith("no static span"):
+            warnings.append(LogWarning("unclosed_motion", f"lines {table.lines[span.start]}-"
+                                                          f"{table.lines[span.stop - 1]} lie before the first or after "
+                                                          "the last static span: kept as a 'move'"))
+
+    segment_temperature = DEFAULT_TEMPERATURE if temperature is None else float(temperature)
+    segments = []
+    details = []
+    counters = {"static": 0, "rotation": 0, "move": 0}
+    for span in segmentation.spans:
+        counters[span.kind] += 1
+        seg_temperature = (float(np.mean(table.temperature[span.start:span.stop])) if table.temperature is not None
+                           else segment_temperature)
+        segments.append(_segment(span, counters[span.kind], timing.sample_rate, seg_temperature))
+        details.append(_detail(span, table))
+    schedule = Schedule(tuple(segments), procedure="imported", notes={"import": {
+        "log": table.path.name,
+        "columns": dict(zip(CHANNELS, table.names)),
+        "ignored_columns": list(table.ignored),
+        "units": dict(zip(CHANNELS, unit_names)),
+        "counts_per_unit": None if counts_per_unit is None else dict(zip(CHANNELS, counts_per_unit)),
+        "time_column": table.time_column,
+        "time_unit": time_unit if table.time_column is not None else None,
+        "detector": {
+            "window_samples": segmentation.window,
+            "min_static_samples": segmentation.min_static,
+            "variance_threshold_accel": segmentation.variance_threshold[0],
+            "variance_threshold_gyro": segmentation.variance_threshold[1],
+            "rest_rate_threshold_rad_s": segmentation.rate_threshold.tolist(),
+            "quiet_lines": [int(table.lines[segmentation.noise.start]),
+                            int(table.lines[segmentation.noise.stop - 1])],
+            "noise_sigma_si": dict(zip(CHANNELS, segmentation.noise.sigma.tolist())),
+            "gyro_bias_rad_s": segmentation.noise.gyro_bias.tolist(),
+        },
+        "segments": details,
+        "warnings": [{"name": w.name, "message": w.message} for w in warnings],
+    }})
+    attrs = {
+        "source": "measured",
+        "imported_from": table.path.name,
+        "plansim_version": plansim_version(),
+        "units": UNITS_DESCRIPTION,
+        **site,
+        "sample_rate_hz": timing.sample_rate,
+        "sample_rate_source": ("time column" if sample_rate is None else "--sample-rate") if table.time is not None
+        else "--sample-rate (no time column: gaps and jitter cannot be seen)",
+        "detector_window_s": segmentation.window / timing.sample_rate,
+        "detector_min_static_s": segmentation.min_static / timing.sample_rate,
+        "import_warnings": ", ".join(dict.fromkeys(w.name for w in warnings)) or "none",
+        "heading": "not known for any segment: a plain log has no heading reference",
+    }
+    if table.time is not None:
+        attrs.update({"sample_rate_estimated_hz": timing.estimated_rate, "time_jitter_rms_s": timing.jitter_rms,
+                      "time_jitter_max_s": timing.jitter_max, "time_gaps": len(timing.gaps),
+                      "time_gap_missing_samples": timing.missing_samples,
+                      "time_gap_largest_s": max((dt for _, dt in timing.gaps), default=0.0)})
+    if table.temperature is None:
+        how = "given (--temperature)" if temperature is not None else "assumed (the log has no temperature)"
+        attrs["segment_temperature"] = f"{segment_temperature:g} degC, {how}"
+    for c, name in enumerate(CHANNELS):
+        attrs[f"noise_{name}_si"] = float(segmentation.noise.sigma[c])
+    timestamps = None if time_s is None else time_s
+    try:
+        recording = Recording(samples, schedule, attrs, timestamps=timestamps, temperature=table.temperature)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings))
+
+
+def _segment(span: Span, number: int, sample_rate: float, temperature: float) -> Segment:
+    common = dict(dwell=span.samples / sample_rate, settle=0.0, sample_rate=sample_rate, temperature=temperature)
+    if span.kind == "static":
+        return Segment(f"static {number}: {span.up} up, tilt {math.degrees(span.tilt):.1f} deg", "static", 0, span.up,
+                       heading=math.nan, orientation=span.orientation, **common)
+    measured = math.degrees(float(span.integrated[span.axis])) if span.axis >= 0 else math.nan
+    if span.kind == "rotation":
+        steady = (f", steady at {math.degrees(span.steady_rate):.4g} deg/s" if math.isfinite(span.steady_rate)
+                  else "")
+        return Segment(f"rotation {number}: {math.degrees(span.angle):+.0f} deg about +{AXES[span.axis]} (measured "
+                       f"{measured:+.2f} deg{steady})", "rotation", span.axis, span.up, heading=math.nan,
+                       rate=math.nan, rate_axis=f"+{AXES[span.axis]}", angle=span.angle,
+                       orientation=span.orientation, **common)
+    about = f"turned {measured:+.1f} deg about {AXES[span.axis]}" if span.axis >= 0 else "not integrated"
+    return Segment(f"move {number}: {about}", "move", 0, span.up or "+z", heading=math.nan, rate=math.nan,
+                   orientation="unknown", **common)
+
+
+def _detail(span: Span, table: LogTable) -> dict:
+    detail = {"kind": span.kind, "lines": [int(table.lines[span.start]), int(table.lines[span.stop - 1])],
+              "mean_si": [float(v) for v in span.mean]}
+    if span.kind == "static":
+        detail["tilt_deg"] = math.degrees(span.tilt)
+    else:
+        detail["integrated_deg"] = [None if not math.isfinite(v) else math.degrees(float(v)) for v in span.integrated]
+        if span.kind == "rotation":
+            detail["steady_rate_deg_s"] = math.degrees(span.steady_rate) if math.isfinite(span.steady_rate) else None
+        else:
+            detail["why_not_a_rotation"] = span.reason
+    return detail
+
+
+def format_summary(result: ImportResult) -> str:
+    """The import's findings as text, every number with its unit (what ``plansim import`` prints)."""
+    table, timing, seg = result.table, result.timing, result.segmentation
+    rec = result.recording
+    lines = [f"plansim import {table.path.name}: {rec.samples.shape[0]} samples"]
+    unit_text = ", ".join(dict.fromkeys(result.units))
+    if result.scale is not None:
+        unit_text = "counts: " + ", ".join(f"{c:g}/{u}" for c, u in zip(result.scale, result.units))
+    lines.append("  channels: " + " ".join(f"{c}={n}" for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
+                 + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
+    if table.time is None:
+        lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (given; no time column: gaps and jitter cannot be "
+                     "seen)")
+    else:
+        lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (from column {table.time_column!r}: "
+                     f"{timing.estimated_rate:.6g} Hz); jitter {timing.jitter_rms:.3g} s RMS, "
+                     f"{timing.jitter_max:.3g} s at most; {len(timing.gaps)} gap(s), {timing.missing_samples} "
+                     "sample(s) missing")
+    noise = seg.noise
+    gyro = " ".join(f"{c} {math.degrees(v):.3g}" for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
+    accel = " ".join(f"{c} {v:.3g}" for c, v in zip(CHANNELS[3:], noise.sigma[3:]))
+    density = " ".join(f"{c} {math.degrees(v) * 60.0 / math.sqrt(timing.sample_rate):.3g}"
+                       for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
+    lines.append(f"  noise per sample (quiet stretch, lines {table.lines[noise.start]}-{table.lines[noise.stop - 1]}): "
+                 f"{gyro} deg/s; {accel} m/s^2 (as white noise: {density} deg/sqrt(h))")
+    rate = " ".join(f"{math.degrees(v):.3g}" for v in seg.rate_threshold)
+    lines.append(f"  at rest: variance ratios <= {seg.variance_threshold[0]:.3g} (accelerometers), "
+                 f"{seg.variance_threshold[1]:.3g} (gyros) over {seg.window} samples "
+                 f"({seg.window / timing.sample_rate:.3g} s), for at least {seg.min_static / timing.sample_rate:.3g} "
+                 f"s; a quiet stretch turning faster than {rate} deg/s (x y z) is a steady turn")
+    counts = {kind: len(seg.of_kind(kind)) for kind in ("static", "rotation", "move")}
+    lines.append(f"  segments: {counts['static']} static, {counts['rotation']} rotation, {counts['move']} move")
+    lines.append(f"  {'#':>3}  {'test':8s}  {'lines':>13s}  {'duration':>9s}  label")
+    for k, (span, segment) in enumerate(zip(seg.spans, rec.schedule.segments)):
+        rows = f"{table.lines[span.start]}-{table.lines[span.stop - 1]}"
+        lines.append(f"  {k:3d}  {segment.test:8s}  {rows:>13s}  {span.samples / timing.sample_rate:7.2f} s  "
+                     f"{segment.label}")
+    lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
+                 "approximate for the static poses")
+    if counts["rotation"]:
+        lines.append("  rotations: angle = the whole number of quarter turns nearest the measured integral (bias "
+                     "removed); check it against what was done; rate = nan (not logged)")
+    for warning in result.warnings:
+        lines.append(f"  warning [{warning.name}]: {warning.message}")
+    return "\n".join(lines)

@@ -1,0 +1,372 @@
+"""plansim import: a plain log to a recording whose segment table is found from the data.
+
+- A log simulated by plansim (the default unit: 12-bit acquisition, Earth rate, its own errors), written
+  as a plain CSV with a time column and six columns and NOT told the schedule, comes back with its
+  static poses (boundaries within the documented tolerance, the right up axes) and its turns (angle,
+  steady rate).
+- The shared real data (imucal's Ferraris session, MIT licence; read from beside the repository and
+  skipped when absent) imports into the sections its annotation names.
+- Bad logs get a ValueError naming the file, line and column, or a named warning; nothing is written.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from plansim.cli import main
+from plansim.io.log_import import import_log, parse_scale, parse_units
+from plansim.io.recording import nominal_time, read_recording, write_recording
+from plansim.io.scenario_file import load_scenario
+from plansim.runner import simulate_and_record
+from plansim.schedule import Schedule, Segment
+
+REAL = Path(__file__).resolve().parents[2] / "shared/data/real/imucal-ferraris"
+CHANNEL_COLUMNS = "gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z"
+
+
+# ----------------------------------------------------------------------------- a log simulated by plansim
+
+def simulated_log(settle: float = 0.0):
+    """A plansim recording of six poses and two turns about the vertical, and its true segments."""
+    def rest(up):
+        return Segment(f"{up} up", "multi_position", 1, up, dwell=8.0, settle=settle, sample_rate=100.0)
+
+    def turn(axis, rate_deg, dwell):
+        return Segment(f"turn {axis}", "rate", "xyz".index(axis), f"+{axis}", rate=math.radians(rate_deg),
+                       rate_axis=f"+{axis}", dwell=dwell, settle=settle, sample_rate=100.0)
+
+    segments = (rest("+x"), turn("x", 60.0, 6.0), rest("+x"), rest("-x"), rest("+y"), turn("y", -45.0, 8.0),
+                rest("+y"), rest("-y"), rest("+z"), rest("-z"))
+    scenario = dataclasses.replace(load_scenario("jjf2003"), schedule=Schedule(segments))
+    return simulate_and_record(scenario, seed=11, trial=3)
+
+
+def write_plain_log(path: Path, time_ms: np.ndarray, samples_si: np.ndarray) -> None:
+    """A plain log as a lab's logger writes it: time in ms, gyros in deg/s, accelerometers in m/s^2."""
+    block = np.column_stack([time_ms, np.degrees(samples_si[:, :3]), samples_si[:, 3:]])
+    header = "t_ms,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z"
+    np.savetxt(path, block, delimiter=",", header=header, comments="", fmt="%.10g")
+
+
+def test_a_simulated_log_gives_back_its_segments(tmp_path):
+    recording = simulated_log()
+    log = tmp_path / "sim_log.csv"
+    write_plain_log(log, recording.time * 1000.0, recording.samples)
+    result = import_log(log, columns=tuple(CHANNEL_COLUMNS.split(",")), time_column="t_ms", time_unit="ms",
+                        units="deg/s,m/s^2")
+    truth = recording.schedule.segments
+    first = recording.first_sample
+    true_rests = [(int(first[k]), int(first[k]) + s.samples, s.up) for k, s in enumerate(truth) if not s.is_rotating]
+    found = result.segmentation.of_kind("static")
+    # consecutive rests with the same up axis and no motion between them (the table did not move) are one rest
+    merged = []
+    for a, b, up in true_rests:
+        if merged and merged[-1][1] == a and merged[-1][2] == up:
+            merged[-1] = (merged[-1][0], b, up)
+        else:
+            merged.append((a, b, up))
+    assert len(found) == len(merged)
+    half = result.segmentation.window // 2
+    for span, (a, b, up) in zip(found, merged):
+        assert span.up == up
+        # documented tolerance: inside the true rest, at most half a window + 1 sample short at each end
+        assert a <= span.start <= a + half + 1, (span.start, a)
+        assert b - half - 1 <= span.stop <= b, (span.stop, b)
+    rotations = result.segmentation.of_kind("rotation")
+    assert [(r.axis, round(math.degrees(r.angle))) for r in rotations] == [(0, 360), (1, -360)]
+    for r, (rate, seconds) in zip(rotations, ((60.0, 6.0), (-45.0, 8.0))):
+        # the integral and the steady rate measure the unit's own scale factor (about 1 +- 0.3 %)
+        assert math.degrees(r.integrated[r.axis]) == pytest.approx(rate * seconds, rel=0.005)
+        assert math.degrees(r.steady_rate) == pytest.approx(rate, rel=0.005)
+        assert r.orientation == "approximate"
+    # the recording holds every sample, in segments, with the log's clock
+    rec = result.recording
+    np.testing.assert_allclose(rec.samples, recording.samples, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(rec.time, recording.time, rtol=0, atol=1e-9)
+    segments = rec.schedule.segments
+    assert [s.test for s in segments] == ["static", "rotation", "static", "move", "static", "move", "static",
+                                          "rotation", "static", "move", "static", "move", "static", "move", "static"]
+    for s in segments:
+        assert math.isnan(s.heading) and s.rate_known == (s.test == "static")
+    assert all(s.orientation == "approximate" for s in segments if s.test == "static")
+    assert [math.degrees(s.angle) for s in segments if s.test == "rotation"] == [360.0, -360.0]
+    assert result.warnings == ()
+    assert rec.attrs["sample_rate_hz"] == pytest.approx(100.0, rel=1e-9)
+    assert rec.attrs["time_gaps"] == 0 and rec.attrs["import_warnings"] == "none"
+    for suffix in (".nc", ".csv"):
+        write_recording(rec, tmp_path / f"rec{suffix}")
+        assert read_recording(tmp_path / f"rec{suffix}") == rec
+
+
+def test_a_simulated_log_with_settle_gaps_splits_at_each_gap(tmp_path):
+    recording = simulated_log(settle=10.0)
+    log = tmp_path / "sim_gaps.csv"
+    write_plain_log(log, recording.time * 1000.0, recording.samples)
+    result = import_log(log, columns=tuple(CHANNEL_COLUMNS.split(",")), time_column="t_ms", time_unit="ms",
+                        units="deg/s,m/s^2")
+    assert [w.name for w in result.warnings] == ["gap"]
+    assert result.timing.missing_samples == 10 * 1000 - 1000  # ten settle gaps of 10 s, less one step each
+    assert len(result.timing.gaps) == len(recording.schedule) - 1
+    # no static span holds a gap, and the turns (each across a gap) are moves without an angle
+    gap_starts = set(result.timing.gap_starts.tolist())
+    for span in result.segmentation.of_kind("static"):
+        assert not any(span.start < k < span.stop for k in gap_starts)
+    assert result.segmentation.of_kind("rotation") == []
+    ups = [span.up for span in result.segmentation.of_kind("static")]
+    assert [u for k, u in enumerate(ups) if k == 0 or u != ups[k - 1]] == ["+x", "-x", "+y", "-y", "+z", "-z"]
+
+
+# ----------------------------------------------------------------------------- the shared real data
+
+def real(name: str) -> Path:
+    path = REAL / name
+    if not path.is_file():
+        pytest.skip(f"the shared real data {name} is not beside the repository ({REAL})")
+    return path
+
+
+def test_real_ferraris_session_imports_into_its_sections(tmp_path):
+    log = real("example_ferraris_session.csv")
+    sections = json.loads(real("example_ferraris_session_list.json").read_text())
+    result = import_log(log, columns=tuple(CHANNEL_COLUMNS.split(",")), units="deg/s,m/s^2", sample_rate=102.4)
+    spans = result.segmentation.spans
+    statics = result.segmentation.of_kind("static")
+    # every annotated static section lies inside one static span with the right axis up
+    for name, up in (("x_p", "+x"), ("x_a", "-x"), ("y_p", "+y"), ("y_a", "-y"), ("z_p", "+z"), ("z_a", "-z")):
+        a, b = sections[name]["start"], sections[name]["end"]
+        holding = [s for s in statics if s.start <= a and b <= s.stop]
+        assert len(holding) == 1 and holding[0].up == up, name
+        assert math.degrees(holding[0].tilt) < 6.0
+    assert {s.up for s in statics} == {"+x", "-x", "+y", "-y", "+z", "-z"}
+    # three rotations, one full turn each about x, y, z, holding the annotated turns; the integrals (bias
+    # removed with the static spans on either side) near the -372, -355, -359 deg the data's notes give
+    rotations = [s for s in spans if s.kind == "rotation"]
+    assert [(r.axis, math.degrees(r.angle)) for r in rotations] == [(0, -360.0), (1, -360.0), (2, -360.0)]
+    for r, name, integral in zip(rotations, ("x_rot", "y_rot", "z_rot"), (-372.0, -355.0, -359.0)):
+        assert r.start <= sections[name]["start"] and sections[name]["end"] <= r.stop
+        assert math.degrees(r.integrated[r.axis]) == pytest.approx(integral, abs=3.0)
+        assert math.isnan(r.steady_rate)  # turned by hand
+    # the noise (a 16-bit unit: 1/16.4 deg/s and 1/2048 g steps) and nothing flagged
+    sigma = result.segmentation.noise.sigma
+    assert np.all((np.degrees(sigma[:3]) > 0.02) & (np.degrees(sigma[:3]) < 0.1))
+    assert np.all((sigma[3:] > 0.005) & (sigma[3:] < 0.03))
+    assert result.warnings == ()
+    rec = result.recording
+    assert rec.samples.shape == (10376, 6) and rec.timestamps is None
+    write_recording(rec, tmp_path / "ferraris.nc")
+    assert read_recording(tmp_path / "ferraris.nc") == rec
+
+
+def test_real_annotated_session_in_counts_with_its_labels_ignored():
+    log = real("annotated_session.csv")
+    result = import_log(log, columns=tuple(CHANNEL_COLUMNS.split(",")), units="deg/s,g", scale="16.4,2048",
+                        sample_rate=204.8)
+    assert set(result.table.ignored) == {"part", "samples"}
+    statics = result.segmentation.of_kind("static")
+    assert [s.up for s in statics] == ["-x", "+x", "-y", "+y", "-z", "+z"]
+    # the labels (not given to the import) agree: each static span is mostly its labelled static section and
+    # holds most of it; where the unit rested in the same pose at the start of the next (turn) section, the
+    # span runs on into it (the sections were cut from one session and pasted together)
+    labels = [line.split(",")[0] for line in log.read_text().splitlines()[1:]]
+    for span, part in zip(statics, ("x_a", "x_p", "y_a", "y_p", "z_a", "z_p")):
+        inside = labels[span.start:span.stop]
+        assert max(set(inside), key=inside.count) == part
+        assert inside.count(part) >= 0.8 * labels.count(part)
+        assert set(inside) <= {part, part[0] + "_rot"}
+    for span in statics:
+        # 1 g, give or take this unit's accelerometer errors (a z scale error of about 2 % and 0.4 m/s^2 bias)
+        assert np.linalg.norm(span.mean[3:]) == pytest.approx(9.80665, rel=0.07)
+
+
+def test_real_annotated_session_counter_runs_backwards(tmp_path):
+    log = real("annotated_session.csv")
+    code = main(["import", str(log), "--out", str(tmp_path / "a.nc"), "--columns", CHANNEL_COLUMNS,
+                 "--units", "deg/s,g", "--scale", "16.4,2048", "--time", "samples", "--time-unit", "samples",
+                 "--sample-rate", "204.8"])
+    assert code == 2
+    assert os.listdir(tmp_path) == []
+
+
+# ----------------------------------------------------------------------------- bad logs
+
+def synthetic_log(seed: int = 0, seconds_rest: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+    """(time s, samples SI): rest with +z up, a 360 deg turn about z in 2 s, rest."""
+    rng = np.random.default_rng(seed)
+    fs = 100.0
+    n_rest, n_turn = int(seconds_rest * fs), int(2.0 * fs)
+    n = 2 * n_rest + n_turn
+    x = rng.normal(size=(n, 6)) * np.r_[[math.radians(0.1)] * 3, [0.01] * 3]
+    x[:, 5] += 9.81
+    x[:, :3] += np.radians([0.3, -0.2, 0.1])
+    phase = np.arange(n_turn) / n_turn
+    x[n_rest:n_rest + n_turn, 2] += 2 * math.pi * fs / n_turn * (1 - np.cos(2 * math.pi * phase))  # 360 deg
+    return np.arange(n) / fs, x
+
+
+def write_synthetic(path: Path, time: np.ndarray | None, x: np.ndarray, names=("gx", "gy", "gz", "ax", "ay", "az"),
+                    extra: dict | None = None) -> None:
+    columns = ([("time", time)] if time is not None else []) + list(zip(names, x.T)) + list((extra or {}).items())
+    header = ",".join(name for name, _ in columns)
+    np.savetxt(path, np.column_stack([values for _, values in columns]), delimiter=",", header=header,
+               comments="", fmt="%.12g")
+
+
+def test_a_clean_synthetic_log_and_the_cli(tmp_path, capsys):
+    t, x = synthetic_log()
+    log = tmp_path / "log.csv"
+    write_synthetic(log, t, x)
+    out = tmp_path / "rec.csv"
+    assert main(["import", str(log), "--out", str(out), "--time", "time", "--latitude", "49.6", "--height",
+                 "280"]) == 0
+    text = capsys.readouterr().out
+    assert "segments: 2 static, 1 rotation, 0 move" in text and "+360 deg about +z" in text
+    assert "sample rate: 100 Hz" in text and "deg/s" in text and "m/s^2" in text
+    rec = read_recording(out)
+    assert [s.test for s in rec.schedule.segments] == ["static", "rotation", "static"]
+    assert rec.schedule.segments[1].angle == pytest.approx(2 * math.pi)
+    assert rec.attrs["site_latitude_deg"] == 49.6 and rec.attrs["site_height_m"] == 280.0
+    assert rec.attrs["source"] == "measured" and rec.attrs["segment_temperature"].endswith("assumed (the log has "
+                                                                                           "no temperature)")
+    assert set(os.listdir(tmp_path)) == {"log.csv", "rec.csv", "rec.segments.csv"}
+    # the recording may not overwrite the log
+    assert main(["import", str(log), "--out", str(log), "--time", "time"]) == 2
+    assert "would overwrite the log" in capsys.readouterr().err
+
+
+def test_a_temperature_column_becomes_the_temperature_channel(tmp_path):
+    t, x = synthetic_log()
+    temperature = 25.0 + 0.001 * np.arange(t.size)
+    write_synthetic(tmp_path / "log.csv", t, x, extra={"temp_c": temperature})
+    result = import_log(tmp_path / "log.csv", time_column="time", temperature_column="temp_c")
+    np.testing.assert_allclose(result.recording.temperature, temperature, rtol=1e-12)
+    assert result.recording.schedule.segments[0].temperature == pytest.approx(temperature[:350].mean(), abs=0.05)
+
+
+def expect_error(tmp_path, capsys, argv: list[str], message: str) -> None:
+    """The CLI refuses the log with exit status 2, the message on stderr, and writes nothing."""
+    before = set(os.listdir(tmp_path))
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("plansim: error: ") and message in err, err
+    assert set(os.listdir(tmp_path)) == before
+
+
+def test_bad_logs_are_refused_naming_the_line_and_column(tmp_path, capsys):
+    t, x = synthetic_log()
+    log = tmp_path / "log.csv"
+    out = str(tmp_path / "rec.nc")
+    write_synthetic(log, t, x)
+    lines = log.read_text().splitlines()
+
+    def variant(edit) -> str:
+        copy = list(lines)
+        edit(copy)
+        path = tmp_path / "bad.csv"
+        path.write_text("\n".join(copy) + "\n")
+        return str(path)
+
+    # a missing column (without --columns the channels are gx ... az)
+    write_synthetic(tmp_path / "bad.csv", t, x, names=("gx", "gy", "gz", "ax", "ay", "acc_z"))
+    expect_error(tmp_path, capsys, ["import", str(tmp_path / "bad.csv"), "--out", out, "--time", "time"],
+                 "column 'az' is missing")
+    # an extra column without --columns
+    write_synthetic(tmp_path / "bad.csv", t, x, extra={"counter": np.arange(t.size)})
+    expect_error(tmp_path, capsys, ["import", str(tmp_path / "bad.csv"), "--out", out, "--time", "time"],
+                 "column 'counter' is not expected")
+    # ... which --columns ignores
+    assert main(["import", str(tmp_path / "bad.csv"), "--out", out, "--time", "time", "--columns",
+                 "gx,gy,gz,ax,ay,az"]) == 0
+    os.remove(out)
+    capsys.readouterr()
+    # a row with one value too many, or one too few
+    expect_error(tmp_path, capsys, ["import", variant(lambda c: c.__setitem__(10, c[10] + ",1")), "--out", out,
+                                    "--time", "time"], "line 11 has 8 values, more than the 7 columns")
+    expect_error(tmp_path, capsys, ["import", variant(lambda c: c.__setitem__(12, c[12].rsplit(",", 1)[0])),
+                                    "--out", out, "--time", "time"], "line 13 has 6 values, fewer than the 7")
+    # a NaN, and text
+    expect_error(tmp_path, capsys, ["import", variant(lambda c: c.__setitem__(20, c[20].rsplit(",", 1)[0] + ",nan")),
+                                    "--out", out, "--time", "time"], "column 'az' is 'nan' at line 21")
+    expect_error(tmp_path, capsys, ["import", variant(lambda c: c.__setitem__(30, "0.29," + c[30].split(",", 1)[1]
+                                                                              .replace(",", ",x", 1))),
+                                    "--out", out, "--time", "time"], "at line 31; expected a number")
+    # time going backwards
+    def backwards(c):
+        c[40], c[41] = c[41], c[40]
+    expect_error(tmp_path, capsys, ["import", variant(backwards), "--out", out, "--time", "time"],
+                 "column 'time' goes backwards at line 42 (0.4 then 0.39 s, line 41 then this one)")
+    # no time column and no sample rate; a scale without units; a unit of the wrong kind
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out], "give --time COLUMN")
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--scale", "16.4,2048"],
+                 "--scale '16.4,2048' needs --units")
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--units", "g,deg/s"],
+                 "'g' for channel gx; allowed: rad/s, deg/s, deg/h")
+    # accelerometers in g read as m/s^2: at rest they read 1, not 9.8
+    write_synthetic(tmp_path / "bad.csv", t, x * np.r_[1, 1, 1, [1 / 9.80665] * 3])
+    expect_error(tmp_path, capsys, ["import", str(tmp_path / "bad.csv"), "--out", out, "--time", "time"],
+                 "at rest the accelerometers read 1.000 m/s^2")
+    # a log that never rests: the unit tumbles about x the whole time
+    moving = x.copy()
+    angle = math.radians(30.0) * t
+    moving[:, 0] += math.radians(30.0)
+    moving[:, 4], moving[:, 5] = x[:, 4] + 9.81 * np.sin(angle), x[:, 5] - 9.81 + 9.81 * np.cos(angle)
+    write_synthetic(tmp_path / "bad.csv", t, moving)
+    expect_error(tmp_path, capsys, ["import", str(tmp_path / "bad.csv"), "--out", out, "--time", "time"],
+                 "too few static samples")
+    # a bad --scale, a bad site
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--units", "deg/s,g",
+                                    "--scale", "16.4,-2048"], "expected a positive number of counts per unit")
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--latitude", "91"],
+                 "--latitude 91.0: expected a number from -90 to 90 deg")
+
+
+def test_flawed_logs_import_with_named_warnings(tmp_path):
+    t, x = synthetic_log(seconds_rest=6.0)
+    log = tmp_path / "log.csv"
+    # a gap of 0.5 s inside the first rest: it splits the rest, and is reported
+    t_gap = t.copy()
+    t_gap[300:] += 0.5
+    write_synthetic(log, t_gap, x)
+    result = import_log(log, time_column="time")
+    assert [w.name for w in result.warnings] == ["gap"]
+    assert "50 sample(s) missing" in result.warnings[0].message and "before line 302" in result.warnings[0].message
+    assert result.recording.attrs["time_gaps"] == 1 and result.recording.attrs["import_warnings"] == "gap"
+    assert not any(s.start < 300 < s.stop for s in result.segmentation.spans if s.kind != "move")
+    assert [s.kind for s in result.segmentation.spans] == ["static", "move", "static", "rotation", "static"]
+    # a saturated stretch: the z gyro stuck at a rail during the turn; the turn then has no angle
+    clipped = x.copy()
+    rail = np.max(clipped[:, 2]) * 0.8
+    clipped[:, 2] = np.minimum(clipped[:, 2], rail)
+    write_synthetic(log, t, clipped)
+    result = import_log(log, time_column="time")
+    assert "saturated" in [w.name for w in result.warnings]
+    assert result.segmentation.of_kind("rotation") == []
+    assert any("saturated" in s.reason for s in result.segmentation.of_kind("move"))
+    # jitter, and a sample rate that disagrees with the time column
+    rng = np.random.default_rng(2)
+    write_synthetic(log, t + rng.uniform(-0.0015, 0.0015, t.size), x)
+    result = import_log(log, time_column="time", sample_rate=102.0)
+    assert {w.name for w in result.warnings} == {"jitter", "sample_rate_mismatch"}
+
+
+def test_unit_and_scale_parsing():
+    assert parse_units(None) == ("rad/s",) * 3 + ("m/s^2",) * 3
+    assert parse_units("deg/s,g") == ("deg/s",) * 3 + ("g",) * 3
+    assert parse_units("deg/s,deg/s,rad/s,g,mg,m/s^2")[2:4] == ("rad/s", "g")
+    with pytest.raises(ValueError, match="3 entries; expected 2 .* or 6"):
+        parse_units("deg/s,g,g")
+    assert parse_scale("16.4,2048") == (16.4,) * 3 + (2048.0,) * 3
+    with pytest.raises(ValueError, match="'x' for channel gx is not a number"):
+        parse_scale("x,1")
+
+
+def test_simulated_recording_times_are_the_nominal_ones():
+    # the test logs above are built from this clock: global time, settle times included
+    recording = simulated_log(settle=10.0)
+    assert np.array_equal(recording.time, nominal_time(recording.schedule))

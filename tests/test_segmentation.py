@@ -1,0 +1,144 @@
+"""The rest detector of plansim.estimate.segmentation: its pieces, and its false alarms on static noise.
+
+The false-alarm test is the calibration the module's thresholds rest on (docs/measured-data.md): logs at
+rest with noise of several kinds — white Gaussian, heavy-tailed (Student t, 3 degrees of freedom),
+quantised to about its own size, low-pass filtered (correlated), and with the gyro bias drifting — must
+come out as one static span, at the default window.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from plansim.estimate.segmentation import (
+    DEFAULT_WINDOW,
+    analyse_time,
+    moving_mean_variance,
+    nearest_axis,
+    resolution,
+    segment_log,
+)
+
+FS = 100.0
+GRAVITY = np.array([0.0, 0.0, 9.81])
+
+
+def static_noise(kind: str, seconds: float, rng: np.random.Generator) -> np.ndarray:
+    """(N, 6) samples of a unit at rest (+z up): gyro noise 0.2 deg/s, accelerometer 0.01 m/s^2 per sample."""
+    n = int(seconds * FS)
+    scale = np.array([math.radians(0.2)] * 3 + [0.01] * 3)
+    e = rng.standard_normal((n, 6))
+    if kind == "student_t3":
+        e = rng.standard_t(3, (n, 6)) / math.sqrt(3.0)  # unit variance, heavy tails
+    elif kind == "low_pass":
+        rho = 0.8  # correlation time ~ 4.5 samples
+        e = lfilter([1.0 - rho], [1.0, -rho], e, axis=0) / math.sqrt((1.0 - rho) / (1.0 + rho))
+    x = e * scale + np.r_[math.radians(0.3), -math.radians(0.1), 0.0, 0.05, -0.02, 9.81]
+    if kind == "quantised":  # one step = 3 sigma: most samples sit on one level
+        step = 3.0 * scale
+        x = np.round(x / step) * step
+    elif kind == "drifting":  # the gyro bias wanders by ~2 sigma over the log
+        walk = np.cumsum(rng.standard_normal((n, 3)), axis=0) / math.sqrt(n)
+        x[:, :3] += 2.0 * scale[:3] * walk
+    return x
+
+
+@pytest.mark.parametrize("kind", ["white", "student_t3", "low_pass", "quantised", "drifting"])
+def test_a_log_at_rest_is_one_static_span(kind):
+    rng = np.random.default_rng(["white", "student_t3", "low_pass", "quantised", "drifting"].index(kind))
+    for _ in range(3):
+        x = static_noise(kind, 200.0, rng)
+        result = segment_log(x, None, FS)
+        assert [(s.kind, s.start, s.stop) for s in result.spans] == [("static", 0, x.shape[0])], kind
+        assert result.spans[0].up == "+z" and result.spans[0].orientation == "approximate"
+
+
+def test_noise_floor_measures_the_noise():
+    rng = np.random.default_rng(3)
+    x = static_noise("white", 60.0, rng)
+    result = segment_log(x, None, FS)
+    sigma = result.noise.sigma
+    np.testing.assert_allclose(sigma[:3], math.radians(0.2), rtol=0.15)
+    np.testing.assert_allclose(sigma[3:], 0.01, rtol=0.15)
+    w = result.window
+    assert w == round(DEFAULT_WINDOW * FS)
+    np.testing.assert_allclose(result.noise.window_sigma, math.radians(0.2) / math.sqrt(w), rtol=0.5)
+
+
+def test_quantised_noise_is_not_zero():
+    rng = np.random.default_rng(4)
+    x = static_noise("quantised", 60.0, rng)
+    result = segment_log(x, None, FS)
+    # the MAD of such a channel is 0; the variance-based estimate is near the true standard deviation
+    assert np.all(result.noise.sigma[3:] > 0.005)
+    np.testing.assert_allclose(result.noise.resolution[3:], 0.03, rtol=1e-9)
+
+
+def test_moving_statistics_match_a_direct_computation():
+    rng = np.random.default_rng(5)
+    x = rng.normal(size=(40, 2)) + 1000.0
+    mean, var = moving_mean_variance(x, 7)
+    for t in range(40):
+        window = x[max(0, t - 3):min(40, t + 4)]
+        np.testing.assert_allclose(mean[t], window.mean(axis=0), rtol=0, atol=1e-9)
+        np.testing.assert_allclose(var[t], window.var(axis=0), rtol=1e-7, atol=1e-9)
+    assert resolution(np.array([[0.0], [0.5], [0.5], [1.5]]))[0] == 0.5
+
+
+def test_nearest_axis_and_tilt():
+    up, tilt = nearest_axis(np.array([0.3, -9.7, 0.1]))
+    assert up == "-y" and tilt == pytest.approx(math.atan(math.hypot(0.3, 0.1) / 9.7))
+
+
+def test_time_analysis_finds_gaps_jitter_and_repeats():
+    rng = np.random.default_rng(6)
+    t = np.arange(1000) / 100.0 + rng.uniform(-1e-4, 1e-4, 1000)
+    t[500:] += 0.05  # 5 samples' worth of time missing before sample 500
+    report = analyse_time(t, 1000)
+    assert report.sample_rate == pytest.approx(100.0, rel=1e-3)
+    assert [k for k, _ in report.gaps] == [500] and report.missing_samples == 5
+    assert report.jitter_rms < 2e-4 and report.jitter_max < 3e-4
+    t2 = t.copy()
+    t2[10] = t2[9]
+    assert analyse_time(t2, 1000).repeated == 1
+    with pytest.raises(ValueError, match="time decreases at sample 11"):
+        t3 = t.copy()
+        t3[11] = t3[10] - 1.0
+        analyse_time(t3, 1000)
+    with pytest.raises(ValueError, match="needs the sample rate"):
+        analyse_time(None, 1000)
+
+
+def test_a_turn_between_two_rests_is_a_rotation_with_its_steady_rate():
+    rng = np.random.default_rng(7)
+    rest = static_noise("white", 5.0, rng)
+    rate = math.radians(-90.0)  # -360 deg in 4 s about z, which points up
+    turning = static_noise("white", 4.0, rng)
+    turning[:, 2] += rate
+    x = np.vstack([rest, turning, static_noise("white", 5.0, rng)])
+    result = segment_log(x, None, FS)
+    kinds = [s.kind for s in result.spans]
+    assert kinds == ["static", "rotation", "static"]
+    rotation = result.spans[1]
+    assert rotation.axis == 2 and rotation.angle == pytest.approx(-2 * math.pi)
+    assert math.degrees(rotation.integrated[2]) == pytest.approx(-360.0, abs=0.5)
+    assert math.degrees(rotation.steady_rate) == pytest.approx(-90.0, abs=0.05)
+    assert result.steady_turns and rotation.orientation == "approximate"
+
+
+def test_no_rest_at_all_is_too_few_static_samples():
+    rng = np.random.default_rng(8)
+    x = static_noise("white", 30.0, rng)
+    # a unit tumbling the whole time: gravity turns about x at 20 deg/s
+    angle = np.radians(20.0) * np.arange(x.shape[0]) / FS
+    x[:, 0] += math.radians(20.0) + math.radians(5.0) * np.sin(angle * 7)
+    x[:, 4] = 9.81 * np.sin(angle)
+    x[:, 5] = 9.81 * np.cos(angle)
+    with pytest.raises(ValueError, match="too few static samples: no span at rest of at least 1 s"):
+        segment_log(x, None, FS)
+    with pytest.raises(ValueError, match="too few samples: the log has 50"):
+        segment_log(x[:50], None, FS)
