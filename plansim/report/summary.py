@@ -27,7 +27,8 @@ parameter, in SI:
 Memory: the kept tails hold ``(2.5 % + 2.5 % + 5 %) × n × 39`` values for the parameters plus
 ``2 × 5 % × n`` per parameter of the Appendix A budgets (27 of them) and ``5 % × n`` per parameter
 for each further reading (A.1: 1, A.2: 1, A.3: 2, A.5: 2), 8 bytes each, and at most as much again
-waiting to be merged: about 150 MB at n = 10⁶ (:func:`summary_memory_bytes`).
+waiting to be merged: :func:`summary_memory_bytes` bounds it by 211 MB at n = 10⁶, 29 MB of which
+for the further readings.
 """
 
 from __future__ import annotations
