@@ -324,6 +324,8 @@ def test_bad_logs_are_refused_naming_the_line_and_column(tmp_path, capsys):
                                     "--scale", "16.4,-2048"], "expected a positive number of counts per unit")
     expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--latitude", "91"],
                  "--latitude 91.0: expected a number from -90 to 90 deg")
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--window", "0"],
+                 "--window 0.0: expected a positive number of seconds")
 
 
 def test_flawed_logs_import_with_named_warnings(tmp_path):

@@ -277,14 +277,18 @@ def moving_mean_variance(x: np.ndarray, window: int) -> tuple[np.ndarray, np.nda
     half = window // 2
     lo = np.clip(np.arange(n) - half, 0, n)
     hi = np.clip(np.arange(n) - half + window, 0, n)
-    centre = np.median(x, axis=0)
-    y = x - centre  # small numbers: the running sums keep their precision
-    s1 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(y, axis=0)])
-    s2 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(y * y, axis=0)])
-    count = (hi - lo)[:, None].astype(np.float64)
-    mean = (s1[hi] - s1[lo]) / count
-    variance = np.maximum((s2[hi] - s2[lo]) / count - mean * mean, 0.0)
-    return mean + centre, variance
+    count = (hi - lo).astype(np.float64)
+    mean = np.empty(x.shape)
+    variance = np.empty(x.shape)
+    for c in range(x.shape[1]):  # one column at a time: a few (N,) temporaries, not (N, C) ones
+        centre = float(np.median(x[:, c]))
+        y = x[:, c] - centre  # small numbers: the running sums keep their precision
+        s1 = np.concatenate(([0.0], np.cumsum(y)))
+        m = (s1[hi] - s1[lo]) / count
+        s1 = np.concatenate(([0.0], np.cumsum(y * y)))
+        variance[:, c] = np.maximum((s1[hi] - s1[lo]) / count - m * m, 0.0)
+        mean[:, c] = m + centre
+    return mean, variance
 
 
 def resolution(x: np.ndarray) -> np.ndarray:
@@ -496,14 +500,17 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
 def _one_sided_reference(x: np.ndarray, w: int) -> np.ndarray:
     """Per sample, whichever of the mean of the *w* samples before it and of the *w* after it is nearer it."""
     n = x.shape[0]
-    centre = np.median(x, axis=0)
-    sums = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x - centre, axis=0)])
     k = np.arange(n)
     lo, hi = np.maximum(k - w, 0), np.minimum(k + 1 + w, n)
-    before = np.where((k > 0)[:, None], (sums[k] - sums[lo]) / np.maximum(k - lo, 1)[:, None], np.inf) + centre
-    after = np.where((k < n - 1)[:, None], (sums[hi] - sums[k + 1]) / np.maximum(hi - k - 1, 1)[:, None],
-                     np.inf) + centre
-    return np.where(np.abs(x - before) <= np.abs(x - after), before, after)
+    n_before, n_after = np.maximum(k - lo, 1), np.maximum(hi - k - 1, 1)
+    out = np.empty(x.shape)
+    for c in range(x.shape[1]):
+        centre = float(np.median(x[:, c]))
+        sums = np.concatenate(([0.0], np.cumsum(x[:, c] - centre)))
+        before = np.where(k > 0, (sums[k] - sums[lo]) / n_before, np.inf) + centre
+        after = np.where(k < n - 1, (sums[hi] - sums[k + 1]) / n_after, np.inf) + centre
+        out[:, c] = np.where(np.abs(x[:, c] - before) <= np.abs(x[:, c] - after), before, after)
+    return out
 
 
 def _sigma(variance: np.ndarray, w: int, floor: np.ndarray) -> np.ndarray:

@@ -51,6 +51,8 @@ GRAVITY_TOLERANCE = 0.3
 JITTER_WARNING = 0.1
 #: a given sample rate that differs from the time column's by more than this fraction is a warning
 RATE_MISMATCH_WARNING = 0.01
+#: rows converted to numbers at a time while reading
+_BLOCK_ROWS = 65536
 #: the temperature assumed for each segment when the log has no temperature channel, degC
 DEFAULT_TEMPERATURE = 20.0
 
@@ -217,7 +219,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                              "are then ignored)")
         index = [header_names.index(name) for name in wanted]
         width = len(header_names)
-        values: list[list[str]] = []
+        blocks: list[np.ndarray] = []  # rows converted block by block: floats, not text, are kept
+        block: list[list[float]] = []
         lines: list[int] = []
         line_number = header_line
         for row in csv.reader(fh, delimiter=delimiter):
@@ -230,25 +233,28 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 word = "more" if len(row) > width else "fewer"
                 raise ValueError(f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
                                  f"of the header (line {header_line}); every row holds one value per column")
-            values.append([row[k] for k in index])
+            try:
+                numbers = [float(row[k]) for k in index]
+            except ValueError:
+                j = next(j for j, k in enumerate(index) if not _is_number(row[k]))
+                raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
+                                 "expected a number") from None
+            if not all(map(math.isfinite, numbers)):
+                j = next(j for j, v in enumerate(numbers) if not math.isfinite(v))
+                raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
+                                 "every value must be a finite number (a sample lost by the logger? cut the log before "
+                                 "or after it)")
+            block.append(numbers)
             lines.append(line_number)
+            if len(block) == _BLOCK_ROWS:
+                blocks.append(np.array(block, dtype=np.float64))
+                block = []
+        if block:
+            blocks.append(np.array(block, dtype=np.float64))
     _check_line_end(target, where)
-    if not values:
+    if not blocks:
         raise ValueError(f"{where}: no sample after the header (line {header_line})")
-    data = np.empty((len(values), len(wanted)))
-    for j, name in enumerate(wanted):
-        column = [row[j] for row in values]
-        try:
-            data[:, j] = np.array(column, dtype=np.float64)
-        except ValueError:
-            k = next(k for k, text in enumerate(column) if not _is_number(text))
-            raise ValueError(f"{where}: column {name!r} is {column[k].strip()!r} at line {lines[k]}; expected a "
-                             "number") from None
-        bad = np.flatnonzero(~np.isfinite(data[:, j]))
-        if bad.size:
-            k = int(bad[0])
-            raise ValueError(f"{where}: column {name!r} is {column[k].strip()!r} at line {lines[k]}; every value "
-                             "must be a finite number (a sample lost by the logger? cut the log before or after it)")
+    data = np.concatenate(blocks)
     time = data[:, 6] if time_column is not None else None
     temperature = data[:, -1] if temperature_column is not None else None
     return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
@@ -321,6 +327,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if temperature_column is not None and temperature is not None:
         raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
                          "temperature)")
+    for option, value in (("--window", window), ("--min-static", min_static)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value > 0 and math.isfinite(value)):
+            raise ValueError(f"{option} {value!r}: expected a positive number of seconds")
     if temperature is not None and not math.isfinite(temperature):
         raise ValueError(f"--temperature {temperature!r}: expected a finite number of degC")
     site = {}
