@@ -11,26 +11,33 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    on each sample (truncated at the ends of the log).
 2. **Resolution.** Each channel's step: the smallest non-zero difference between two consecutive
    samples. A quantised channel cannot show noise below step/√12, so that is its noise floor.
-3. **Quietest stretch.** ``Q``, the stretch of ``max(min_static, 4 windows)`` without a time gap where
-   the sum over the channels of (moving variance / that channel's median moving variance over the log)
-   is smallest. It is taken to be at rest.
-4. **Noise.** In ``Q``: per channel σ = √(median of the moving variance / median of χ²(w−1)/w) (the
-   robust standard deviation of one sample, at least the quantisation floor; the MAD of the samples would
-   be 0 for a channel quantised to about its noise), the gyro bias b (the mean of the clipped samples, see
-   below) and the noise of a *w*-sample gyro
-   mean, s = 1.4826 · MAD(m(t + w) − m(t)) / √2 (a robust overlapping Allan deviation at τ = *w*
-   samples; at least σ/√w, which it equals for white noise, and larger for correlated noise).
-5. **Quiet samples.** A sample is quiet when, over its window, Σ_accel var/σ² ≤ ``VARIANCE_FACTOR`` × 3
-   and Σ_gyro var/σ² ≤ ``VARIANCE_FACTOR`` × 3 (3 is the expected sum at rest), and no time gap lies
-   within *h* samples. Runs of at least ``min_static`` seconds of quiet samples are kept if they hold one
-   pose: the mean specific force of their first and last windows differ by at most ``RATE_FACTOR`` √2
-   times the noise of a window mean plus ``POSE_TOLERANCE`` (0.5°) of gravity on each axis (a unit
-   tumbling smoothly can be as quiet as its own quietest stretch, but its gravity turns).
-6. **At rest or turning steadily?** A quiet run is at rest unless its mean gyro output differs from b by
-   more than ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to
-   ±Ω_E on any axis, depending on its pose); otherwise it is a *steady turn* (a rate table holding a
-   rate), and belongs to the motion around it. A turn slower than that threshold cannot be told from
-   rest by any detector without a reference; the threshold is reported.
+3. **Quietest stretch.** ``Q``, the stretch of ``max(min_static, QUIET_WINDOWS windows)`` without a time
+   gap where the sum over the channels of (moving variance / that channel's median moving variance over
+   the log) is smallest. It is taken to be at rest.
+4. **Noise.** In ``Q``, per channel: σ = √(median of the moving variance / median of χ²(w−1)/w), the
+   robust standard deviation of one sample, at least the quantisation floor (the MAD of the samples
+   would be 0 for a channel quantised to about its noise). Then every sample is clipped to ``CLIP`` σ
+   about the nearer of the means of the *w* samples before it and the *w* after it (an isolated spike
+   cannot look like motion; a step stays sharp, a ramp still shows), the moving statistics are taken
+   again on the clipped samples and σ once more from them. Also in ``Q``: the gyro bias b (mean of the
+   clipped samples) and the noise of a *w*-sample gyro mean, s = 1.4826 · MAD(m(t + w) − m(t)) / √2 (a
+   robust overlapping Allan deviation at τ = *w* samples; at least σ/√w, which it equals for white
+   noise, and larger for correlated noise).
+5. **Quiet samples.** A sample is quiet when, over its window, Σ_accel var/σ² and Σ_gyro var/σ² are each
+   at most the larger of ``VARIANCE_FACTOR`` × 3 (3 is the expected sum at rest) and the median of that
+   sum in ``Q`` plus ``SPREAD_FACTOR`` robust standard deviations of it (wider for correlated or
+   heavy-tailed noise), and no time gap lies within *h* samples. Runs of at least ``min_static`` seconds
+   of quiet samples are kept if they hold one pose: the mean specific force of their first and last
+   windows differ by at most ``RATE_FACTOR`` √2 times the noise of a window mean plus ``POSE_TOLERANCE``
+   (0.5°) of gravity on each axis (a unit tumbling smoothly can be as quiet as its own quietest stretch,
+   but its gravity turns).
+6. **At rest or turning steadily?** The run that holds ``Q`` is at rest. Working outwards from it, each
+   other run is at rest unless its mean gyro output differs from that of the nearest run at rest by more
+   than ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to ±Ω_E on
+   any axis, depending on its pose; comparing neighbours, a slow drift of the bias over a long log is not
+   a turn); otherwise it is a *steady turn* (a rate table holding a rate), and belongs to the motion
+   around it. A turn slower than that threshold cannot be told from rest by any detector without a
+   reference; the threshold is reported.
 7. **Poses.** Each static span's up axis is the body axis nearest its mean specific force; the tilt is
    the angle between the two. The heading cannot be told without a heading reference: it is not
    reported.
