@@ -1,4 +1,4 @@
-"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``import``, ``bench``.
+"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``import``, ``fit``, ``bench``.
 
 Errors in the user's input end with ``plansim: error: …`` and exit status 2, before any work starts:
 output paths are checked first (:func:`plansim.io.files.check_output_path`). The output files of one
@@ -249,6 +249,57 @@ def _add_import_command(sub) -> None:
     p.set_defaults(func=_cmd_import)
 
 
+def _cmd_fit(args) -> int:
+    from plansim.fit import fit_recording, resolve_site
+    from plansim.fit.result import fit_dataset, fit_json
+    from plansim.io.recording import read_recording
+    from plansim.io.scenario_file import load_scenario
+    from plansim.report.fit import fit_report
+
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".nc",))
+    scenario = load_scenario(args.scenario) if args.scenario is not None else None
+    recording = read_recording(args.recording)
+    site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
+    options = {}
+    if scenario is not None:
+        options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
+                       reference_gravity=scenario.reduction.reference_gravity,
+                       omega_squared_sign=scenario.reduction.omega_squared_sign)
+    result = fit_recording(recording, site, **options)
+    with OutputSet() as outputs:
+        if args.out is not None:
+            fit_dataset(result).to_netcdf(outputs.stage(args.out, "--out", (".nc",)), engine="h5netcdf")
+        outputs.commit()
+    if args.json:
+        print(json.dumps(fit_json(result), indent=2))
+    else:
+        print(fit_report(result, residuals=not args.no_residuals))
+        if args.out is not None:
+            print(f"\nwrote fit: {args.out}")
+    return 0
+
+
+def _add_fit_command(sub) -> None:
+    p = sub.add_parser(
+        "fit", help=COMMANDS["fit"],
+        description="Fit a recording: which of the 39 JJF 2003 parameters its segments identify, their estimates by "
+                    "the specification's estimators (where the procedure is complete) and by one joint weighted "
+                    "least squares, the noise from the data (Allan deviation), and each parameter's standard "
+                    "uncertainty (docs/fitting.md)")
+    p.add_argument("recording", help="recording file (.nc, or the samples .csv beside its .segments.csv)")
+    p.add_argument("--latitude", type=float, default=None, metavar="DEG",
+                   help="site latitude (default: the recording's site_latitude_deg, else the scenario's)")
+    p.add_argument("--height", type=float, default=None, metavar="M", help="site height, with --latitude")
+    p.add_argument("--scenario", default=None,
+                   help="the lab's scenario (name or TOML path): its site, turntable/fixture grade and reduction "
+                        "(default: JJF 2003 Table 1 and the recording's attributes)")
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the report")
+    p.add_argument("--out", default=None, help="write the fit as a NetCDF file (.nc)")
+    p.add_argument("--no-residuals", action="store_true", help="leave the per-segment residual table out of the report")
+    p.set_defaults(func=_cmd_fit)
+
+
 def _cmd_validate(args) -> int:
     from plansim.io.claims import load_claims
     from plansim.io.scenario_file import load_scenario
@@ -330,6 +381,7 @@ COMMANDS = {
     "scenarios": "list the built-in scenarios",
     "record": "write one simulated trial's raw samples",
     "import": "a plain CSV log to a recording with segments",
+    "fit": "fit a recording: parameters, noise, uncertainty",
     "bench": "measure speed and memory on this machine",
 }
 
@@ -386,6 +438,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_record)
 
     _add_import_command(sub)
+    _add_fit_command(sub)
 
     p = sub.add_parser("bench", help=COMMANDS["bench"],
                        description="Measure speed and memory on this machine (takes a few minutes)")

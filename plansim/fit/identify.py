@@ -1,0 +1,122 @@
+"""Which of the 39 parameters a recording's segments identify: the rank and null space of the design.
+
+The segment means are linear in the parameters, ``m = J·θ`` (:mod:`plansim.fit.model`). A parameter
+θ_k is identified when every θ that fits the noise-free means equally well has the same θ_k, i.e.
+when the unit vector e_k is orthogonal to the null space of J (it lies in J's row space). Computed on
+J with every column scaled to unit length (so that a rate in rad/s and a bias in m/s² weigh alike),
+by the singular value decomposition: singular values below :data:`RANK_TOLERANCE` times the largest
+span the null space; θ_k is identified when its component in that null space is below
+:data:`NULL_TOLERANCE`.
+
+J is evaluated at the nominal point (Kg = Ka = I, the rest 0) on the recording's *designed*
+excitation: the table's rates and gravity, without the Earth rate. The Earth rate (at most 7.3e-5 rad/s,
+15 °/h) stays a known input of the fit, but on its own it does not count as identifying a parameter:
+it would "identify" Kg from static poses through 15 °/h of input and P through Ω² ≈ 5e-9 (rad/s)²,
+with uncertainties of 10 % and 10⁴ m/s² per (rad/s)² for a MEMS unit — mathematically, never usefully
+(docs/fitting.md). A parameter that is not identified is reported as NaN with the reason, never given a value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from plansim.model.parameters import PARAMETER_NAMES
+
+#: singular values below this fraction of the largest (of the column-scaled design) count as zero: the
+#: design's entries are exact sums of gravity and rates, so rounding leaves ~1e-15; 1e-9 keeps every
+#: genuine direction down to a rate point of 1e-9 of the largest
+RANK_TOLERANCE = 1e-9
+#: a parameter is identified when the norm of its unit vector's projection onto the null space is below this
+NULL_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class Identifiability:
+    """The outcome of :func:`identifiability`.
+
+    Attributes
+    ----------
+    identified : tuple of str
+        Parameters the segments determine, in the order of :data:`~plansim.model.parameters.PARAMETER_NAMES`.
+    not_identified : dict
+        Parameter -> the reason it is not identified.
+    rank : int
+        Rank of the design: the number of independent combinations of parameters the segments determine.
+    row_space : (rank, 39) array
+        Orthonormal basis of the determined combinations in the column-scaled coordinates (rows).
+    scale : (39,) array
+        The column norms of J (0 for a parameter the segments do not depend on): θ_k = z_k / scale_k.
+    """
+
+    identified: tuple[str, ...]
+    not_identified: dict[str, str]
+    rank: int
+    row_space: np.ndarray = field(repr=False)
+    scale: np.ndarray = field(repr=False)
+
+    @property
+    def mask(self) -> np.ndarray:
+        """(39,) True where identified."""
+        return np.array([name in self.identified for name in PARAMETER_NAMES])
+
+    @property
+    def basis(self) -> np.ndarray:
+        """(39, rank) θ − θ_nominal = basis · z spans exactly what the segments determine."""
+        inverse = np.divide(1.0, self.scale, out=np.zeros_like(self.scale), where=self.scale > 0)
+        return inverse[:, None] * self.row_space.T
+
+
+def identifiability(design: np.ndarray, what: str = "the recording's segments") -> Identifiability:
+    """Which parameters the design ``J`` (rows: segment means, columns: the 39 parameters) identifies.
+
+    Parameters
+    ----------
+    design : (R, 39) array
+        ∂(segment means)/∂θ at the nominal point, the Earth rate left out (:meth:`MeanModel.parameter_jacobian`).
+    what : str
+        How to name the data in the reasons.
+
+    Returns
+    -------
+    Identifiability
+    """
+    design = np.asarray(design, dtype=float)
+    if design.ndim != 2 or design.shape[1] != len(PARAMETER_NAMES):
+        raise ValueError(f"design: expected shape (R, {len(PARAMETER_NAMES)}), got {design.shape}")
+    scale = np.linalg.norm(design, axis=0)
+    largest = scale.max() if scale.size else 0.0
+    enters = scale > 1e-12 * largest if largest > 0 else np.zeros(len(scale), bool)
+    scale = np.where(enters, scale, 0.0)
+    scaled = design[:, enters] / scale[enters]
+    n = int(enters.sum())
+    if n:
+        _, singular, vt = np.linalg.svd(scaled, full_matrices=True)
+        rank = int(np.sum(singular > RANK_TOLERANCE * singular[0])) if singular.size else 0
+        null = vt[rank:].T  # (n, n - rank)
+        row = vt[:rank]
+    else:
+        rank, null, row = 0, np.zeros((0, 0)), np.zeros((0, 0))
+    row_space = np.zeros((rank, len(PARAMETER_NAMES)))
+    row_space[:, enters] = row
+    projector = null @ null.T if null.size else np.zeros((n, n))
+    entering = [name for name, e in zip(PARAMETER_NAMES, enters) if e]
+    identified, not_identified = [], {}
+    for k, name in enumerate(PARAMETER_NAMES):
+        if not enters[k]:
+            not_identified[name] = (f"{what} do not excite it: no table rate or gravity reaches it (the Earth rate "
+                                     "alone does not count)")
+            continue
+        j = entering.index(name)
+        if np.sqrt(max(projector[j, j], 0.0)) < NULL_TOLERANCE:
+            identified.append(name)
+            continue
+        partners = [entering[i] for i in np.argsort(-np.abs(projector[j]))
+                    if i != j and abs(projector[j, i]) > NULL_TOLERANCE]
+        if partners:
+            shown = ", ".join(partners[:6]) + (f" and {len(partners) - 6} more" if len(partners) > 6 else "")
+            not_identified[name] = f"{what} see it only in combination with {shown}"
+        else:
+            not_identified[name] = f"{what} see it only in combination with other parameters"
+    return Identifiability(tuple(identified), not_identified, rank, row_space, scale)

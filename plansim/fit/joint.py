@@ -1,0 +1,476 @@
+"""``fit_recording``: a recording's segments to parameters, with uncertainties from the data's own noise.
+
+Steps (docs/fitting.md):
+
+1. **Segments.** Those whose pose and rate are known (every segment of a plansim recording; a measured
+   log's table segments) enter the mean model (:mod:`plansim.fit.model`). Segments of the other kinds
+   (a ``move``; a pose whose orientation is approximate or unknown; a turn whose rate was not logged)
+   are listed with the reason they are not used yet.
+2. **Identifiability** of the 39 parameters from the rank and null space of the design
+   (:mod:`plansim.fit.identify`).
+3. **Noise** from the samples: Allan deviation and within-segment scatter (:mod:`plansim.fit.noise`).
+4. **Type B inputs** that act once per setting and never show in the scatter: the turntable's and
+   fixture's errors (the lab's grade, or JJF 2003 Table 1), the unrecorded start angle of each turning
+   segment, gravity and the Earth rate when the site is not known, and the Kg entries held at their
+   nominal value where the Earth rate alone meets them.
+5. **Estimates.** (a) Where the procedure is complete (``check_design`` passes), the specification's
+   estimators, eq. (3)–(13), on the segment means. (b) In every case, one joint generalised least
+   squares over all the used segments' means, ``scipy.optimize.least_squares`` on the residuals
+   whitened by the covariance V of the means (noise plus Type B): θ̂ minimises (m − Jθ)ᵀ V⁻¹ (m − Jθ)
+   over the identified combinations, the rest held at the nominal point.
+6. **Uncertainty** by the GUM law of propagation (JCGM 100 5.1.2): both estimators are linear in the
+   segment means, θ̂ = A·m, so the contribution of each independent input (the noise of each segment
+   mean, each table error, …) to θ̂_k is A_k·(∂m/∂x)·u(x); ``combine`` adds them and gives ν_eff.
+7. **Residuals** per segment and channel, χ²/dof, and where the schedule repeats a setting the
+   between-segment variance component from the data beside the one the noise and the table grade predict.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from plansim.estimate.jjf2003 import check_design, reduction_matrix
+from plansim.fit.identify import Identifiability, identifiability
+from plansim.fit.model import MeanModel, nominal_parameters
+from plansim.fit.noise import NoiseEstimate, estimate_noise, quantisation_harmonics
+from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
+from plansim.schedule.segments import Schedule
+from plansim.uncertainty.metrology.propagation import combine
+
+#: standard uncertainty of a Kg entry that the recording does not identify but the Earth rate reaches (the
+#: model holds it at its nominal value, 1 or 0): 1 %, the scale-factor error and misalignment a MEMS gyro's
+#: data sheet allows (docs/fitting.md); its effect is ≤ 0.01·7.3e-5 rad/s on a segment mean
+HELD_KG_UNCERTAINTY = 0.01
+#: two-sided probability outside which a χ² (fit, or between-segment comparison) is flagged
+CHI2_FLAG_PROBABILITY = 0.01
+
+METHOD_SPEC = "jjf2003"
+METHOD_JOINT = "joint_wls"
+
+
+@dataclass(frozen=True)
+class Method:
+    """The estimates of one method (39 each, SI; NaN where not identified).
+
+    ``contributions`` maps a kind of input (``noise``, ``table``, ``angle``, ``site``, ``held``) to the
+    (39,) root-sum-square of its contributions: the budget in short.
+    """
+
+    name: str
+    estimate: np.ndarray
+    u: np.ndarray
+    dof: np.ndarray
+    contributions: dict = field(repr=False)
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class BetweenSegments:
+    """Repeated settings of one channel: the data's scatter between segments against the prediction."""
+
+    channel: str
+    groups: int
+    dof: int
+    observed_sd: float  # r.m.s. within-group deviation of the residuals (data), SI
+    predicted_sd: float  # the same predicted from the noise model and the Type B table errors
+    predicted_noise_sd: float  # ... from the noise alone
+    predicted_table_sd: float  # ... from the per-setting table errors alone
+    component_sd: float  # between-segment component from the data: sqrt(max(observed² − noise part, 0))
+    ratio: float  # observed² / predicted²
+    verdict: str
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """Everything :func:`fit_recording` found. Arrays over the used segments unless said otherwise."""
+
+    site: Site
+    turntable_source: str
+    identifiability: Identifiability
+    used: tuple[int, ...]  # indices into the recording's schedule
+    unused: dict  # index -> reason
+    labels: tuple[str, ...]  # of the used segments
+    observed: np.ndarray  # (S, 6) segment means
+    fitted: np.ndarray  # (S, 6) joint model's means at θ̂
+    residual_sd: np.ndarray  # (S, 6) predicted standard deviation of each residual
+    noise: NoiseEstimate
+    joint: Method
+    spec: Method | None
+    spec_note: str
+    spec_bias: np.ndarray  # (39,) E[spec] − θ at the joint estimate (site's Earth rate etc.); NaN if unknown
+    chi2: float
+    chi2_dof: int
+    chi2_verdict: str
+    between: tuple[BetweenSegments, ...]
+    attrs: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    @property
+    def residuals(self) -> np.ndarray:
+        """(S, 6) observed − fitted, SI."""
+        return self.observed - self.fitted
+
+    @property
+    def identified(self) -> tuple[str, ...]:
+        return self.identifiability.identified
+
+    @property
+    def not_identified(self) -> dict:
+        return self.identifiability.not_identified
+
+    @property
+    def methods(self) -> tuple[Method, ...]:
+        return (self.spec, self.joint) if self.spec is not None else (self.joint,)
+
+
+def _segment_use(schedule: Schedule) -> tuple[list[int], dict[int, str]]:
+    used, unused = [], {}
+    for k, s in enumerate(schedule.segments):
+        if s.test == "move":
+            unused[k] = "a move between poses: no reference to fit it against"
+        elif s.orientation != "known" or not s.heading_known:
+            unused[k] = (f"orientation {s.orientation!r}: poses known only roughly need the norm-based fit, "
+                         "not implemented yet (docs/fitting.md)")
+        elif not s.rate_known:
+            unused[k] = "the rate was not logged: turns known by their angle are not fitted yet (docs/fitting.md)"
+        else:
+            used.append(k)
+    return used, unused
+
+
+def _samples_of(recording, k: int) -> np.ndarray:
+    first = int(recording.first_sample[k])
+    return np.asarray(recording.samples[first:first + recording.schedule.segments[k].samples], dtype=float)
+
+
+def _chi2_verdict(chi2: float, dof: int) -> str:
+    from scipy.special import chdtrc
+
+    if dof <= 0:
+        return "no degrees of freedom left: the fit is exact by construction"
+    upper = float(chdtrc(dof, chi2))  # P(χ² ≥ observed)
+    if upper < CHI2_FLAG_PROBABILITY / 2:
+        return (f"the residuals are larger than the estimated noise and table errors predict (P = {upper:.2g}): "
+                "an effect the model lacks, or noise that does not average down")
+    if upper > 1 - CHI2_FLAG_PROBABILITY / 2:
+        return f"the residuals are smaller than predicted (P = {1 - upper:.2g} of so small a χ²): the stated " \
+               "uncertainties may be too large"
+    return f"consistent with the estimated noise and table errors (P(χ² ≥ observed) = {upper:.2g})"
+
+
+class _Sources:
+    """The independent inputs of the segment means: sensitivity columns (6S, n), standard uncertainties,
+    degrees of freedom and kinds. Their covariance is V = D·diag(u²)·Dᵀ."""
+
+    def __init__(self, size: int):
+        self.size = size
+        self.columns: list[np.ndarray] = []
+        self.u: list[float] = []
+        self.dof: list[float] = []
+        self.kind: list[str] = []
+
+    def add(self, column, u, dof, kind):
+        self.columns.append(np.asarray(column, dtype=float))
+        self.u.append(float(u))
+        self.dof.append(float(dof))
+        self.kind.append(kind)
+
+    def matrix(self) -> np.ndarray:
+        """(6S, n) sensitivity × u."""
+        return np.column_stack(self.columns) * np.asarray(self.u)[None, :] if self.columns else np.zeros((self.size, 0))
+
+    def covariance(self, kinds=None) -> np.ndarray:
+        d = self.matrix()
+        if kinds is not None:
+            d = d[:, [k in kinds for k in self.kind]]
+        return d @ d.T
+
+
+def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, turntable, site_inputs,
+                   held: list[int], jacobian: np.ndarray, levels: np.ndarray) -> _Sources:
+    S = model.n_segments
+    sources = _Sources(6 * S)
+    quantisation = noise.quantisation_variance
+    variance = (noise.mean_variance - quantisation).ravel()
+    dof = noise.mean_variance_dof.ravel()
+    for i in range(6 * S):
+        column = np.zeros(6 * S)
+        column[i] = 1.0
+        sources.add(column, math.sqrt(max(variance[i], 0.0)), dof[i], "noise")
+    # a quantiser the noise does not dither: the error of a segment mean is a function of its level μ_s,
+    # e_s = Σ_k (−1)^k b_k sin(2πk(μ_s + v)/q) with the channel's offset v unknown (uniform over a step), so
+    # segments at nearly the same level (a repeated setting; the rate test's accelerometers) share it:
+    # Cov(e_s, e_r) = Σ_k b_k,s b_k,r/2 · cos(2πk(μ_s − μ_r)/q) · d_k,s d_k,r (+ the variance lost to the
+    # damping on the diagonal), d_k,s = exp(−2π²k²u(μ_s)²/q²) for a level known to u(μ_s) (docs/fitting.md).
+    # Without levels (the first pass) each segment's error is taken independent.
+    for c, channel in enumerate(noise.channels):
+        q = channel.quantisation_step
+        if q <= 0 or not np.any(quantisation[:, c] > 0):
+            continue
+        if levels is None:
+            for k in np.flatnonzero(quantisation[:, c] > 0):
+                column = np.zeros((S, 6))
+                column[k, c] = 1.0
+                sources.add(column.ravel(), math.sqrt(quantisation[k, c]), math.inf, "quantisation")
+            continue
+        mu, u_mu = levels
+        b = quantisation_harmonics(q, noise.quantisation_sigma[:, c])  # (K, S)
+        b[:, quantisation[:, c] <= 0] = 0.0
+        k = np.arange(1, b.shape[0] + 1)[:, None]
+        damping = np.exp(-2.0 * math.pi**2 * k**2 * (u_mu[None, :, c] / q) ** 2)
+        phase = 2.0 * math.pi * k * mu[None, :, c] / q
+        shared = b * damping
+        cov = 0.5 * ((shared * np.cos(phase)).T @ (shared * np.cos(phase))
+                     + (shared * np.sin(phase)).T @ (shared * np.sin(phase)))
+        cov += np.diag(0.5 * np.sum(b**2 * (1.0 - damping**2), axis=0))
+        values, vectors = np.linalg.eigh(cov)
+        for value, vector in zip(values, vectors.T):
+            if value > 1e-12 * values.max():
+                column = np.zeros((S, 6))
+                column[:, c] = vector
+                sources.add(column.ravel(), math.sqrt(value), math.inf, "quantisation")
+    inputs = list(model.table_sources(theta, turntable))
+    if site_inputs is not None:
+        inputs += model.site_sources(theta, *site_inputs)
+    covariance = model.angle_covariance(theta)  # the start angle itself, then its interaction with each input
+    for source in inputs:
+        sources.add(source.sensitivity, source.u, math.inf, source.kind)
+        if source.angle_spread is not None:
+            covariance = covariance + source.u**2 * source.angle_spread
+    # each channel's share on its own: across the channels of a segment the angle's effect is a turning vector
+    # seen through Kg, whose cross terms are what is being estimated, so the fit must not lean on that
+    # correlation (it would weigh a gyro's ±2e-8 rad/s on-axis leak of the Earth rate as an exact measure
+    # of the ±3e-5 rad/s off-axis one)
+    for s in np.flatnonzero(model.rotating):
+        for c in range(6):
+            if covariance[s, c, c] > 0:
+                column = np.zeros((S, 6))
+                column[s, c] = 1.0
+                sources.add(column.ravel(), math.sqrt(covariance[s, c, c]), math.inf, "angle")
+    for k in held:
+        sources.add(jacobian[:, k], HELD_KG_UNCERTAINTY, math.inf, "held")
+    return sources
+
+
+def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "") -> Method:
+    """θ̂ = gain · m: u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent sources."""
+    contributions = gain @ sources.matrix()  # (39, n)
+    dofs = np.asarray(sources.dof)
+    u = np.full(len(PARAMETER_NAMES), math.nan)
+    nu = np.full(len(PARAMETER_NAMES), math.nan)
+    for k in np.flatnonzero(mask):
+        u[k], nu[k] = combine(contributions[k], dofs)
+    by_kind = {}
+    kinds = np.asarray(sources.kind)
+    for kind in dict.fromkeys(sources.kind):
+        part = np.sqrt(np.sum(contributions[:, kinds == kind] ** 2, axis=1))
+        by_kind[kind] = np.where(mask, part, math.nan)
+    return Method(name, np.full(len(PARAMETER_NAMES), math.nan), u, nu, by_kind, note)
+
+
+#: eigenvalues of the means' covariance V below this fraction of its largest are raised to it before V is
+#: inverted: a channel that shows no noise at all (noise-free data) must not make V singular to rounding
+EIGENVALUE_FLOOR = 1e-14
+
+
+def whitening(V: np.ndarray) -> np.ndarray:
+    """W with W·V·Wᵀ = I (V = U Λ Uᵀ, W = Λ^{-1/2} Uᵀ), eigenvalues floored at :data:`EIGENVALUE_FLOOR`·max."""
+    values, vectors = np.linalg.eigh(V)
+    values = np.maximum(values, EIGENVALUE_FLOOR * max(values.max(), 1e-300))
+    return (vectors / np.sqrt(values)).T
+
+
+def _solve(J: np.ndarray, basis: np.ndarray, theta0: np.ndarray, observed: np.ndarray, W: np.ndarray):
+    """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
+
+    Returns θ̂ (39,) and the gain A (39, 6S) with θ̂ − θ0 = A·(m − J θ0).
+    """
+    if basis.shape[1] == 0:
+        return theta0.copy(), np.zeros((len(theta0), len(observed)))
+    X = W @ J @ basis
+    y = W @ (observed - J @ theta0)
+    result = least_squares(lambda z: X @ z - y, np.zeros(basis.shape[1]), jac=lambda z: X, method="lm",
+                           x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    gain = basis @ np.linalg.lstsq(X, W, rcond=None)[0]
+    return theta0 + basis @ result.x, gain
+
+
+def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
+                  reference_gravity: float | None = None, omega_squared_sign: str = "model") -> FitResult:
+    """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
+
+    Parameters
+    ----------
+    recording : plansim.io.recording.Recording
+        (or anything with ``samples`` (M, 6), ``schedule``, ``first_sample``, ``segment_means()`` and ``attrs``).
+    site : Site, optional
+        Where the unit was (:func:`plansim.fit.site.resolve_site`); default: not known.
+    turntable : plansim.config.scenario.Turntable, optional
+        The turntable's and fixture's grade; default JJF 2003 Table 1 (:data:`TABLE_1_TURNTABLE`).
+    turntable_source : str
+        How to name it in the report.
+    reference_gravity : float, optional
+        "1 g" of the specification's matrix A, m/s²; default: the site's gravity (the middle of the range
+        of :func:`~plansim.fit.site.unknown_site_inputs` when the site is not known).
+    omega_squared_sign : {"model", "as_printed"}
+        Eq. (12)'s sign (:func:`plansim.estimate.jjf2003.rate_sensitivity`).
+
+    Returns
+    -------
+    FitResult
+    """
+    site = Site() if site is None else site
+    if turntable is None:
+        turntable, turntable_source = TABLE_1_TURNTABLE, turntable_source or "JJF 2003 Table 1"
+    schedule = recording.schedule
+    used, unused = _segment_use(schedule)
+    notes = []
+    if not used:
+        raise ValueError("recording: no segment has a known pose and rate, so none can be fitted; "
+                         f"{len(unused)} segment(s) not used: " + "; ".join(f"{k}: {r}" for k, r in unused.items()))
+    used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
+    if site.known:
+        gravity, earth, site_inputs = site.gravity, site.earth_rate_vector, None
+    else:
+        gravity, u_gravity, earth, u_earth = unknown_site_inputs(site.earth_rate)
+        site_inputs = (u_gravity, u_earth)
+        notes.append(f"site not known: gravity {gravity:.6f} ± {u_gravity:.4f} m/s² and the Earth rate over every "
+                     "latitude enter as Type B inputs (give --latitude/--height)")
+    model = MeanModel(used_schedule, gravity, earth)
+    ident = identifiability(model.parameter_jacobian(earth_rate=False))
+    J = model.parameter_jacobian(earth_rate=True)
+    mask = ident.mask
+    held = [PARAMETER_INDEX[p.name] for p in PARAMETERS
+            if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
+
+    # noise: every segment that is not a move (any pose at rest shows the sensors' noise)
+    noise_segments = [k for k, s in enumerate(schedule.segments) if s.test != "move"]
+    all_noise = estimate_noise([_samples_of(recording, k) for k in noise_segments],
+                               [schedule.segments[k] for k in noise_segments])
+    rows = [noise_segments.index(k) for k in used]
+    noise = NoiseEstimate(all_noise.channels, all_noise.within_std[rows], all_noise.mean_variance[rows],
+                          all_noise.mean_variance_dof[rows], all_noise.quantisation_variance[rows],
+                          all_noise.quantisation_sigma[rows], all_noise.notes)
+
+    means_all = np.asarray(recording.segment_means(), dtype=float)
+    observed = means_all[used]
+    m = observed.ravel()
+    theta0 = nominal_parameters()
+    basis = ident.basis
+    theta, levels = theta0, None
+    for _ in range(2):  # Type B sensitivities at the nominal point, then at the estimate
+        sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels)
+        V = sources.covariance()
+        W = whitening(V)
+        theta, gain = _solve(J, basis, theta0, m, W)
+        # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
+        level_cov = J @ gain @ V @ gain.T @ J.T
+        levels = ((J @ theta).reshape(observed.shape),
+                  np.sqrt(np.maximum(np.diag(level_cov), 0.0)).reshape(observed.shape))
+    joint = _propagate(METHOD_JOINT, gain, sources, mask)
+    joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
+    fitted = (J @ theta).reshape(observed.shape)
+    residual = m - J @ theta
+    hat = J @ gain
+    project = np.eye(len(m)) - hat
+    residual_cov = project @ V @ project.T
+    residual_sd = np.sqrt(np.maximum(np.diag(residual_cov), 0.0)).reshape(observed.shape)
+    chi2 = float(np.sum((W @ residual) ** 2))
+    chi2_dof = len(m) - ident.rank
+
+    # the specification's estimators where the procedure is complete
+    spec, spec_note = None, ""
+    spec_bias = np.full(len(PARAMETER_NAMES), math.nan)
+    g_ref = gravity if reference_gravity is None else reference_gravity
+    try:
+        check_design(schedule)
+    except ValueError as exc:
+        spec_note = f"the specification's estimators need the whole procedure: {exc}"
+    else:
+        M = reduction_matrix(schedule, g_ref, omega_squared_sign)
+        if M is None:
+            spec_note = "the specification's reduction is not linear for this schedule"
+        else:
+            needed = np.flatnonzero(np.any(M != 0, axis=1)) // 6
+            missing = sorted(set(needed.tolist()) - set(used))
+            if missing:
+                spec_note = (f"the specification's estimators use segment(s) {missing}, whose pose or rate is not "
+                             "known")
+            else:
+                rows6 = (np.asarray(used)[:, None] * 6 + np.arange(6)[None, :]).ravel()
+                spec_gain = M[rows6].T  # (39, 6S_used)
+                estimate = means_all.ravel() @ M
+                all_mask = np.ones(len(PARAMETER_NAMES), bool)
+                spec = _propagate(METHOD_SPEC, spec_gain, sources, all_mask,
+                                  f"JJF 2003 eq. (3)-(13), 1 g = {g_ref:.8g} m/s^2")
+                spec = Method(METHOD_SPEC, estimate, spec.u, spec.dof, spec.contributions, spec.note)
+                if mask.all():
+                    spec_bias = spec_gain @ (J @ theta) - theta
+    if spec is None and not spec_note:
+        spec_note = "not run"
+    between = _between_segments(used_schedule, residual, residual_cov, project, sources)
+    return FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
+                     unused=unused, labels=tuple(s.label for s in used_schedule.segments), observed=observed,
+                     fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
+                     spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,
+                     chi2_verdict=_chi2_verdict(chi2, chi2_dof), between=between,
+                     attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes)
+
+
+def _repeat_groups(schedule: Schedule) -> list[list[int]]:
+    """Segments that repeat one setting (same up-axis, rate and rate axis; the heading may differ)."""
+    groups: dict[tuple, list[int]] = {}
+    for k, s in enumerate(schedule.segments):
+        key = (s.up, s.rate, s.rate_axis if s.is_rotating else None)
+        groups.setdefault(key, []).append(k)
+    return [g for g in groups.values() if len(g) >= 2]
+
+
+def _between_segments(schedule: Schedule, residual: np.ndarray, residual_cov: np.ndarray, project: np.ndarray,
+                      sources: _Sources) -> tuple[BetweenSegments, ...]:
+    """Within-group scatter of the residuals of repeated settings, per channel, against its prediction.
+
+    For channel c, Q_c projects the residuals of each group onto their deviations from the group's mean;
+    the observed sum of squares is rᵀQ_c r, its expectation under the model trace(Q_c·R V Rᵀ) with
+    R = I − H (H the fit's hat matrix), split into the noise's and the table's parts. The data's
+    between-segment component beyond the noise is sqrt(max(observed − noise part, 0)/ν).
+    """
+    from scipy.special import chdtrc
+
+    groups = _repeat_groups(schedule)
+    if not groups:
+        return ()
+    n = residual.size
+    V_noise = sources.covariance({"noise"})
+    V_table = sources.covariance({"table", "angle"})
+    out = []
+    for c, name in enumerate(("gx", "gy", "gz", "ax", "ay", "az")):
+        Q = np.zeros((n, n))
+        dof = 0
+        for g in groups:
+            idx = np.array(g) * 6 + c
+            block = np.eye(len(g)) - 1.0 / len(g)
+            Q[np.ix_(idx, idx)] = block
+            dof += len(g) - 1
+        observed = float(residual @ Q @ residual)
+        expected = float(np.trace(Q @ residual_cov))
+        noise_part = float(np.trace(Q @ project @ V_noise @ project.T))
+        table_part = max(float(np.trace(Q @ project @ V_table @ project.T)), 0.0)
+        noise_part = max(noise_part, 0.0)
+        ratio = observed / expected if expected > 0 else math.inf
+        upper = float(chdtrc(dof, dof * ratio)) if math.isfinite(ratio) else 0.0
+        if upper < CHI2_FLAG_PROBABILITY / 2:
+            verdict = "the data scatter more than predicted"
+        elif upper > 1 - CHI2_FLAG_PROBABILITY / 2:
+            verdict = "the data scatter less than predicted"
+        else:
+            verdict = "consistent"
+        out.append(BetweenSegments(name, len(groups), dof, math.sqrt(observed / dof), math.sqrt(expected / dof),
+                                   math.sqrt(noise_part / dof), math.sqrt(table_part / dof),
+                                   math.sqrt(max(observed - noise_part, 0.0) / dof), ratio, verdict))
+    return tuple(out)

@@ -1,0 +1,268 @@
+"""The fit's model of the segment means: the simulator's own noise-free physics, nothing else.
+
+JJF 2003-2022 eq. (1) and (2),
+
+    gyro:          ω' = Kg·ω + Bg + G·a
+    accelerometer: a' = Ka·a + Ba + P·(ω²),
+
+evaluated for each recorded segment at its nominal pose and table rate, with the site's local gravity
+and Earth rate as known inputs, by the same kernel the simulator uses
+(:func:`plansim.kernels.segment_path.noise_free_means`, which
+:func:`plansim.simulate.arguments.noise_free_segment_means` calls): one model, not two. The unit's
+39 parameters go into the truth part of a draws vector (:mod:`plansim.kernels.layout`); every effect
+beyond eq. (1)/(2) is off, and every table error zero unless a caller sets it to get a sensitivity.
+
+The mean of a segment is linear in the 39 parameters (every term of eq. (1)/(2) is a parameter times
+a known input), so the model is ``m = J·θ`` with ``J`` (6S × 39) evaluated once per schedule:
+:meth:`MeanModel.parameter_jacobian`.
+
+Angles nobody recorded: the table angle at which a rotating segment starts (its phase) is not in any
+recording, and the segment mean depends on it through the parts of gravity and the Earth rate that
+turn with the table (for a vertical table axis, only the horizontal Earth rate, over a dwell that is not
+a whole number of turns). The model takes the mean over that angle, uniform over a turn: the average
+of :data:`ANGLES` equally spaced angles, exact for outputs of degree < :data:`ANGLES` in the angle
+(the kernel's outputs have degree ≤ 3), and the spread over it becomes a Type B term
+(:meth:`MeanModel.angle_covariance`; exact for degree < :data:`ANGLES`/2).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from plansim.config.scenario import parse_scenario
+from plansim.kernels import segment_path
+from plansim.kernels.layout import (
+    FIXTURE,
+    HEAD,
+    PER_SEGMENT,
+    PERPENDICULARITY,
+    RATE_SYSTEMATIC,
+    SEG_PHASE,
+    SEG_POSITION_ACCURACY,
+    SEG_RATE_ERROR,
+    TILT,
+    TRUTH,
+    draws_length,
+)
+from plansim.model.parameters import N_PARAMETERS, pack
+from plansim.schedule.segments import Schedule
+from plansim.simulate.arguments import as_float_arrays, kernel_arguments
+
+#: equally spaced start angles (phases) a rotating segment's mean is averaged over: exact for a mean of
+#: degree < 8 in the angle, its variance over the angle exact for degree < 4 (the kernel's is ≤ 3)
+ANGLES = 8
+
+#: the kernel arguments :func:`segment_path.noise_free_means` takes (as noise_free_segment_means passes them)
+_KEEP = ("seg_n", "seg_dt", "seg_C0", "seg_rate", "seg_axis", "seg_axis_index", "seg_temp", "sensor", "S2",
+         "lever", "t_ref", "gravity", "earth_enu")
+
+#: steps of the central differences for the sensitivities to table errors: rad, relative rate, m/s², rad/s.
+#: The outputs are smooth (sines of the angles), so the truncation error is ~h²/6 of the sensitivity
+#: (2e-11 for 1e-5 rad) and the rounding ~1e-16·|m|/h.
+ANGLE_STEP = 1e-5
+RATE_STEP = 1e-6
+GRAVITY_STEP = 1e-3
+EARTH_RATE_STEP = 1e-7
+
+
+def nominal_parameters() -> np.ndarray:
+    """The nominal point of JJF 2003 eq. (1)/(2): Kg = Ka = I, every bias and sensitivity zero (39,)."""
+    eye, zero3, zero33 = np.eye(3), np.zeros(3), np.zeros((3, 3))
+    return pack(eye, zero3, zero33, eye, zero3, zero33)
+
+
+@lru_cache(maxsize=1)
+def _template():
+    """A scenario with every effect, noise and table error off (only its kernel arguments are used)."""
+    return parse_scenario({"name": "fit model"})
+
+
+@dataclasses.dataclass(frozen=True)
+class InputSource:
+    """One Type B input of the segment means: its name, its standard uncertainty and the segment means'
+    sensitivity to it (6S,) averaged over the start angles, flattened segment by segment (channels gx gy gz
+    ax ay az)."""
+
+    name: str
+    kind: str  # "table", "site"
+    u: float
+    sensitivity: np.ndarray
+    #: (S, 6, 6) covariance over the unrecorded start angle of the sensitivity per unit input: in a turning
+    #: segment a tilt of the table axis turns gravity with the table, so the effect of the input depends on
+    #: the angle the segment started at; u²·angle_spread is the variance that interaction adds
+    angle_spread: np.ndarray | None = None
+
+
+class MeanModel:
+    """Noise-free segment means of a schedule's segments under eq. (1)/(2), by the simulator's kernel.
+
+    Parameters
+    ----------
+    schedule : Schedule
+        The segments to model, each with a known pose (``up``, ``heading``) and a known rate.
+    gravity : float
+        Local gravity, m/s².
+    earth_enu : (3,) array_like
+        Earth rate in East-North-Up, rad/s.
+    """
+
+    def __init__(self, schedule: Schedule, gravity: float, earth_enu):
+        for k, s in enumerate(schedule.segments):
+            if not (s.rate_known and s.heading_known):
+                raise ValueError(f"segment {k} ({s.label!r}): the mean model needs a known heading and rate, "
+                                 f"got heading {s.heading!r}, rate {s.rate!r}")
+        self.schedule = schedule
+        self.n_segments = len(schedule)
+        scenario = dataclasses.replace(_template(), schedule=schedule)
+        args = as_float_arrays(kernel_arguments(scenario))
+        self._args = {k: args[k] for k in _KEEP}
+        self.gravity = float(gravity)
+        self.earth_enu = np.ascontiguousarray(earth_enu, dtype=float)
+        self.rotating = np.array([s.is_rotating for s in schedule.segments])
+
+    # ------------------------------------------------------------------ evaluation
+    def evaluate(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
+        """Noise-free segment means (n, S, 6) of draws vectors (n, D), at the given table angles."""
+        draws = np.ascontiguousarray(np.atleast_2d(draws), dtype=float)
+        if draws.shape[1] != draws_length(self.n_segments):
+            raise ValueError(f"draws: expected shape (n, {draws_length(self.n_segments)}), got {draws.shape}")
+        args = dict(self._args)
+        args["gravity"] = self.gravity if gravity is None else float(gravity)
+        args["earth_enu"] = self.earth_enu if earth_enu is None else np.ascontiguousarray(earth_enu, dtype=float)
+        out = np.empty((draws.shape[0], self.n_segments, 6))
+        segment_path.noise_free_means(draws, **args, means_out=out)
+        return out
+
+    def draws(self, theta: np.ndarray) -> np.ndarray:
+        """A draws vector (D,) with the parameters *theta* (39,), every table error and start angle zero."""
+        out = np.zeros(draws_length(self.n_segments))
+        out[TRUTH] = theta
+        return out
+
+    def _at_angles(self, draws: np.ndarray) -> np.ndarray:
+        """(n, D) -> (n·ANGLES, D): each draws vector with every rotating segment started at 2πk/ANGLES."""
+        draws = np.atleast_2d(draws)
+        out = np.repeat(draws, ANGLES, axis=0)
+        rows = np.arange(self.n_segments)[self.rotating]
+        phases = np.tile(2.0 * math.pi * np.arange(ANGLES) / ANGLES, draws.shape[0])
+        out[:, HEAD + PER_SEGMENT * rows + SEG_PHASE] = phases[:, None]
+        return out
+
+    def averaged(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
+        """Segment means (n, S, 6) averaged over the unrecorded start angle of each rotating segment."""
+        draws = np.atleast_2d(draws)
+        values = self.evaluate(self._at_angles(draws), gravity, earth_enu)
+        return values.reshape(draws.shape[0], ANGLES, self.n_segments, 6).mean(axis=1)
+
+    def means(self, theta: np.ndarray) -> np.ndarray:
+        """The model's segment means (S, 6) for parameters *theta* (39,)."""
+        return self.averaged(self.draws(theta))[0]
+
+    # ------------------------------------------------------------------ the design
+    def parameter_jacobian(self, earth_rate: bool = True) -> np.ndarray:
+        """∂m/∂θ (6S, 39), exact: the model is linear in θ and zero at θ = 0.
+
+        ``earth_rate = False`` leaves the Earth rate out: the *designed* excitation (table rates, gravity)
+        that :mod:`plansim.fit.identify` judges identifiability on.
+        """
+        draws = np.zeros((N_PARAMETERS, draws_length(self.n_segments)))
+        draws[:, TRUTH] = np.eye(N_PARAMETERS)
+        earth = None if earth_rate else np.zeros(3)
+        values = self.averaged(draws, earth_enu=earth)  # (39, S, 6)
+        return values.reshape(N_PARAMETERS, -1).T.copy()
+
+    def angle_covariance(self, theta: np.ndarray) -> np.ndarray:
+        """(S, 6, 6) covariance of each segment's mean over its unrecorded start angle (0 at rest)."""
+        values = self.evaluate(self._at_angles(self.draws(theta)))  # (ANGLES, S, 6)
+        centred = values - values.mean(axis=0)
+        return np.einsum("ksi,ksj->sij", centred, centred) / ANGLES
+
+    def _central(self, theta: np.ndarray, columns, step: float, gravity_step: float = 0.0,
+                 earth_step=None) -> np.ndarray:
+        """Central-difference sensitivity (ANGLES, S, 6) of the segment means at each start angle to the draws
+        entries *columns* (all at once: each segment's entries move only its own mean), or to gravity or the
+        Earth rate (``gravity_step``, ``earth_step``, with *step* 1)."""
+        base = self._at_angles(self.draws(theta))
+        plus, minus = base.copy(), base.copy()
+        if columns is not None:
+            plus[:, columns] += step
+            minus[:, columns] -= step
+        earth_step = np.zeros(3) if earth_step is None else np.asarray(earth_step, dtype=float)
+        hi = self.evaluate(plus, self.gravity + gravity_step, self.earth_enu + earth_step)
+        lo = self.evaluate(minus, self.gravity - gravity_step, self.earth_enu - earth_step)
+        return (hi - lo) / (2.0 * step)
+
+    @staticmethod
+    def _source(name: str, kind: str, u: float, at_angles: np.ndarray, segment: int | None = None) -> InputSource:
+        """An input source from its sensitivities at the start angles (ANGLES, S, 6), for one segment or all."""
+        if segment is not None:
+            keep = np.zeros_like(at_angles)
+            keep[:, segment] = at_angles[:, segment]
+            at_angles = keep
+        mean = at_angles.mean(axis=0)
+        centred = at_angles - mean
+        spread = np.einsum("ksi,ksj->sij", centred, centred) / ANGLES
+        return InputSource(name, kind, u, mean.ravel(), spread)
+
+    def table_sources(self, theta: np.ndarray, turntable) -> list[InputSource]:
+        """Type B inputs of the turntable and fixture (JJF 2003 Table 1, §6.2), at the parameters *theta*.
+
+        Per segment: the position error (a rotation of the pose about East, North and Up; accuracy and
+        repeatability together) and, when the table turns, the rate error of the point. Per calibration:
+        the fixture's misalignment (3), the platform tilt (2), the rate-axis perpendicularity (2 per
+        axis) and the systematic rate error. Each with the standard uncertainty of its
+        :class:`~plansim.config.scenario.ErrorDistribution` and the sensitivity of the segment means by
+        central differences of the kernel's physics.
+        """
+        S = self.n_segments
+        sources: list[InputSource] = []
+        u_position = math.hypot(turntable.position_accuracy.standard_uncertainty,
+                                turntable.position_repeatability.standard_uncertainty)
+        if u_position > 0:
+            for axis, name in enumerate("ENU"):
+                columns = HEAD + PER_SEGMENT * np.arange(S) + SEG_POSITION_ACCURACY + 2 * axis
+                d = self._central(theta, columns, ANGLE_STEP)  # (ANGLES, S, 6): each segment's own
+                for s in range(S):
+                    if np.any(d[:, s]):
+                        sources.append(self._source(f"position error about {name}, segment {s}", "table",
+                                                    u_position, d, s))
+        u_point = turntable.rate_error_per_point.standard_uncertainty
+        if u_point > 0 and self.rotating.any():
+            d = self._central(theta, HEAD + PER_SEGMENT * np.arange(S) + SEG_RATE_ERROR, RATE_STEP)
+            for s in np.flatnonzero(self.rotating):
+                sources.append(self._source(f"rate error of the point, segment {s}", "table", u_point, d, s))
+        per_calibration = [
+            ("fixture misalignment about x", FIXTURE.start, turntable.fixture_perpendicularity, ANGLE_STEP),
+            ("fixture misalignment about y", FIXTURE.start + 1, turntable.fixture_perpendicularity, ANGLE_STEP),
+            ("fixture misalignment about z", FIXTURE.start + 2, turntable.fixture_perpendicularity, ANGLE_STEP),
+            ("platform tilt about East", TILT.start, turntable.platform_tilt, ANGLE_STEP),
+            ("platform tilt about North", TILT.start + 1, turntable.platform_tilt, ANGLE_STEP),
+            ("systematic rate error", RATE_SYSTEMATIC, turntable.rate_error_systematic, RATE_STEP),
+        ] + [(f"perpendicularity of the {'xyz'[k // 2]} rate axis ({k % 2})", PERPENDICULARITY.start + k,
+              turntable.axis_perpendicularity, ANGLE_STEP) for k in range(6)]
+        for name, column, distribution, step in per_calibration:
+            u = distribution.standard_uncertainty
+            if u > 0:
+                d = self._central(theta, [column], step)
+                if np.any(d):
+                    sources.append(self._source(name, "table", u, d))
+        return sources
+
+    def site_sources(self, theta: np.ndarray, u_gravity: float, u_earth_enu) -> list[InputSource]:
+        """Type B inputs of an unknown site: gravity and the Earth rate's components."""
+        sources = []
+        if u_gravity > 0:
+            d = self._central(theta, None, 1.0, gravity_step=GRAVITY_STEP) * (1.0 / GRAVITY_STEP)
+            sources.append(self._source("local gravity (site not known)", "site", float(u_gravity), d))
+        for axis, name in enumerate(("East", "North", "Up")):
+            u = float(np.asarray(u_earth_enu)[axis])
+            if u > 0:
+                step = np.zeros(3)
+                step[axis] = EARTH_RATE_STEP
+                d = self._central(theta, None, 1.0, earth_step=step) * (1.0 / EARTH_RATE_STEP)
+                sources.append(self._source(f"Earth rate, {name} component (site not known)", "site", u, d))
+        return sources

@@ -1,0 +1,357 @@
+"""The noise of a recording, from its own samples: within-segment scatter and the Allan deviation.
+
+For each channel (gx gy gz ax ay az):
+
+1. **Allan deviation** of every static segment (overlapping, ``allantools.oadev``, octave-spaced τ up
+   to half the segment), pooled over the static segments at each τ (weighted by the number of terms),
+   and fitted with the IEEE Std 952 (Annex C) model
+
+       σ_A²(τ) = N²/τ + (2 ln 2/π)·B² + K²·τ/3
+
+   (white noise N, bias instability B, rate random walk K; all ≥ 0) by non-negative weighted least
+   squares, each point weighted by its own variance 2σ_A⁴/ν (ν: the equivalent degrees of freedom of
+   the overlapping Allan variance for white noise, Howe, Allan & Barnes 1981), twice (the second time
+   with the first fit's σ_A in the weights).
+2. **Within-segment scatter**: the standard deviation of each segment's samples about their mean; in
+   a turning segment, about a second-degree trigonometric polynomial in the table angle (the turning
+   projection of gravity and the Earth rate is not noise).
+3. **Quantisation**: a channel whose values are whole multiples of one step q (found from the data)
+   is quantised; where the noise is too small to dither it (σ ≲ q/2), a segment mean carries a
+   systematic error of r.m.s. √(Σ_k (q/πk)² e^{−4π²k²σ²/q²} / 2) (q/√12 without noise), which no
+   scatter shows.
+
+**The variance of a segment mean** of duration T is then the Allan variance at τ = T — the mean square
+difference between two adjacent such means — from the fitted model: N²/T + (2 ln 2/π)B² + K²T/3. The
+white part averages down, the bias-instability part does not (it is the same whatever T), and the random
+walk grows. Not σ²/n: that holds for white noise only. In a turning segment the white part is the larger
+of N²/T and the segment's own scatter²/n (the table's rate jitter adds white noise the static segments do
+not have). A floor of :data:`RELATIVE_FLOOR` of the channel's r.m.s. keeps the weights finite when the
+data carry no noise at all (a simulated ``ideal`` recording).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from plansim.kernels.layout import CHANNELS
+
+#: flicker floor of the Allan variance per unit B²: σ_A² = (2 ln 2/π)·B² (IEEE Std 952, C.1)
+FLICKER_VARIANCE = 2.0 * math.log(2.0) / math.pi
+#: the smallest variance of a segment mean, relative to the channel's r.m.s. squared (noise-free data)
+RELATIVE_FLOOR = 1e-12
+#: a channel counts as quantised when its static values are multiples of one step to this (relative) and
+#: at most this fraction of them are distinct
+QUANTISATION_MATCH = 1e-6
+QUANTISATION_DISTINCT = 0.5
+#: the drop in χ² for which the Allan fit takes a bias-instability or random-walk term (per term); calibrated by
+#: simulation (tests/test_fit.py): pure white noise in 21 segments of 3000 samples gets one in 0.9 % of 1000 channels
+TERM_THRESHOLD = 13.0
+#: the harmonics in the table angle removed from a turning segment before its scatter is taken
+TURNING_HARMONICS = 2
+
+UNITS_SI = {"gyro": {"white": "rad/s/sqrt(Hz)", "bias_instability": "rad/s", "rate_random_walk": "rad/s/sqrt(s)",
+                     "mean": "rad/s"},
+            "accel": {"white": "m/s^2/sqrt(Hz)", "bias_instability": "m/s^2",
+                      "rate_random_walk": "m/s^2/sqrt(s)", "mean": "m/s^2"}}
+
+
+def channel_kind(channel: int) -> str:
+    return "gyro" if channel < 3 else "accel"
+
+
+def allan_deviation(values: np.ndarray, sample_rate: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Overlapping Allan deviation of one channel's samples (rate data), octave-spaced τ up to half the record.
+
+    Parameters
+    ----------
+    values : (n,) array
+        Samples, in the channel's unit (rad/s, m/s²).
+    sample_rate : float
+        Hz.
+
+    Returns
+    -------
+    tau : array
+        s.
+    adev : array
+        σ_A(τ), the channel's unit.
+    dof : array
+        Equivalent degrees of freedom of σ_A²(τ) (white-noise formula of Howe, Allan & Barnes 1981:
+        ν = [3(n−1)/(2m) − 2(n−2)/n]·4m²/(4m² + 5), m = τ·rate).
+    """
+    import allantools  # only the fit needs it: a quarter-second import
+
+    values = np.asarray(values, dtype=float)
+    n = values.size
+    if n < 3:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    taus, adev, _, _ = allantools.oadev(values, rate=float(sample_rate), data_type="freq", taus="octave")
+    keep = (taus * sample_rate <= n / 2) & np.isfinite(adev)
+    taus, adev = np.asarray(taus)[keep], np.asarray(adev)[keep]
+    m = np.rint(taus * sample_rate)
+    dof = (3.0 * (n - 1) / (2.0 * m) - 2.0 * (n - 2) / n) * 4.0 * m**2 / (4.0 * m**2 + 5.0)
+    return taus, adev, np.maximum(dof, 1.0)
+
+
+def allan_model(tau, white: float, bias_instability: float, rate_random_walk: float) -> np.ndarray:
+    """σ_A²(τ) = N²/τ + (2 ln 2/π)B² + K²τ/3 (IEEE Std 952, Annex C)."""
+    tau = np.asarray(tau, dtype=float)
+    return white**2 / tau + FLICKER_VARIANCE * bias_instability**2 + rate_random_walk**2 * tau / 3.0
+
+
+def _weighted_nnls(basis: np.ndarray, avar: np.ndarray, dof: np.ndarray) -> tuple[np.ndarray, float]:
+    """Non-negative weighted least squares of σ_A² on *basis*: coefficients and χ² (weights ν/(2σ_A⁴), the
+    second pass with the first fit's σ_A)."""
+    from scipy.optimize import nnls
+
+    level = np.where(avar > 0, avar, np.max(avar) if np.any(avar > 0) else 1.0)
+    coefficients, chi2 = np.zeros(basis.shape[1]), math.inf
+    for _ in range(2):
+        weight = np.sqrt(dof / 2.0) / np.maximum(level, 1e-300)
+        coefficients, norm = nnls(basis * weight[:, None], avar * weight)
+        chi2 = norm**2
+        fitted = basis @ coefficients
+        if not np.all(fitted > 0):
+            break
+        level = fitted
+    return coefficients, chi2
+
+
+def fit_allan(tau: np.ndarray, avar: np.ndarray, dof: np.ndarray,
+              threshold: float | None = None) -> tuple[float, float, float]:
+    """N, B, K ≥ 0 of :func:`allan_model` by weighted non-negative least squares on σ_A²(τ).
+
+    White noise N is always fitted. Bias instability B and random walk K enter only where the data ask
+    for them: a term is added (B, then K, then both) when it lowers the fit's χ² by more than
+    *threshold* (default :data:`TERM_THRESHOLD`, calibrated by simulation to add a term to pure white noise
+    in about 1 % of channels: docs/fitting.md). Otherwise a non-negative fit always finds a little B or
+    K in the scatter of the long-τ points and inflates every segment mean's variance.
+    """
+    threshold = TERM_THRESHOLD if threshold is None else threshold
+    tau, avar, dof = (np.asarray(x, dtype=float) for x in (tau, avar, dof))
+    if tau.size == 0:
+        return math.nan, math.nan, math.nan
+    columns = {"N": 1.0 / tau, "B": np.full_like(tau, FLICKER_VARIANCE), "K": tau / 3.0}
+    chosen = ["N"]
+    coefficients, chi2 = _weighted_nnls(columns["N"][:, None], avar, dof)
+    for extra in (["B"], ["K"], ["B", "K"]):
+        trial = ["N"] + extra
+        if len(tau) <= len(trial):
+            continue
+        c, x2 = _weighted_nnls(np.column_stack([columns[t] for t in trial]), avar, dof)
+        if chi2 - x2 > threshold * (len(trial) - len(chosen)) and x2 < chi2:
+            chosen, coefficients, chi2 = trial, c, x2
+    values = dict(zip(chosen, coefficients))
+    return tuple(float(math.sqrt(max(values.get(t, 0.0), 0.0))) for t in ("N", "B", "K"))
+
+
+def quantisation_step(segments: list[np.ndarray]) -> float:
+    """The step q of a quantised channel, or 0 when the data do not show one.
+
+    Within each segment (a static one: its level does not change) the distinct values of a quantised
+    channel are whole multiples of q apart and most samples repeat one of them. So q is the smallest gap
+    between distinct values within any segment, accepted when every such gap is a whole multiple of it
+    (to :data:`QUANTISATION_MATCH`) and at most :data:`QUANTISATION_DISTINCT` of those segments' samples
+    are distinct. A channel constant within every segment (no noise at all, or noise far below the step)
+    shows no step: 0.
+
+    Parameters
+    ----------
+    segments : list of (n,) arrays
+        One channel's samples in each static segment.
+    """
+    gaps, distinct, samples = [], 0, 0
+    for values in segments:
+        levels = np.unique(np.asarray(values, dtype=float))
+        if levels.size >= 2:
+            gaps.append(np.diff(levels))
+            distinct += levels.size
+            samples += len(values)
+    if not gaps or distinct > QUANTISATION_DISTINCT * samples:
+        return 0.0
+    gaps = np.concatenate(gaps)
+    q = float(gaps.min())
+    if q <= 0:
+        return 0.0
+    ratio = gaps / q
+    if np.all(np.abs(ratio - np.rint(ratio)) <= QUANTISATION_MATCH * np.maximum(ratio, 1.0)):
+        return q
+    return 0.0
+
+
+#: harmonics of the quantiser's Fourier series kept (the dropped tail of Σ 1/k² is < 1/QUANTISATION_HARMONICS)
+QUANTISATION_HARMONICS = 2000
+
+
+def quantisation_harmonics(step: float, sigma) -> np.ndarray:
+    """Amplitudes b_k = (q/πk)·e^{−2π²k²σ²/q²}, k = 1…:data:`QUANTISATION_HARMONICS`, shape (K,) + shape(sigma).
+
+    The mean of a quantised Gaussian signal N(μ, σ²) (step q, mid-tread) is μ + Σ_k (−1)^k b_k sin(2πkμ/q)
+    (the quantiser's Fourier series; Widrow & Kollár, *Quantization Noise*, ch. 5).
+    """
+    sigma = np.asarray(sigma, dtype=float)
+    k = np.arange(1, QUANTISATION_HARMONICS + 1).reshape((-1,) + (1,) * sigma.ndim)
+    if step <= 0:
+        return np.zeros(k.shape[:1] + sigma.shape)
+    return step / (math.pi * k) * np.exp(-2.0 * math.pi**2 * k**2 * (sigma[None, ...] / step) ** 2)
+
+
+def quantisation_error_variance(step: float, sigma) -> np.ndarray:
+    """Mean square systematic error of the mean of a quantised Gaussian signal whose level is unknown within a step.
+
+    With μ uniform over a step, the bias Σ_k (−1)^k b_k sin(2πkμ/q) (:func:`quantisation_harmonics`) has
+    mean square Σ_k b_k²/2: q²/12 at σ = 0, vanishing once σ ≳ q/2 (the noise dithers the quantiser).
+    """
+    return 0.5 * np.sum(quantisation_harmonics(step, sigma) ** 2, axis=0)
+
+
+@dataclass(frozen=True)
+class ChannelNoise:
+    """The noise of one channel, SI (see :data:`UNITS_SI`)."""
+
+    channel: str
+    white: float  # N: rad/s/√Hz (= rad/√s) or m/s²/√Hz
+    bias_instability: float  # B: rad/s or m/s²
+    rate_random_walk: float  # K: rad/s/√s or m/s²/√s
+    quantisation_step: float  # q, the channel's unit; 0: not quantised
+    static_segments: int
+    static_samples: int
+    tau: np.ndarray = field(repr=False)
+    adev: np.ndarray = field(repr=False)
+    dof: np.ndarray = field(repr=False)
+
+    @property
+    def kind(self) -> str:
+        return channel_kind(CHANNELS.index(self.channel))
+
+    def units(self) -> dict[str, str]:
+        return UNITS_SI[self.kind]
+
+
+@dataclass(frozen=True)
+class NoiseEstimate:
+    """:func:`estimate_noise`'s outcome for the segments it was given (S of them)."""
+
+    channels: tuple[ChannelNoise, ...]
+    within_std: np.ndarray  # (S, 6) scatter of the samples within each segment
+    mean_variance: np.ndarray  # (S, 6) variance of each segment mean from the noise model
+    mean_variance_dof: np.ndarray  # (S, 6) its degrees of freedom (inf: known exactly)
+    quantisation_variance: np.ndarray  # (S, 6) the part of mean_variance due to a non-dithered quantiser
+    quantisation_sigma: np.ndarray  # (S, 6) the noise σ per sample before the quantiser (dithering it)
+    notes: tuple[str, ...] = ()
+
+
+def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tuple[np.ndarray, int]:
+    """Scatter (6,) of a turning segment's samples about a degree-2 trigonometric polynomial in the angle."""
+    n = values.shape[0]
+    angle = rate * np.arange(n) / sample_rate
+    columns = [np.ones(n)]
+    for h in range(1, TURNING_HARMONICS + 1):
+        columns += [np.cos(h * angle), np.sin(h * angle)]
+    design = np.column_stack(columns)
+    if n <= design.shape[1] + 1:
+        return np.std(values, axis=0, ddof=1) if n > 1 else np.zeros(6), max(n - 1, 1)
+    coefficients, *_ = np.linalg.lstsq(design, values, rcond=None)
+    residual = values - design @ coefficients
+    dof = n - design.shape[1]
+    return np.sqrt(np.sum(residual**2, axis=0) / dof), dof
+
+
+def estimate_noise(segment_samples: list[np.ndarray], segments) -> NoiseEstimate:
+    """The noise of each channel and the variance of each segment mean, from the samples alone.
+
+    Parameters
+    ----------
+    segment_samples : list of (n_s, 6) arrays
+        Each segment's samples, SI.
+    segments : sequence of Segment
+        The same segments (their rate and sample rate).
+
+    Returns
+    -------
+    NoiseEstimate
+    """
+    S = len(segments)
+    if S != len(segment_samples):
+        raise ValueError(f"segment_samples: {len(segment_samples)} segments, segments: {S}")
+    static = [k for k, s in enumerate(segments) if not s.is_rotating and segment_samples[k].shape[0] >= 3]
+    notes = []
+    within = np.zeros((S, 6))
+    within_dof = np.zeros(S)
+    for k, (s, x) in enumerate(zip(segments, segment_samples)):
+        if s.is_rotating and s.rate_known:
+            within[k], within_dof[k] = _turning_scatter(x, s.rate, s.sample_rate)
+        elif x.shape[0] > 1:
+            within[k], within_dof[k] = np.std(x, axis=0, ddof=1), x.shape[0] - 1
+    everything = np.concatenate(segment_samples, axis=0)
+    rms = np.sqrt(np.mean(everything**2, axis=0))
+    steps = [quantisation_step([segment_samples[k][:, c] for k in static]) for c in range(6)]
+    for c in range(6):  # a channel constant within every segment may share its sibling channels' quantiser
+        if steps[c] == 0.0 and static and all(np.ptp(segment_samples[k][:, c]) == 0 for k in static):
+            kind = range(0, 3) if c < 3 else range(3, 6)
+            for q in sorted({steps[j] for j in kind if steps[j] > 0}):
+                levels = np.array([segment_samples[k][0, c] for k in static]) / q
+                if np.all(np.abs(levels - np.rint(levels)) <= QUANTISATION_MATCH * np.maximum(np.abs(levels), 1.0)):
+                    steps[c] = q
+                    notes.append(f"{CHANNELS[c]} does not vary within any static segment; its levels are whole "
+                                 f"multiples of the step {q:.6g} found on its sibling channels: taken as quantised "
+                                 "by the same acquisition")
+                    break
+            else:
+                notes.append(f"{CHANNELS[c]} does not vary within any static segment: no noise (or noise far below "
+                             "its quantisation step, which it does not show); its segment means weigh as exact")
+    channels = []
+    for c, name in enumerate(CHANNELS):
+        step = steps[c]
+        taus: dict[float, list] = {}
+        for k in static:
+            tau, adev, dof = allan_deviation(segment_samples[k][:, c], segments[k].sample_rate)
+            for t, a, d in zip(tau, adev, dof):
+                entry = taus.setdefault(round(float(t), 12), [0.0, 0.0])
+                entry[0] += d * a**2
+                entry[1] += d
+        if taus:
+            tau = np.array(sorted(taus))
+            dof = np.array([taus[t][1] for t in tau])
+            avar = np.array([taus[t][0] / taus[t][1] for t in tau])
+            white, bias_instability, random_walk = fit_allan(tau, avar, dof)
+        else:
+            tau = avar = dof = np.zeros(0)
+            white = bias_instability = random_walk = math.nan
+        channels.append(ChannelNoise(name, white, bias_instability, random_walk, step, len(static),
+                                     int(sum(segment_samples[k].shape[0] for k in static)), tau,
+                                     np.sqrt(avar), dof))
+    if not static:
+        notes.append("no static segment: white noise from the within-segment scatter only; bias instability and "
+                     "random walk not estimated (NaN)")
+
+    variance = np.zeros((S, 6))
+    variance_dof = np.full((S, 6), math.inf)
+    quantisation = np.zeros((S, 6))
+    dither = np.zeros((S, 6))
+    static_dof = max(sum(segment_samples[k].shape[0] - 1 for k in static), 1)
+    slow_dof = max(len(static) - 1, 1)
+    for k, (s, x) in enumerate(zip(segments, segment_samples)):
+        n = x.shape[0]
+        duration = n / s.sample_rate
+        for c, ch in enumerate(channels):
+            own = within[k, c] ** 2 / n
+            if math.isnan(ch.white):
+                white, white_dof, slow = own, max(within_dof[k], 1), 0.0
+            else:
+                white, white_dof = ch.white**2 / duration, static_dof
+                if s.is_rotating and own > white:
+                    white, white_dof = own, max(within_dof[k], 1)
+                slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
+            if ch.quantisation_step > 0:
+                dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
+                quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
+            floor = (RELATIVE_FLOOR * rms[c]) ** 2
+            total = white + slow + quantisation[k, c] + floor
+            variance[k, c] = total
+            denominator = white**2 / white_dof + slow**2 / slow_dof
+            variance_dof[k, c] = total**2 / denominator if denominator > 0 else math.inf
+    return NoiseEstimate(tuple(channels), within, variance, variance_dof, quantisation, dither, tuple(notes))

@@ -1,0 +1,122 @@
+"""A fit's result as data: the ``--json`` object of ``plansim fit`` and the ``--out`` NetCDF Dataset.
+
+Everything in SI, each number with its unit. The JSON object has exactly the keys ``identified``,
+``not_identified``, ``parameters``, ``noise``, ``residuals`` and ``chi2_dof`` (docs/fitting.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from plansim.fit.joint import FitResult
+from plansim.fit.noise import UNITS_SI, channel_kind
+from plansim.kernels.layout import CHANNELS
+from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
+
+JSON_KEYS = ("identified", "not_identified", "parameters", "noise", "residuals", "chi2_dof")
+
+
+def _number(value: float):
+    """A float for JSON: NaN and infinity become None (JSON has neither)."""
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def fit_json(result: FitResult) -> dict:
+    """The ``plansim fit --json`` object (SI, units named)."""
+    parameters = []
+    for method in result.methods:
+        for k, spec in enumerate(PARAMETERS):
+            parameters.append({"name": spec.name, "unit": spec.si_unit, "estimate": _number(method.estimate[k]),
+                               "u": _number(method.u[k]), "method": method.name})
+    noise = []
+    for ch in result.noise.channels:
+        units = UNITS_SI[ch.kind]
+        noise.append({"channel": ch.channel,
+                      "white_noise_density": _number(ch.white), "white_noise_density_unit": units["white"],
+                      "bias_instability": _number(ch.bias_instability),
+                      "bias_instability_unit": units["bias_instability"],
+                      "rate_random_walk": _number(ch.rate_random_walk),
+                      "rate_random_walk_unit": units["rate_random_walk"],
+                      "quantisation_step": _number(ch.quantisation_step), "quantisation_step_unit": units["mean"]})
+    residuals = []
+    for s, k in enumerate(result.used):
+        for c, channel in enumerate(CHANNELS):
+            residuals.append({"segment": int(k), "label": result.labels[s], "channel": channel,
+                              "residual": _number(result.residuals[s, c]),
+                              "u": _number(result.residual_sd[s, c]),
+                              "unit": UNITS_SI[channel_kind(c)]["mean"]})
+    return {
+        "identified": list(result.identified),
+        "not_identified": [{"name": name, "reason": reason} for name, reason in result.not_identified.items()],
+        "parameters": parameters,
+        "noise": noise,
+        "residuals": residuals,
+        "chi2_dof": {"chi2": _number(result.chi2), "dof": int(result.chi2_dof),
+                     "ratio": _number(result.chi2 / result.chi2_dof) if result.chi2_dof > 0 else None,
+                     "verdict": result.chi2_verdict},
+    }
+
+
+def fit_dataset(result: FitResult) -> xr.Dataset:
+    """The fit as a self-describing Dataset (``plansim fit --out fit.nc``): estimates, uncertainties,
+    residuals, noise and the between-segment comparison, SI with units."""
+    units = [p.si_unit for p in PARAMETERS]
+    data = {}
+    for method in result.methods:
+        data[f"estimate_{method.name}"] = ("parameter", method.estimate,
+                                           {"long_name": f"estimate by {method.name}"})
+        data[f"u_{method.name}"] = ("parameter", method.u, {"long_name": f"standard uncertainty of {method.name}"})
+        data[f"dof_{method.name}"] = ("parameter", method.dof,
+                                      {"long_name": f"effective degrees of freedom of {method.name} (JCGM 100 G.4)"})
+        for kind, values in method.contributions.items():
+            data[f"u_{method.name}_{kind}"] = ("parameter", values,
+                                               {"long_name": f"part of u_{method.name} from the {kind} inputs"})
+    data["identified"] = ("parameter", np.array([n in result.identified for n in PARAMETER_NAMES], dtype=np.int8),
+                          {"long_name": "1 when the recording's segments identify the parameter"})
+    data["spec_bias"] = ("parameter", result.spec_bias,
+                         {"long_name": "expected error of the specification's estimators at the joint estimate "
+                                       "(the site's Earth rate and gravity; NaN when not computed)"})
+    data["observed"] = (("segment", "channel"), result.observed, {"long_name": "segment mean, JJF 2003 eq. (3)"})
+    data["fitted"] = (("segment", "channel"), result.fitted, {"long_name": "joint model's segment mean"})
+    data["residual"] = (("segment", "channel"), result.residuals, {"long_name": "observed - fitted"})
+    data["residual_u"] = (("segment", "channel"), result.residual_sd,
+                          {"long_name": "predicted standard deviation of the residual"})
+    data["within_std"] = (("segment", "channel"), result.noise.within_std,
+                          {"long_name": "scatter of the samples within the segment"})
+    data["mean_variance"] = (("segment", "channel"), result.noise.mean_variance,
+                             {"long_name": "variance of the segment mean from the noise model"})
+    for field, long_name in (("white", "white-noise density N"), ("bias_instability", "bias instability B"),
+                             ("rate_random_walk", "rate random walk K"), ("quantisation_step", "quantisation step")):
+        data[f"noise_{field}"] = ("channel", np.array([getattr(ch, field) for ch in result.noise.channels]),
+                                  {"long_name": long_name,
+                                   "units": "; ".join(f"{ch.channel}: {ch.units().get(field, ch.units()['mean'])}"
+                                                      for ch in result.noise.channels)})
+    if result.between:
+        for field in ("observed_sd", "predicted_sd", "predicted_noise_sd", "predicted_table_sd", "component_sd",
+                      "ratio"):
+            data[f"between_{field}"] = ("channel", np.array([getattr(b, field) for b in result.between]),
+                                        {"long_name": f"repeated settings: {field.replace('_', ' ')}"})
+    ds = xr.Dataset(data, coords={"parameter": list(PARAMETER_NAMES), "channel": list(CHANNELS),
+                                  "segment": np.asarray(result.used, dtype=np.int32),
+                                  "parameter_unit": ("parameter", units),
+                                  "segment_label": ("segment", list(result.labels))})
+    for name in ("observed", "fitted", "residual", "residual_u", "within_std"):
+        ds[name].attrs["units"] = "gx gy gz rad/s; ax ay az m/s^2"
+    ds["mean_variance"].attrs["units"] = "gx gy gz (rad/s)^2; ax ay az (m/s^2)^2"
+    ds.attrs.update({
+        "title": "plansim fit of a recording",
+        "site": result.site.describe(),
+        "turntable": result.turntable_source,
+        "chi2": result.chi2, "chi2_dof": result.chi2_dof, "chi2_verdict": result.chi2_verdict,
+        "spec_note": result.spec_note,
+        "not_identified": "; ".join(f"{k}: {v}" for k, v in result.not_identified.items()),
+        "unused_segments": "; ".join(f"{k}: {v}" for k, v in result.unused.items()),
+        "notes": " | ".join(result.notes),
+    })
+    for key, value in result.attrs.items():
+        ds.attrs[f"recording_{key}"] = value if isinstance(value, (int, float, str)) else str(value)
+    return ds
