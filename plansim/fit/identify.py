@@ -44,10 +44,11 @@ class Identifiability:
         Parameter -> the reason it is not identified.
     rank : int
         Rank of the design: the number of independent combinations of parameters the segments determine.
-    row_space : (rank, 39) array
-        Orthonormal basis of the determined combinations in the column-scaled coordinates (rows).
-    scale : (39,) array
-        The column norms of J (0 for a parameter the segments do not depend on): θ_k = z_k / scale_k.
+    row_space : (rank, 39 + n) array
+        Orthonormal basis of the determined combinations in the column-scaled coordinates (rows), over the
+        39 parameters and the n nuisance parameters (the tilts of hand-placed poses).
+    scale : (39 + n,) array
+        The column norms of the design (0 for a parameter the segments do not depend on): θ_k = z_k / scale_k.
     """
 
     identified: tuple[str, ...]
@@ -63,12 +64,12 @@ class Identifiability:
 
     @property
     def basis(self) -> np.ndarray:
-        """(39, rank) θ − θ_nominal = basis · z spans exactly what the segments determine."""
+        """(39 + n, rank): (θ, nuisance) − their start = basis · z spans exactly what the segments determine."""
         inverse = np.divide(1.0, self.scale, out=np.zeros_like(self.scale), where=self.scale > 0)
         return inverse[:, None] * self.row_space.T
 
 
-def identifiability(design: np.ndarray, what: str = "the recording's segments") -> Identifiability:
+def identifiability(design: np.ndarray, what: str = "the recording's segments", nuisance=None) -> Identifiability:
     """Which parameters the design ``J`` (rows: segment means, columns: the 39 parameters) identifies.
 
     Parameters
@@ -77,6 +78,9 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments") 
         ∂(segment means)/∂θ at the nominal point, the Earth rate left out (:meth:`MeanModel.parameter_jacobian`).
     what : str
         How to name the data in the reasons.
+    nuisance : (R, n) array, optional
+        ∂(segment means)/∂(nuisance parameters) (the tilts of hand-placed poses): they take part in the null
+        space — a parameter that a tilt can stand in for is not identified — but are not reported.
 
     Returns
     -------
@@ -85,11 +89,14 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments") 
     design = np.asarray(design, dtype=float)
     if design.ndim != 2 or design.shape[1] != len(PARAMETER_NAMES):
         raise ValueError(f"design: expected shape (R, {len(PARAMETER_NAMES)}), got {design.shape}")
-    scale = np.linalg.norm(design, axis=0)
+    extra = np.zeros((design.shape[0], 0)) if nuisance is None else np.asarray(nuisance, dtype=float)
+    names = list(PARAMETER_NAMES) + [f"tilt {k // 2} ({'EN'[k % 2]})" for k in range(extra.shape[1])]
+    full = np.hstack([design, extra])
+    scale = np.linalg.norm(full, axis=0)
     largest = scale.max() if scale.size else 0.0
     enters = scale > 1e-12 * largest if largest > 0 else np.zeros(len(scale), bool)
     scale = np.where(enters, scale, 0.0)
-    scaled = design[:, enters] / scale[enters]
+    scaled = full[:, enters] / scale[enters]
     n = int(enters.sum())
     if n:
         _, singular, vt = np.linalg.svd(scaled, full_matrices=True)
@@ -98,15 +105,15 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments") 
         row = vt[:rank]
     else:
         rank, null, row = 0, np.zeros((0, 0)), np.zeros((0, 0))
-    row_space = np.zeros((rank, len(PARAMETER_NAMES)))
+    row_space = np.zeros((rank, len(names)))
     row_space[:, enters] = row
     projector = null @ null.T if null.size else np.zeros((n, n))
-    entering = [name for name, e in zip(PARAMETER_NAMES, enters) if e]
+    entering = [name for name, e in zip(names, enters) if e]
     identified, not_identified = [], {}
     for k, name in enumerate(PARAMETER_NAMES):
         if not enters[k]:
             not_identified[name] = (f"{what} do not excite it: no table rate or gravity reaches it (the Earth rate "
-                                     "alone does not count)")
+                                    "alone does not count)")
             continue
         j = entering.index(name)
         if np.sqrt(max(projector[j, j], 0.0)) < NULL_TOLERANCE:
@@ -114,8 +121,13 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments") 
             continue
         partners = [entering[i] for i in np.argsort(-np.abs(projector[j]))
                     if i != j and abs(projector[j, i]) > NULL_TOLERANCE]
-        if partners:
-            shown = ", ".join(partners[:6]) + (f" and {len(partners) - 6} more" if len(partners) > 6 else "")
+        tilts = any(p.startswith("tilt") for p in partners)
+        partners = [p for p in partners if not p.startswith("tilt")]
+        shown = ", ".join(partners[:6]) + (f" and {len(partners) - 6} more" if len(partners) > 6 else "")
+        if tilts:
+            not_identified[name] = (f"{what} see it only in combination with the tilts of the hand-placed poses"
+                                    + (f" and {shown}" if shown else ""))
+        elif partners:
             not_identified[name] = f"{what} see it only in combination with {shown}"
         else:
             not_identified[name] = f"{what} see it only in combination with other parameters"

@@ -93,6 +93,8 @@ class FitResult:
     turntable_source: str
     identifiability: Identifiability
     used: tuple[int, ...]  # indices into the recording's schedule
+    tilts: np.ndarray  # (n_placed, 2) fitted tilt of each hand-placed pose about East and North, rad
+    placed: tuple[int, ...]  # the hand-placed poses (indices into the recording's schedule)
     unused: dict  # index -> reason
     labels: tuple[str, ...]  # of the used segments
     observed: np.ndarray  # (S, 6) segment means
@@ -133,19 +135,26 @@ def _segment_use(schedule: Schedule) -> tuple[list[int], dict[int, str]]:
     for k, s in enumerate(schedule.segments):
         if s.test == "move":
             unused[k] = "a move between poses: no reference to fit it against"
-        elif s.orientation != "known" or not s.heading_known:
-            unused[k] = (f"orientation {s.orientation!r}: poses known only roughly need the norm-based fit, "
-                         "not implemented yet (docs/fitting.md)")
         elif not s.rate_known:
             unused[k] = "the rate was not logged: turns known by their angle are not fitted yet (docs/fitting.md)"
+        elif s.is_rotating and (s.orientation != "known" or not s.heading_known):
+            unused[k] = (f"a turn whose pose is {s.orientation!r}: the fit takes turns on a known pose only "
+                         "(docs/fitting.md)")
         else:
-            used.append(k)
+            used.append(k)  # a pose placed by hand is fitted with its tilt as a nuisance parameter
     return used, unused
 
 
 def _samples_of(recording, k: int) -> np.ndarray:
     first = int(recording.first_sample[k])
     return np.asarray(recording.samples[first:first + recording.schedule.segments[k].samples], dtype=float)
+
+
+def _chi2_quantile(dof: int, probability: float) -> float:
+    """The *probability* quantile of χ² with *dof* degrees of freedom."""
+    from scipy.special import chdtri
+
+    return float(chdtri(dof, 1.0 - probability))
 
 
 def _chi2_verdict(chi2: float, dof: int) -> str:
@@ -192,7 +201,7 @@ class _Sources:
 
 
 def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, turntable, site_inputs,
-                   held: list[int], jacobian: np.ndarray, levels: np.ndarray) -> _Sources:
+                   held: list[int], jacobian: np.ndarray, levels, tilts) -> _Sources:
     S = model.n_segments
     sources = _Sources(6 * S)
     quantisation = noise.quantisation_variance
@@ -234,10 +243,10 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
                 column = np.zeros((S, 6))
                 column[:, c] = vector
                 sources.add(column.ravel(), math.sqrt(value), math.inf, "quantisation")
-    inputs = list(model.table_sources(theta, turntable))
+    inputs = list(model.table_sources(theta, turntable, tilts))
     if site_inputs is not None:
-        inputs += model.site_sources(theta, *site_inputs)
-    covariance = model.angle_covariance(theta)  # the start angle itself, then its interaction with each input
+        inputs += model.site_sources(theta, *site_inputs, tilts=tilts)
+    covariance = model.angle_covariance(theta, tilts)  # the start angle itself, then its interaction with each input
     for source in inputs:
         sources.add(source.sensitivity, source.u, math.inf, source.kind)
         if source.angle_spread is not None:
@@ -246,7 +255,7 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
     # seen through Kg, whose cross terms are what is being estimated, so the fit must not lean on that
     # correlation (it would weigh a gyro's ±2e-8 rad/s on-axis leak of the Earth rate as an exact measure
     # of the ±3e-5 rad/s off-axis one)
-    for s in np.flatnonzero(model.rotating):
+    for s in np.flatnonzero(model.rotating | model.heading_unknown):
         for c in range(6):
             if covariance[s, c, c] > 0:
                 column = np.zeros((S, 6))
@@ -273,6 +282,8 @@ def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray,
     return Method(name, np.full(len(PARAMETER_NAMES), math.nan), u, nu, by_kind, note)
 
 
+#: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
+MAX_EVALUATIONS = 400
 #: eigenvalues of the means' covariance V below this fraction of its largest are raised to it before V is
 #: inverted: a channel that shows no noise at all (noise-free data) must not make V singular to rounding
 EIGENVALUE_FLOOR = 1e-14
@@ -285,19 +296,58 @@ def whitening(V: np.ndarray) -> np.ndarray:
     return (vectors / np.sqrt(values)).T
 
 
-def _solve(J: np.ndarray, basis: np.ndarray, theta0: np.ndarray, observed: np.ndarray, W: np.ndarray):
+def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
+           W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True):
     """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
 
-    Returns θ̂ (39,) and the gain A (39, 6S) with θ̂ − θ0 = A·(m − J θ0).
+    The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
+    parameters and of the tilts of the hand-placed poses. Without hand-placed poses the model is linear
+    (``J_linear``·θ); with them it is evaluated by the kernel at each step.
+
+    Returns θ̂ (39,), the tilts (n_placed, 2), the gain A (39, 6S) of θ̂ on the means, the design of the
+    identified combinations D (6S, rank) at the solution and the gain G (rank, 6S) of z (the fit's hat matrix
+    is D·G), and χ² = ‖W·(m − model)‖².
     """
+    n = len(theta0)
     if basis.shape[1] == 0:
-        return theta0.copy(), np.zeros((len(theta0), len(observed)))
-    X = W @ J @ basis
-    y = W @ (observed - J @ theta0)
-    result = least_squares(lambda z: X @ z - y, np.zeros(basis.shape[1]), jac=lambda z: X, method="lm",
-                           x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    gain = basis @ np.linalg.lstsq(X, W, rcond=None)[0]
-    return theta0 + basis @ result.x, gain
+        empty = np.zeros((len(observed), 0))
+        chi2 = float(np.sum((W @ (observed - J_linear @ theta0)) ** 2)) if model.n_tilts == 0 else \
+            float(np.sum((W @ (observed - model.means(theta0, tilts0).ravel())) ** 2))
+        return theta0.copy(), tilts0.copy(), np.zeros((n, len(observed))), empty, empty.T, chi2
+
+    def unpack(z):
+        step = basis @ z
+        return theta0 + step[:n], tilts0 + step[n:].reshape(tilts0.shape)
+
+    if model.n_tilts == 0:
+        design = J_linear @ basis[:n]
+        X = W @ design
+        y = W @ (observed - J_linear @ theta0)
+        result = least_squares(lambda z: X @ z - y, np.zeros(basis.shape[1]), jac=lambda z: X, method="lm",
+                               x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    else:
+        def design_at(z):
+            theta, tilts = unpack(z)
+            return np.hstack([model.parameter_jacobian(tilts=tilts), model.tilt_jacobian(theta, tilts)]) @ basis
+
+        def residual(z):
+            theta, tilts = unpack(z)
+            return W @ (model.means(theta, tilts).ravel() - observed)
+
+        # start from the linear solution with the tilts held at their first guess, then free them together
+        z0 = np.zeros(basis.shape[1])
+        if linear_start:
+            z0 = np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0]
+        result = least_squares(residual, z0, jac=lambda z: W @ design_at(z), method="lm",
+                               x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
+        if not result.success:
+            raise ValueError(f"the fit of the hand-placed poses did not converge in {MAX_EVALUATIONS} evaluations "
+                             f"({result.message}); check the segment table's poses (docs/fitting.md)")
+        design = design_at(result.x)
+        X = W @ design
+    gain_z = np.linalg.lstsq(X, W, rcond=None)[0]
+    theta, tilts = unpack(result.x)
+    return theta, tilts, basis[:n] @ gain_z, design, gain_z, 2.0 * float(result.cost)
 
 
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
@@ -342,9 +392,20 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         notes.append(f"site not known: gravity {gravity:.6f} ± {u_gravity:.4f} m/s² and the Earth rate over every "
                      "latitude enter as Type B inputs (give --latitude/--height)")
     model = MeanModel(used_schedule, gravity, earth)
-    ident = identifiability(model.parameter_jacobian(earth_rate=False))
-    J = model.parameter_jacobian(earth_rate=True)
+    means_all = np.asarray(recording.segment_means(), dtype=float)
+    observed = means_all[used]
+    theta0 = nominal_parameters()
+    tilts0 = model.initial_tilts(observed[:, 3:])
+    # at the nominal point: the nominal parameters and every pose as named (a hand-placed pose untilted), so that
+    # what a tilt stands in for at first order (an accelerometer's cross-coupling) counts as not identified
+    nominal_tilts = np.zeros_like(tilts0)
+    ident = identifiability(model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts),
+                            nuisance=model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False))
+    J = model.parameter_jacobian(earth_rate=True, tilts=tilts0)
     mask = ident.mask
+    if model.n_tilts:
+        notes.append(f"{int(model.placed.sum())} pose(s) placed by hand: each one's tilt from its nominal pose is "
+                     "fitted (two nuisance parameters), and an unknown heading is averaged over")
     held = [PARAMETER_INDEX[p.name] for p in PARAMETERS
             if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
 
@@ -357,31 +418,42 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                           all_noise.mean_variance_dof[rows], all_noise.quantisation_variance[rows],
                           all_noise.quantisation_sigma[rows], all_noise.notes)
 
-    means_all = np.asarray(recording.segment_means(), dtype=float)
-    observed = means_all[used]
     m = observed.ravel()
-    theta0 = nominal_parameters()
     basis = ident.basis
-    theta, levels = theta0, None
+    theta, tilts, levels = theta0, tilts0, None
     for _ in range(2):  # Type B sensitivities at the nominal point, then at the estimate
-        sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels)
+        sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts)
         V = sources.covariance()
         W = whitening(V)
-        theta, gain = _solve(J, basis, theta0, m, W)
+        theta, tilts, gain, design, gain_z, chi2 = _solve(model, basis, theta0, tilts0, m, W, J)
+        rank = ident.rank
+        if model.n_tilts:
+            # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
+            # accelerometer's cross-coupling): those combinations are freed when the data ask for them (χ² drops
+            # by more than its 99 % quantile for as many degrees of freedom), from the first solution
+            local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts),
+                                    nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False))
+            if local.rank > rank:
+                try:
+                    second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False)
+                except ValueError:
+                    second = None
+                if second is not None and chi2 - second[-1] > _chi2_quantile(local.rank - rank, 0.99):
+                    theta, tilts, gain, design, gain_z, chi2 = second
+                    rank = local.rank
+        J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
+        fitted = model.means(theta, tilts)
+        hat = design @ gain_z
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
-        level_cov = J @ gain @ V @ gain.T @ J.T
-        levels = ((J @ theta).reshape(observed.shape),
-                  np.sqrt(np.maximum(np.diag(level_cov), 0.0)).reshape(observed.shape))
+        levels = (fitted, np.sqrt(np.maximum(np.diag(hat @ V @ hat.T), 0.0)).reshape(observed.shape))
     joint = _propagate(METHOD_JOINT, gain, sources, mask)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
-    fitted = (J @ theta).reshape(observed.shape)
-    residual = m - J @ theta
-    hat = J @ gain
+    residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
     residual_cov = project @ V @ project.T
     residual_sd = np.sqrt(np.maximum(np.diag(residual_cov), 0.0)).reshape(observed.shape)
     chi2 = float(np.sum((W @ residual) ** 2))
-    chi2_dof = len(m) - ident.rank
+    chi2_dof = len(m) - rank
 
     # the specification's estimators where the procedure is complete
     spec, spec_note = None, ""
@@ -397,7 +469,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             spec_note = "the specification's reduction is not linear for this schedule"
         else:
             needed = np.flatnonzero(np.any(M != 0, axis=1)) // 6
-            missing = sorted(set(needed.tolist()) - set(used))
+            missing = sorted(set(needed.tolist()) - {k for k in used if schedule.segments[k].orientation == "known"})
             if missing:
                 spec_note = (f"the specification's estimators use segment(s) {missing}, whose pose or rate is not "
                              "known")
@@ -410,11 +482,12 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                   f"JJF 2003 eq. (3)-(13), 1 g = {g_ref:.8g} m/s^2")
                 spec = Method(METHOD_SPEC, estimate, spec.u, spec.dof, spec.contributions, spec.note)
                 if mask.all():
-                    spec_bias = spec_gain @ (J @ theta) - theta
+                    spec_bias = spec_gain @ fitted.ravel() - theta
     if spec is None and not spec_note:
         spec_note = "not run"
     between = _between_segments(used_schedule, residual, residual_cov, project, sources)
     return FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
+                     tilts=tilts, placed=tuple(np.asarray(used)[model.placed].tolist()),
                      unused=unused, labels=tuple(s.label for s in used_schedule.segments), observed=observed,
                      fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
                      spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,
@@ -426,6 +499,8 @@ def _repeat_groups(schedule: Schedule) -> list[list[int]]:
     """Segments that repeat one setting (same up-axis, rate and rate axis; the heading may differ)."""
     groups: dict[tuple, list[int]] = {}
     for k, s in enumerate(schedule.segments):
+        if s.orientation != "known":  # a pose placed by hand is not a repeat of a setting
+            continue
         key = (s.up, s.rate, s.rate_axis if s.is_rotating else None)
         groups.setdefault(key, []).append(k)
     return [g for g in groups.values() if len(g) >= 2]

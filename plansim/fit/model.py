@@ -112,17 +112,49 @@ class MeanModel:
 
     def __init__(self, schedule: Schedule, gravity: float, earth_enu):
         for k, s in enumerate(schedule.segments):
-            if not (s.rate_known and s.heading_known):
-                raise ValueError(f"segment {k} ({s.label!r}): the mean model needs a known heading and rate, "
-                                 f"got heading {s.heading!r}, rate {s.rate!r}")
+            if not s.rate_known:
+                raise ValueError(f"segment {k} ({s.label!r}): the mean model needs a known rate, got {s.rate!r}")
+            if not s.heading_known and s.is_rotating:
+                raise ValueError(f"segment {k} ({s.label!r}): a turning segment needs a known heading")
         self.schedule = schedule
         self.n_segments = len(schedule)
-        scenario = dataclasses.replace(_template(), schedule=schedule)
+        #: poses placed by hand (orientation approximate or unknown): their tilt is a nuisance parameter
+        self.placed = np.array([s.orientation != "known" for s in schedule.segments])
+        #: poses whose heading is not known: their mean is averaged over the heading like a start angle
+        self.heading_unknown = np.array([not s.heading_known for s in schedule.segments])
+        known = Schedule(tuple(dataclasses.replace(s, heading=0.0, orientation="known") if not s.heading_known
+                               else s for s in schedule.segments), procedure=schedule.procedure)
+        scenario = dataclasses.replace(_template(), schedule=known)
         args = as_float_arrays(kernel_arguments(scenario))
         self._args = {k: args[k] for k in _KEEP}
         self.gravity = float(gravity)
         self.earth_enu = np.ascontiguousarray(earth_enu, dtype=float)
         self.rotating = np.array([s.is_rotating for s in schedule.segments])
+        self._nominal_up = np.array([args["seg_C0"][k].T @ np.array([0.0, 0.0, 1.0]) for k in range(self.n_segments)])
+
+    @property
+    def n_tilts(self) -> int:
+        """Number of nuisance parameters: two tilt angles (about East and North, rad) per hand-placed pose."""
+        return 2 * int(self.placed.sum())
+
+    def initial_tilts(self, accelerometer_means: np.ndarray) -> np.ndarray:
+        """Tilts (n_placed, 2) that turn each hand-placed pose's nominal up-axis onto its measured specific force.
+
+        The pose is C = R(φ)·C0 with φ = (φ_E, φ_N, 0) in East-North-Up; the specific force in the case frame is
+        Cᵀ·(0, 0, g), so φ rotates v = C0·d onto Up, d the measured direction: φ = (v × Up)/|v × Up|·acos(v·Up).
+        """
+        out = np.zeros((int(self.placed.sum()), 2))
+        C0 = self._args["seg_C0"]
+        for i, k in enumerate(np.flatnonzero(self.placed)):
+            a = np.asarray(accelerometer_means[k], dtype=float)
+            if not np.linalg.norm(a) > 0:
+                continue
+            v = C0[k] @ (a / np.linalg.norm(a))
+            axis = np.cross(v, [0.0, 0.0, 1.0])
+            norm = np.linalg.norm(axis)
+            if norm > 0:
+                out[i] = (axis / norm * math.atan2(norm, v[2]))[:2]
+        return out
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
@@ -137,19 +169,37 @@ class MeanModel:
         segment_path.noise_free_means(draws, **args, means_out=out)
         return out
 
-    def draws(self, theta: np.ndarray) -> np.ndarray:
-        """A draws vector (D,) with the parameters *theta* (39,), every table error and start angle zero."""
+    def draws(self, theta: np.ndarray, tilts=None) -> np.ndarray:
+        """A draws vector (D,) with the parameters *theta* (39,) and the hand-placed poses' *tilts* (n_placed, 2),
+        every table error and start angle zero."""
         out = np.zeros(draws_length(self.n_segments))
         out[TRUTH] = theta
+        if tilts is not None and self.placed.any():
+            rows = HEAD + PER_SEGMENT * np.flatnonzero(self.placed) + SEG_POSITION_ACCURACY
+            tilts = np.asarray(tilts, dtype=float).reshape(-1, 2)
+            out[rows] = tilts[:, 0]
+            out[rows + 2] = tilts[:, 1]
         return out
 
     def _at_angles(self, draws: np.ndarray) -> np.ndarray:
-        """(n, D) -> (n·ANGLES, D): each draws vector with every rotating segment started at 2πk/ANGLES."""
+        """(n, D) -> (n·ANGLES, D): each draws vector with every rotating segment started at 2πk/ANGLES, and every
+        pose of unknown heading turned by 2πk/ANGLES about the vertical (after its own rotation)."""
         draws = np.atleast_2d(draws)
         out = np.repeat(draws, ANGLES, axis=0)
+        angles = np.tile(2.0 * math.pi * np.arange(ANGLES) / ANGLES, draws.shape[0])
         rows = np.arange(self.n_segments)[self.rotating]
-        phases = np.tile(2.0 * math.pi * np.arange(ANGLES) / ANGLES, draws.shape[0])
-        out[:, HEAD + PER_SEGMENT * rows + SEG_PHASE] = phases[:, None]
+        out[:, HEAD + PER_SEGMENT * rows + SEG_PHASE] = angles[:, None]
+        turned = np.flatnonzero(self.heading_unknown)
+        if turned.size:
+            from scipy.spatial.transform import Rotation
+
+            first = HEAD + PER_SEGMENT * turned + SEG_POSITION_ACCURACY
+            columns = np.stack([first, first + 2, first + 4], axis=-1)  # (m, 3): about E, N, U
+            own = out[:, columns].reshape(-1, 3)
+            heading = np.repeat(angles, turned.size)
+            composed = (Rotation.from_rotvec(np.column_stack([np.zeros_like(heading), np.zeros_like(heading),
+                                                              heading])) * Rotation.from_rotvec(own)).as_rotvec()
+            out[:, columns] = composed.reshape(out.shape[0], turned.size, 3)
         return out
 
     def averaged(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
@@ -158,42 +208,59 @@ class MeanModel:
         values = self.evaluate(self._at_angles(draws), gravity, earth_enu)
         return values.reshape(draws.shape[0], ANGLES, self.n_segments, 6).mean(axis=1)
 
-    def means(self, theta: np.ndarray) -> np.ndarray:
-        """The model's segment means (S, 6) for parameters *theta* (39,)."""
-        return self.averaged(self.draws(theta))[0]
+    def means(self, theta: np.ndarray, tilts=None) -> np.ndarray:
+        """The model's segment means (S, 6) for parameters *theta* (39,) and the hand-placed poses' *tilts*."""
+        return self.averaged(self.draws(theta, tilts))[0]
 
     # ------------------------------------------------------------------ the design
-    def parameter_jacobian(self, earth_rate: bool = True) -> np.ndarray:
-        """∂m/∂θ (6S, 39), exact: the model is linear in θ and zero at θ = 0.
+    def parameter_jacobian(self, earth_rate: bool = True, tilts=None) -> np.ndarray:
+        """∂m/∂θ (6S, 39), exact: the model is linear in θ and zero at θ = 0 (at the given tilts).
 
         ``earth_rate = False`` leaves the Earth rate out: the *designed* excitation (table rates, gravity)
         that :mod:`plansim.fit.identify` judges identifiability on.
         """
-        draws = np.zeros((N_PARAMETERS, draws_length(self.n_segments)))
+        draws = np.tile(self.draws(np.zeros(N_PARAMETERS), tilts), (N_PARAMETERS, 1))
         draws[:, TRUTH] = np.eye(N_PARAMETERS)
         earth = None if earth_rate else np.zeros(3)
         values = self.averaged(draws, earth_enu=earth)  # (39, S, 6)
         return values.reshape(N_PARAMETERS, -1).T.copy()
 
-    def angle_covariance(self, theta: np.ndarray) -> np.ndarray:
-        """(S, 6, 6) covariance of each segment's mean over its unrecorded start angle (0 at rest)."""
-        values = self.evaluate(self._at_angles(self.draws(theta)))  # (ANGLES, S, 6)
+    def tilt_jacobian(self, theta: np.ndarray, tilts, earth_rate: bool = True) -> np.ndarray:
+        """∂m/∂(tilts) (6S, n_tilts) by central differences (each pose's tilt moves only its own mean)."""
+        out = np.zeros((6 * self.n_segments, self.n_tilts))
+        placed = np.flatnonzero(self.placed)
+        if not placed.size:
+            return out
+        for component in range(2):
+            columns = HEAD + PER_SEGMENT * placed + SEG_POSITION_ACCURACY + 2 * component
+            d = self._central(theta, columns, ANGLE_STEP, tilts=tilts, earth_rate=earth_rate).mean(axis=0)  # (S, 6)
+            for i, k in enumerate(placed):
+                out[6 * k:6 * k + 6, 2 * i + component] = d[k]
+        return out
+
+    def angle_covariance(self, theta: np.ndarray, tilts=None) -> np.ndarray:
+        """(S, 6, 6) covariance of each segment's mean over its unrecorded start angle or heading (0 otherwise)."""
+        values = self.evaluate(self._at_angles(self.draws(theta, tilts)))  # (ANGLES, S, 6)
         centred = values - values.mean(axis=0)
         return np.einsum("ksi,ksj->sij", centred, centred) / ANGLES
 
     def _central(self, theta: np.ndarray, columns, step: float, gravity_step: float = 0.0,
-                 earth_step=None) -> np.ndarray:
+                 earth_step=None, tilts=None, earth_rate: bool = True) -> np.ndarray:
         """Central-difference sensitivity (ANGLES, S, 6) of the segment means at each start angle to the draws
         entries *columns* (all at once: each segment's entries move only its own mean), or to gravity or the
-        Earth rate (``gravity_step``, ``earth_step``, with *step* 1)."""
-        base = self._at_angles(self.draws(theta))
+        Earth rate (``gravity_step``, ``earth_step``, with *step* 1). ``earth_rate = False``: without it."""
+        base = self.draws(theta, tilts)
         plus, minus = base.copy(), base.copy()
         if columns is not None:
-            plus[:, columns] += step
-            minus[:, columns] -= step
-        earth_step = np.zeros(3) if earth_step is None else np.asarray(earth_step, dtype=float)
-        hi = self.evaluate(plus, self.gravity + gravity_step, self.earth_enu + earth_step)
-        lo = self.evaluate(minus, self.gravity - gravity_step, self.earth_enu - earth_step)
+            plus[columns] += step
+            minus[columns] -= step
+        earth = self.earth_enu if earth_rate else np.zeros(3)
+        if earth_rate and earth_step is not None:
+            earth_step = np.asarray(earth_step, dtype=float)
+        else:
+            earth_step = np.zeros(3)
+        hi = self.evaluate(self._at_angles(plus), self.gravity + gravity_step, earth + earth_step)
+        lo = self.evaluate(self._at_angles(minus), self.gravity - gravity_step, earth - earth_step)
         return (hi - lo) / (2.0 * step)
 
     @staticmethod
@@ -208,7 +275,7 @@ class MeanModel:
         spread = np.einsum("ksi,ksj->sij", centred, centred) / ANGLES
         return InputSource(name, kind, u, mean.ravel(), spread)
 
-    def table_sources(self, theta: np.ndarray, turntable) -> list[InputSource]:
+    def table_sources(self, theta: np.ndarray, turntable, tilts=None) -> list[InputSource]:
         """Type B inputs of the turntable and fixture (JJF 2003 Table 1, §6.2), at the parameters *theta*.
 
         Per segment: the position error (a rotation of the pose about East, North and Up; accuracy and
@@ -216,7 +283,8 @@ class MeanModel:
         the fixture's misalignment (3), the platform tilt (2), the rate-axis perpendicularity (2 per
         axis) and the systematic rate error. Each with the standard uncertainty of its
         :class:`~plansim.config.scenario.ErrorDistribution` and the sensitivity of the segment means by
-        central differences of the kernel's physics.
+        central differences of the kernel's physics. A pose placed by hand has no table position error: its
+        tilt is a parameter of the fit (*tilts*).
         """
         S = self.n_segments
         sources: list[InputSource] = []
@@ -225,14 +293,14 @@ class MeanModel:
         if u_position > 0:
             for axis, name in enumerate("ENU"):
                 columns = HEAD + PER_SEGMENT * np.arange(S) + SEG_POSITION_ACCURACY + 2 * axis
-                d = self._central(theta, columns, ANGLE_STEP)  # (ANGLES, S, 6): each segment's own
+                d = self._central(theta, columns, ANGLE_STEP, tilts=tilts)  # (ANGLES, S, 6): each its own
                 for s in range(S):
-                    if np.any(d[:, s]):
+                    if np.any(d[:, s]) and not self.placed[s]:
                         sources.append(self._source(f"position error about {name}, segment {s}", "table",
                                                     u_position, d, s))
         u_point = turntable.rate_error_per_point.standard_uncertainty
         if u_point > 0 and self.rotating.any():
-            d = self._central(theta, HEAD + PER_SEGMENT * np.arange(S) + SEG_RATE_ERROR, RATE_STEP)
+            d = self._central(theta, HEAD + PER_SEGMENT * np.arange(S) + SEG_RATE_ERROR, RATE_STEP, tilts=tilts)
             for s in np.flatnonzero(self.rotating):
                 sources.append(self._source(f"rate error of the point, segment {s}", "table", u_point, d, s))
         per_calibration = [
@@ -247,22 +315,22 @@ class MeanModel:
         for name, column, distribution, step in per_calibration:
             u = distribution.standard_uncertainty
             if u > 0:
-                d = self._central(theta, [column], step)
+                d = self._central(theta, [column], step, tilts=tilts)
                 if np.any(d):
                     sources.append(self._source(name, "table", u, d))
         return sources
 
-    def site_sources(self, theta: np.ndarray, u_gravity: float, u_earth_enu) -> list[InputSource]:
+    def site_sources(self, theta: np.ndarray, u_gravity: float, u_earth_enu, tilts=None) -> list[InputSource]:
         """Type B inputs of an unknown site: gravity and the Earth rate's components."""
         sources = []
         if u_gravity > 0:
-            d = self._central(theta, None, 1.0, gravity_step=GRAVITY_STEP) * (1.0 / GRAVITY_STEP)
+            d = self._central(theta, None, 1.0, gravity_step=GRAVITY_STEP, tilts=tilts) * (1.0 / GRAVITY_STEP)
             sources.append(self._source("local gravity (site not known)", "site", float(u_gravity), d))
         for axis, name in enumerate(("East", "North", "Up")):
             u = float(np.asarray(u_earth_enu)[axis])
             if u > 0:
                 step = np.zeros(3)
                 step[axis] = EARTH_RATE_STEP
-                d = self._central(theta, None, 1.0, earth_step=step) * (1.0 / EARTH_RATE_STEP)
+                d = self._central(theta, None, 1.0, earth_step=step, tilts=tilts) * (1.0 / EARTH_RATE_STEP)
                 sources.append(self._source(f"Earth rate, {name} component (site not known)", "site", u, d))
         return sources

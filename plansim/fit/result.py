@@ -100,7 +100,12 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
                       "ratio"):
             data[f"between_{field}"] = ("channel", np.array([getattr(b, field) for b in result.between]),
                                         {"long_name": f"repeated settings: {field.replace('_', ' ')}"})
-    ds = xr.Dataset(data, coords={"parameter": list(PARAMETER_NAMES), "channel": list(CHANNELS),
+    if result.placed:
+        data["tilt"] = (("placed_segment", "tilt_axis"), result.tilts,
+                        {"long_name": "fitted tilt of a pose placed by hand from its nominal pose", "units": "rad"})
+    coords_extra = {"placed_segment": np.asarray(result.placed, dtype=np.int32), "tilt_axis": ["East", "North"]} \
+        if result.placed else {}
+    ds = xr.Dataset(data, coords={**coords_extra, "parameter": list(PARAMETER_NAMES), "channel": list(CHANNELS),
                                   "segment": np.asarray(result.used, dtype=np.int32),
                                   "parameter_unit": ("parameter", units),
                                   "segment_label": ("segment", list(result.labels))})

@@ -76,8 +76,8 @@ def fit_report(result, residuals: bool = True) -> str:
         lines.append(f"The specification's estimators: not run — {result.spec_note}")
     budget = result.joint.contributions
     if budget:
-        lines.append("Joint WLS uncertainty by input (display units): "
-                     + ", ".join(f"{kind}" for kind in budget) + " — in the --out file (u_joint_wls_<input>)")
+        lines.append("The joint fit's u comes from these kinds of input: " + ", ".join(budget)
+                     + " (each one's part per parameter in the --out file: u_joint_wls_<kind>)")
 
     lines += ["", "Noise from the data (Allan deviation of the static segments, IEEE Std 952 fit)"]
     for c, ch in enumerate(result.noise.channels):
@@ -89,6 +89,11 @@ def fit_report(result, residuals: bool = True) -> str:
         lines.append(f"  {ch.channel}: white N = {_g(ch.white / wf, 3)} {wu}, bias instability B = "
                      f"{_g(ch.bias_instability / of, 3)} {ou}, rate random walk K = {_g(ch.rate_random_walk / of, 3)} "
                      f"{ou}/sqrt(s), {step} ({ch.static_segments} static segments)")
+
+    if result.placed:
+        lines += ["", "Poses placed by hand: fitted tilt from the nominal pose (about East, North; deg)"]
+        for k, (east, north) in zip(result.placed, result.tilts):
+            lines.append(f"  segment {k}: {math.degrees(east):+.3f} {math.degrees(north):+.3f}")
 
     ratio = result.chi2 / result.chi2_dof if result.chi2_dof > 0 else math.nan
     lines += ["", f"chi2/dof = {_g(result.chi2, 5)}/{result.chi2_dof} = {_g(ratio, 4)}: {result.chi2_verdict}"]
