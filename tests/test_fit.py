@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -191,13 +192,43 @@ def test_segments_it_cannot_fit_yet_are_listed_with_the_reason():
     static = [k for k, s in enumerate(recording.schedule.segments) if s.test == "multi_position"]
     base = _subset(recording, static)
     segments = list(base.schedule.segments)
-    segments[0] = dataclasses.replace(segments[0], test="rotation", rate=math.nan, angle=2 * math.pi)
+    segments[0] = dataclasses.replace(segments[0], test="rotation", rate=math.nan)  # no angle either
     segments[1] = dataclasses.replace(segments[1], test="move", rate=math.nan)
+    segments[2] = dataclasses.replace(segments[2], test="rotation", rate=math.nan, angle=2 * math.pi,
+                                      rate_axis="+y", orientation="approximate", heading=math.nan)  # +y horizontal
     edited = Recording(base.samples, Schedule(tuple(segments)), base.attrs)
     result = fit_recording(edited, Site(math.radians(39.9), 50.0, earth_rate=False), scenario.turntable)
-    assert set(result.unused) == {0, 1}
-    assert "not logged" in result.unused[0] and "move" in result.unused[1]
-    assert len(result.used) == len(segments) - 2
+    assert set(result.unused) == {0, 1, 2}
+    assert "neither its rate nor its angle" in result.unused[0] and "move" in result.unused[1]
+    assert "horizontal axis" in result.unused[2]
+    assert len(result.used) == len(segments) - 3
+
+
+def test_turns_known_by_their_angle_give_the_gyro_scale_factors():
+    """The rate test's +50 deg/s points turned into turns by hand known only by their angle (rate not logged,
+    heading not known): the mean rate is angle/duration, only the gyros are fitted, each turned axis's
+    misalignment is a nuisance parameter, so Kgxx, Kgyy, Kgzz are identified and the cross-couplings are not."""
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=4, trial=0)
+    _, _, truth = simulate_recording(scenario, 4, 0)
+    segments = recording.schedule.segments
+    poses = [k for k, s in enumerate(segments) if s.test == "multi_position"]
+    turns = [k for k, s in enumerate(segments) if s.test == "rate" and abs(math.degrees(s.rate) - 50) < 1e-9]
+    base = _subset(recording, poses + turns)
+    edited = list(base.schedule.segments)
+    for i in range(len(poses), len(edited)):
+        s = edited[i]
+        edited[i] = dataclasses.replace(s, test="rotation", rate=math.nan, angle=s.rate * s.samples / s.sample_rate,
+                                        orientation="approximate", heading=math.nan)
+    result = fit_recording(Recording(base.samples, Schedule(tuple(edited)), base.attrs),
+                           Site(math.radians(39.9), 50.0, earth_rate=False), scenario.turntable)
+    assert {"Kgxx", "Kgyy", "Kgzz"} <= set(result.identified)
+    assert "Kgxy" in result.not_identified and "hand placement" in result.not_identified["Kgxy"]
+    assert result.hand_axes == (0, 1, 2) and not result.fitted_rows[len(poses):, 3:].any()
+    for name in ("Kgxx", "Kgyy", "Kgzz"):
+        k = PARAMETER_NAMES.index(name)
+        assert abs(result.joint.estimate[k] - truth[k]) < 4 * result.joint.u[k]
+        assert result.joint.u[k] < 1e-4
 
 
 def test_hand_placed_poses_fit_with_their_tilts_as_nuisance_parameters():
@@ -216,7 +247,7 @@ def test_hand_placed_poses_fit_with_their_tilts_as_nuisance_parameters():
     result = fit_recording(Recording(base.samples, Schedule(placed), base.attrs),
                            Site(math.radians(39.9), 50.0, earth_rate=False), scenario.turntable)
     assert set(result.identified) == set(GROUP["Bg"] + GROUP["G"] + GROUP["Ba"] + ["Kaxx", "Kayy", "Kazz"])
-    assert "tilts of the hand-placed poses" in result.not_identified["Kaxy"]
+    assert "hand placement" in result.not_identified["Kaxy"]
     assert result.placed == tuple(range(12)) and result.tilts.shape == (12, 2)
     assert np.max(np.abs(np.degrees(result.tilts))) > 2  # the poses are really tilted
     mask = result.identifiability.mask
@@ -442,3 +473,32 @@ def test_the_site_comes_from_the_command_line_then_the_recording_then_the_scenar
     assert not resolve_site().known
     with pytest.raises(ValueError, match="--height"):
         resolve_site(10.0, None)
+
+
+# ------------------------------------------------------------------------------------------ real data
+
+FERRARIS = Path(__file__).resolve().parents[2] / "shared/data/real/imucal-ferraris"
+
+
+def test_the_ferraris_example_session_imports_and_fits():
+    """The real log (MIT, mad-lab-fau/imucal): 13 hand-placed poses and 3 turns of -360 deg by hand, site not
+    known. The fit gives what its README saw at a first look (Ba +0.54/-0.62/+0.40 m/s², Kazz ≈ +2 %, Bg
+    -0.60/-0.37/+0.06 deg/s) and the gyro scale factors from the turns (measured integral over the angle),
+    and says that the residuals exceed the noise model (χ²/dof ≈ 5.6)."""
+    log = FERRARIS / "example_ferraris_session.csv"
+    if not log.exists():
+        pytest.skip(f"the shared real data is not beside the repository ({FERRARIS})")
+    from plansim.io.log_import import import_log
+
+    imported = import_log(log, columns=("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"), units="deg/s,m/s^2",
+                          sample_rate=102.4)
+    result = fit_recording(imported.recording)
+    assert {"Kgxx", "Kgyy", "Kgzz", "Bgx", "Bgy", "Bgz", "Kaxx", "Kayy", "Kazz", "Bax", "Bay", "Baz"} \
+        <= set(result.identified)
+    estimate = dict(zip(PARAMETER_NAMES, result.joint.estimate))
+    assert [estimate[f"Ba{a}"] for a in "xyz"] == pytest.approx([0.534, -0.617, 0.399], abs=0.005)
+    assert [math.degrees(estimate[f"Bg{a}"]) for a in "xyz"] == pytest.approx([-0.599, -0.368, 0.057], abs=0.002)
+    assert estimate["Kazz"] == pytest.approx(1.024, abs=0.002)
+    assert [estimate[f"Kg{a}{a}"] for a in "xyz"] == pytest.approx([1.0278, 0.9825, 0.9982], abs=0.001)
+    assert result.chi2 / result.chi2_dof > 3 and "larger than" in result.chi2_verdict
+    assert len(result.placed) == 13 and result.hand_axes == (0, 1, 2)

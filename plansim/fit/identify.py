@@ -125,8 +125,8 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments", 
         partners = [p for p in partners if not p.startswith("tilt")]
         shown = ", ".join(partners[:6]) + (f" and {len(partners) - 6} more" if len(partners) > 6 else "")
         if tilts:
-            not_identified[name] = (f"{what} see it only in combination with the tilts of the hand-placed poses"
-                                    + (f" and {shown}" if shown else ""))
+            not_identified[name] = (f"{what} see it only in combination with the hand placement (the tilts of poses "
+                                    "placed by hand, the axes of turns by hand)" + (f" and {shown}" if shown else ""))
         elif partners:
             not_identified[name] = f"{what} see it only in combination with {shown}"
         else:

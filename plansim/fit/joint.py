@@ -27,6 +27,7 @@ Steps (docs/fitting.md):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -95,6 +96,9 @@ class FitResult:
     used: tuple[int, ...]  # indices into the recording's schedule
     tilts: np.ndarray  # (n_placed, 2) fitted tilt of each hand-placed pose about East and North, rad
     placed: tuple[int, ...]  # the hand-placed poses (indices into the recording's schedule)
+    hand_axes: tuple[int, ...]  # body axes turned by hand (0 x, 1 y, 2 z)
+    axis_tilts: np.ndarray  # (len(hand_axes), 2) fitted misalignment of each, rad
+    fitted_rows: np.ndarray  # (S, 6) False where a segment's channel is not fitted (a hand turn's accelerometers)
     unused: dict  # index -> reason
     labels: tuple[str, ...]  # of the used segments
     observed: np.ndarray  # (S, 6) segment means
@@ -130,19 +134,47 @@ class FitResult:
         return (self.spec, self.joint) if self.spec is not None else (self.joint,)
 
 
-def _segment_use(schedule: Schedule) -> tuple[list[int], dict[int, str]]:
-    used, unused = [], {}
+@dataclass(frozen=True)
+class _Use:
+    """Which segments the fit uses and how: the model's segment for each, the rows it fits, the hand-turned axes."""
+
+    used: list
+    unused: dict
+    model_segments: list
+    gyro_only: list  # per used segment: only its gyro means are fitted (a turn known by its angle, a hand turn)
+    hand_axes: tuple
+
+
+def _segment_use(schedule: Schedule) -> _Use:
+    used, unused, model_segments, gyro_only, hand_axes = [], {}, [], [], set()
     for k, s in enumerate(schedule.segments):
         if s.test == "move":
             unused[k] = "a move between poses: no reference to fit it against"
-        elif not s.rate_known:
-            unused[k] = "the rate was not logged: turns known by their angle are not fitted yet (docs/fitting.md)"
-        elif s.is_rotating and (s.orientation != "known" or not s.heading_known):
-            unused[k] = (f"a turn whose pose is {s.orientation!r}: the fit takes turns on a known pose only "
-                         "(docs/fitting.md)")
-        else:
+            continue
+        turning = s.is_rotating
+        if not turning:
             used.append(k)  # a pose placed by hand is fitted with its tilt as a nuisance parameter
-    return used, unused
+            model_segments.append(s)
+            gyro_only.append(False)
+            continue
+        if not s.rate_known and not s.angle_known:
+            unused[k] = "a turn with neither its rate nor its angle: nothing to fit it against"
+            continue
+        on_table = s.orientation == "known" and s.heading_known
+        if not on_table and (s.orientation == "unknown" or s.rate_axis[1] != s.up[1]):
+            unused[k] = (f"a turn about a horizontal axis or from a pose not known ({s.orientation}): the specific "
+                         "force turns with it along a path no recording holds; not fitted (docs/fitting.md)")
+            continue
+        duration = s.samples / s.sample_rate
+        by_angle = not (s.rate_known and on_table) and s.angle_known
+        rate = s.angle / duration if by_angle else s.rate  # the mean rate: ∫ω dt = angle, whatever the profile
+        model_segments.append(dataclasses.replace(s, rate=rate, heading=s.heading if s.heading_known else 0.0,
+                                                  orientation="known"))
+        used.append(k)
+        gyro_only.append(by_angle or not on_table)
+        if not on_table:
+            hand_axes.add("xyz".index(s.rate_axis[1]))
+    return _Use(used, unused, model_segments, gyro_only, tuple(sorted(hand_axes)))
 
 
 def _samples_of(recording, k: int) -> np.ndarray:
@@ -378,12 +410,18 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     if turntable is None:
         turntable, turntable_source = TABLE_1_TURNTABLE, turntable_source or "JJF 2003 Table 1"
     schedule = recording.schedule
-    used, unused = _segment_use(schedule)
+    use = _segment_use(schedule)
+    used, unused = use.used, use.unused
     notes = []
     if not used:
-        raise ValueError("recording: no segment has a known pose and rate, so none can be fitted; "
+        raise ValueError("recording: no segment can be fitted; "
                          f"{len(unused)} segment(s) not used: " + "; ".join(f"{k}: {r}" for k, r in unused.items()))
     used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
+    model_schedule = Schedule(tuple(use.model_segments), procedure=schedule.procedure)
+    rows = np.ones((len(used), 6), dtype=bool)
+    rows[np.asarray(use.gyro_only, dtype=bool), 3:] = False  # a hand turn's accelerometers feel the hand
+    rows = rows.ravel()
+    select = np.eye(rows.size)[rows]
     if site.known:
         gravity, earth, site_inputs = site.gravity, site.earth_rate_vector, None
     else:
@@ -391,7 +429,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         site_inputs = (u_gravity, u_earth)
         notes.append(f"site not known: gravity {gravity:.6f} ± {u_gravity:.4f} m/s² and the Earth rate over every "
                      "latitude enter as Type B inputs (give --latitude/--height)")
-    model = MeanModel(used_schedule, gravity, earth)
+    model = MeanModel(model_schedule, gravity, earth, hand_axes=use.hand_axes)
     means_all = np.asarray(recording.segment_means(), dtype=float)
     observed = means_all[used]
     theta0 = nominal_parameters()
@@ -399,13 +437,17 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     # at the nominal point: the nominal parameters and every pose as named (a hand-placed pose untilted), so that
     # what a tilt stands in for at first order (an accelerometer's cross-coupling) counts as not identified
     nominal_tilts = np.zeros_like(tilts0)
-    ident = identifiability(model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts),
-                            nuisance=model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False))
+    ident = identifiability(model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts)[rows],
+                            nuisance=model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)[rows])
     J = model.parameter_jacobian(earth_rate=True, tilts=tilts0)
     mask = ident.mask
-    if model.n_tilts:
+    if model.placed.any():
         notes.append(f"{int(model.placed.sum())} pose(s) placed by hand: each one's tilt from its nominal pose is "
                      "fitted (two nuisance parameters), and an unknown heading is averaged over")
+    if use.hand_axes:
+        notes.append("turns by hand about " + ", ".join("xyz"[a] for a in use.hand_axes) + ": the mean rate is the "
+                     "reference angle over the duration, only the gyros are fitted, and each turned axis's "
+                     "misalignment is fitted (two nuisance parameters)")
     held = [PARAMETER_INDEX[p.name] for p in PARAMETERS
             if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
 
@@ -413,10 +455,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     noise_segments = [k for k, s in enumerate(schedule.segments) if s.test != "move"]
     all_noise = estimate_noise([_samples_of(recording, k) for k in noise_segments],
                                [schedule.segments[k] for k in noise_segments])
-    rows = [noise_segments.index(k) for k in used]
-    noise = NoiseEstimate(all_noise.channels, all_noise.within_std[rows], all_noise.mean_variance[rows],
-                          all_noise.mean_variance_dof[rows], all_noise.quantisation_variance[rows],
-                          all_noise.quantisation_sigma[rows], all_noise.notes)
+    keep = [noise_segments.index(k) for k in used]
+    noise = NoiseEstimate(all_noise.channels, all_noise.within_std[keep], all_noise.mean_variance[keep],
+                          all_noise.mean_variance_dof[keep], all_noise.quantisation_variance[keep],
+                          all_noise.quantisation_sigma[keep], all_noise.notes)
 
     m = observed.ravel()
     basis = ident.basis
@@ -424,15 +466,15 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     for _ in range(2):  # Type B sensitivities at the nominal point, then at the estimate
         sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts)
         V = sources.covariance()
-        W = whitening(V)
+        W = whitening(V[np.ix_(rows, rows)]) @ select  # only the fitted rows
         theta, tilts, gain, design, gain_z, chi2 = _solve(model, basis, theta0, tilts0, m, W, J)
         rank = ident.rank
         if model.n_tilts:
             # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
             # accelerometer's cross-coupling): those combinations are freed when the data ask for them (χ² drops
             # by more than its 99 % quantile for as many degrees of freedom), from the first solution
-            local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts),
-                                    nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False))
+            local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
+                                    nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
             if local.rank > rank:
                 try:
                     second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False)
@@ -451,9 +493,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
     residual_cov = project @ V @ project.T
-    residual_sd = np.sqrt(np.maximum(np.diag(residual_cov), 0.0)).reshape(observed.shape)
+    residual_sd = np.where(rows, np.sqrt(np.maximum(np.diag(residual_cov), 0.0)), math.nan).reshape(observed.shape)
     chi2 = float(np.sum((W @ residual) ** 2))
-    chi2_dof = len(m) - rank
+    chi2_dof = int(rows.sum()) - rank
 
     # the specification's estimators where the procedure is complete
     spec, spec_note = None, ""
@@ -487,7 +529,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         spec_note = "not run"
     between = _between_segments(used_schedule, residual, residual_cov, project, sources)
     return FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
-                     tilts=tilts, placed=tuple(np.asarray(used)[model.placed].tolist()),
+                     tilts=np.asarray(tilts)[:2 * int(model.placed.sum())].reshape(-1, 2),
+                     placed=tuple(np.asarray(used)[model.placed].tolist()),
+                     hand_axes=use.hand_axes, axis_tilts=np.asarray(tilts)[2 * int(model.placed.sum()):].reshape(-1, 2),
+                     fitted_rows=rows.reshape(observed.shape),
                      unused=unused, labels=tuple(s.label for s in used_schedule.segments), observed=observed,
                      fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
                      spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,

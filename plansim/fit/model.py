@@ -108,9 +108,12 @@ class MeanModel:
         Local gravity, m/s².
     earth_enu : (3,) array_like
         Earth rate in East-North-Up, rad/s.
+    hand_axes : sequence of int
+        Body axes (0 x, 1 y, 2 z) turned by hand: the turn's axis in the case frame is then not known exactly,
+        and its two small misalignment angles are nuisance parameters.
     """
 
-    def __init__(self, schedule: Schedule, gravity: float, earth_enu):
+    def __init__(self, schedule: Schedule, gravity: float, earth_enu, hand_axes=()):
         for k, s in enumerate(schedule.segments):
             if not s.rate_known:
                 raise ValueError(f"segment {k} ({s.label!r}): the mean model needs a known rate, got {s.rate!r}")
@@ -130,15 +133,24 @@ class MeanModel:
         self.gravity = float(gravity)
         self.earth_enu = np.ascontiguousarray(earth_enu, dtype=float)
         self.rotating = np.array([s.is_rotating for s in schedule.segments])
-        self._nominal_up = np.array([args["seg_C0"][k].T @ np.array([0.0, 0.0, 1.0]) for k in range(self.n_segments)])
+        #: the draws entries that are nuisance parameters: each hand-placed pose's tilt about East and North,
+        #: then the axis of each body axis turned by hand (two small angles, the kernel's rate-axis perpendicularity)
+        placed = np.flatnonzero(self.placed)
+        first = HEAD + PER_SEGMENT * placed + SEG_POSITION_ACCURACY
+        columns = np.column_stack([first, first + 2]).ravel() if placed.size else np.zeros(0, dtype=int)
+        self.hand_axes = tuple(hand_axes)
+        axis_columns = [PERPENDICULARITY.start + 2 * a + c for a in self.hand_axes for c in (0, 1)]
+        self.nuisance_columns = np.concatenate([columns, np.asarray(axis_columns, dtype=int)]).astype(int)
 
     @property
     def n_tilts(self) -> int:
-        """Number of nuisance parameters: two tilt angles (about East and North, rad) per hand-placed pose."""
-        return 2 * int(self.placed.sum())
+        """Number of nuisance parameters: two tilt angles (about East and North, rad) per hand-placed pose and two
+        misalignment angles (rad) per body axis turned by hand."""
+        return len(self.nuisance_columns)
 
     def initial_tilts(self, accelerometer_means: np.ndarray) -> np.ndarray:
-        """Tilts (n_placed, 2) that turn each hand-placed pose's nominal up-axis onto its measured specific force.
+        """Start values of the nuisance parameters (n_tilts,): for each hand-placed pose the tilt that turns its
+        nominal up-axis onto its measured specific force, and zero for each hand-turned axis.
 
         The pose is C = R(φ)·C0 with φ = (φ_E, φ_N, 0) in East-North-Up; the specific force in the case frame is
         Cᵀ·(0, 0, g), so φ rotates v = C0·d onto Up, d the measured direction: φ = (v × Up)/|v × Up|·acos(v·Up).
@@ -154,7 +166,7 @@ class MeanModel:
             norm = np.linalg.norm(axis)
             if norm > 0:
                 out[i] = (axis / norm * math.atan2(norm, v[2]))[:2]
-        return out
+        return np.concatenate([out.ravel(), np.zeros(2 * len(self.hand_axes))])
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
@@ -170,15 +182,12 @@ class MeanModel:
         return out
 
     def draws(self, theta: np.ndarray, tilts=None) -> np.ndarray:
-        """A draws vector (D,) with the parameters *theta* (39,) and the hand-placed poses' *tilts* (n_placed, 2),
-        every table error and start angle zero."""
+        """A draws vector (D,) with the parameters *theta* (39,) and the nuisance parameters *tilts* (n_tilts,),
+        every other table error and start angle zero."""
         out = np.zeros(draws_length(self.n_segments))
         out[TRUTH] = theta
-        if tilts is not None and self.placed.any():
-            rows = HEAD + PER_SEGMENT * np.flatnonzero(self.placed) + SEG_POSITION_ACCURACY
-            tilts = np.asarray(tilts, dtype=float).reshape(-1, 2)
-            out[rows] = tilts[:, 0]
-            out[rows + 2] = tilts[:, 1]
+        if tilts is not None and self.n_tilts:
+            out[self.nuisance_columns] = np.asarray(tilts, dtype=float).ravel()
         return out
 
     def _at_angles(self, draws: np.ndarray) -> np.ndarray:
@@ -226,16 +235,19 @@ class MeanModel:
         return values.reshape(N_PARAMETERS, -1).T.copy()
 
     def tilt_jacobian(self, theta: np.ndarray, tilts, earth_rate: bool = True) -> np.ndarray:
-        """∂m/∂(tilts) (6S, n_tilts) by central differences (each pose's tilt moves only its own mean)."""
+        """∂m/∂(nuisance parameters) (6S, n_tilts) by central differences."""
         out = np.zeros((6 * self.n_segments, self.n_tilts))
         placed = np.flatnonzero(self.placed)
-        if not placed.size:
-            return out
-        for component in range(2):
+        for component in range(2):  # the poses' tilts: each moves only its own pose's mean, so all at once
+            if not placed.size:
+                break
             columns = HEAD + PER_SEGMENT * placed + SEG_POSITION_ACCURACY + 2 * component
             d = self._central(theta, columns, ANGLE_STEP, tilts=tilts, earth_rate=earth_rate).mean(axis=0)  # (S, 6)
             for i, k in enumerate(placed):
                 out[6 * k:6 * k + 6, 2 * i + component] = d[k]
+        for j in range(2 * placed.size, self.n_tilts):  # the hand-turned axes
+            d = self._central(theta, [self.nuisance_columns[j]], ANGLE_STEP, tilts=tilts, earth_rate=earth_rate)
+            out[:, j] = d.mean(axis=0).ravel()
         return out
 
     def angle_covariance(self, theta: np.ndarray, tilts=None) -> np.ndarray:
@@ -314,7 +326,7 @@ class MeanModel:
               turntable.axis_perpendicularity, ANGLE_STEP) for k in range(6)]
         for name, column, distribution, step in per_calibration:
             u = distribution.standard_uncertainty
-            if u > 0:
+            if u > 0 and column not in self.nuisance_columns:  # a hand-turned axis is a parameter of the fit
                 d = self._central(theta, [column], step, tilts=tilts)
                 if np.any(d):
                     sources.append(self._source(name, "table", u, d))

@@ -343,7 +343,7 @@ def estimate_noise(segment_samples: list[np.ndarray], segments) -> NoiseEstimate
                 white, white_dof, slow = own, max(within_dof[k], 1), 0.0
             else:
                 white, white_dof = ch.white**2 / duration, static_dof
-                if s.is_rotating and own > white:
+                if s.is_rotating and s.rate_known and own > white:  # a table's rate jitter (a hand's is no noise)
                     white, white_dof = own, max(within_dof[k], 1)
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             if ch.quantisation_step > 0:

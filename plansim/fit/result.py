@@ -45,6 +45,8 @@ def fit_json(result: FitResult) -> dict:
     residuals = []
     for s, k in enumerate(result.used):
         for c, channel in enumerate(CHANNELS):
+            if not result.fitted_rows[s, c]:
+                continue  # not fitted: a hand turn's accelerometer
             residuals.append({"segment": int(k), "label": result.labels[s], "channel": channel,
                               "residual": _number(result.residuals[s, c]),
                               "u": _number(result.residual_sd[s, c]),

@@ -95,6 +95,11 @@ def fit_report(result, residuals: bool = True) -> str:
         for k, (east, north) in zip(result.placed, result.tilts):
             lines.append(f"  segment {k}: {math.degrees(east):+.3f} {math.degrees(north):+.3f}")
 
+    if result.hand_axes:
+        lines += ["", "Turns by hand: fitted misalignment of the turned axis (two small angles; deg)"]
+        for axis, (first, second) in zip(result.hand_axes, result.axis_tilts):
+            lines.append(f"  about {'xyz'[axis]}: {math.degrees(first):+.3f} {math.degrees(second):+.3f}")
+
     ratio = result.chi2 / result.chi2_dof if result.chi2_dof > 0 else math.nan
     lines += ["", f"chi2/dof = {_g(result.chi2, 5)}/{result.chi2_dof} = {_g(ratio, 4)}: {result.chi2_verdict}"]
     if result.between:
@@ -122,6 +127,9 @@ def fit_report(result, residuals: bool = True) -> str:
             for c in range(6):
                 factor = gf if c < 3 else af
                 r, u = result.residuals[s, c], result.residual_sd[s, c]
+                if not result.fitted_rows[s, c]:
+                    cells.append(f"{'-':>9s} ")  # not fitted (a hand turn's accelerometer)
+                    continue
                 mark = "*" if u > 0 and abs(r) > 3 * u else " "
                 cells.append(f"{_g(r / factor, 3):>9s}{mark}")
             lines.append(f"{k:>4d} {result.labels[s][:34]:34s} " + " ".join(cells))
