@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
+from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.fit.identify import Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
@@ -417,6 +418,11 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         raise ValueError("recording: no segment can be fitted; "
                          f"{len(unused)} segment(s) not used: " + "; ".join(f"{k}: {r}" for k, r in unused.items()))
     used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
+    if all(s.orientation != "known" for s in used_schedule.segments):
+        # no segment on a table: its grade has nothing to act on (the hand placement is fitted instead)
+        zero = ErrorDistribution("uniform", 0.0)
+        turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
+        turntable_source = "none: every pose and turn is by hand (no table)"
     model_schedule = Schedule(tuple(use.model_segments), procedure=schedule.procedure)
     rows = np.ones((len(used), 6), dtype=bool)
     rows[np.asarray(use.gyro_only, dtype=bool), 3:] = False  # a hand turn's accelerometers feel the hand
