@@ -26,6 +26,7 @@ from plansim.fit.noise import (
     TERM_THRESHOLD,
     allan_deviation,
     fit_allan,
+    pooled_allan_variance,
     quantisation_error_variance,
     quantisation_step,
 )
@@ -301,16 +302,7 @@ def _white_channel_false_alarms(channels: int, seed: int) -> int:
     rng = np.random.default_rng(seed)
     hits = 0
     for _ in range(channels):
-        pooled: dict[float, list[float]] = {}
-        for _segment in range(21):
-            tau, adev, dof = allan_deviation(rng.normal(size=3000), 100.0)
-            for t, a, d in zip(tau, adev, dof):
-                entry = pooled.setdefault(round(t, 12), [0.0, 0.0])
-                entry[0] += d * a * a
-                entry[1] += d
-        tau = np.array(sorted(pooled))
-        dof = np.array([pooled[t][1] for t in tau])
-        avar = np.array([pooled[t][0] / pooled[t][1] for t in tau])
+        tau, avar, dof = pooled_allan_variance((rng.normal(size=3000), 100.0) for _segment in range(21))
         _, b, k = fit_allan(tau, avar, dof)
         hits += b > 0 or k > 0
     return hits
@@ -335,20 +327,14 @@ def test_bias_instability_is_found_when_it_is_there():
     phi = math.exp(-1 / (rate * tc))
     found = 0
     for _ in range(5):
-        pooled: dict[float, list[float]] = {}
+        records = []
         for _segment in range(20):
             drive = sigma * math.sqrt(1 - phi**2) * rng.normal(size=n)
             bias = np.zeros(n)
             for i in range(1, n):
                 bias[i] = phi * bias[i - 1] + drive[i]
-            tau, adev, dof = allan_deviation(bias + 4.4e-4 * rng.normal(size=n), rate)
-            for t, a, d in zip(tau, adev, dof):
-                entry = pooled.setdefault(round(t, 12), [0.0, 0.0])
-                entry[0] += d * a * a
-                entry[1] += d
-        tau = np.array(sorted(pooled))
-        dof = np.array([pooled[t][1] for t in tau])
-        avar = np.array([pooled[t][0] / pooled[t][1] for t in tau])
+            records.append((bias + 4.4e-4 * rng.normal(size=n), rate))
+        tau, avar, dof = pooled_allan_variance(records)
         _, b, k = fit_allan(tau, avar, dof)
         found += b > 0 or k > 0
     assert found == 5

@@ -96,6 +96,34 @@ def allan_deviation(values: np.ndarray, sample_rate: float) -> tuple[np.ndarray,
     return taus, adev, np.maximum(dof, 1.0)
 
 
+def pooled_allan_variance(records) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Allan variance of several records of one channel, pooled at each τ.
+
+    Parameters
+    ----------
+    records : iterable of (values, sample_rate)
+        Each record's samples (SI) and its sample rate, Hz; see :func:`allan_deviation`.
+
+    Returns
+    -------
+    tau, avar, dof : ndarray
+        The τ found in any record (s, ascending), the Allan variance there averaged over the records
+        weighted by their equivalent degrees of freedom, and the summed degrees of freedom; all empty
+        when there is no record.
+    """
+    pooled: dict[float, list[float]] = {}
+    for values, sample_rate in records:
+        tau, adev, dof = allan_deviation(values, sample_rate)
+        for t, a, d in zip(tau, adev, dof):
+            entry = pooled.setdefault(round(float(t), 12), [0.0, 0.0])
+            entry[0] += d * a**2
+            entry[1] += d
+    tau = np.array(sorted(pooled))
+    dof = np.array([pooled[t][1] for t in tau])
+    avar = np.array([pooled[t][0] / pooled[t][1] for t in tau])
+    return tau, avar, dof
+
+
 def allan_model(tau, white: float, bias_instability: float, rate_random_walk: float) -> np.ndarray:
     """σ_A²(τ) = N²/τ + (2 ln 2/π)B² + K²τ/3 (IEEE Std 952, Annex C)."""
     tau = np.asarray(tau, dtype=float)
@@ -306,17 +334,9 @@ def estimate_noise(segment_samples: list[np.ndarray], segments) -> NoiseEstimate
     channels = []
     for c, name in enumerate(CHANNELS):
         step = steps[c]
-        taus: dict[float, list] = {}
-        for k in static:
-            tau, adev, dof = allan_deviation(segment_samples[k][:, c], segments[k].sample_rate)
-            for t, a, d in zip(tau, adev, dof):
-                entry = taus.setdefault(round(float(t), 12), [0.0, 0.0])
-                entry[0] += d * a**2
-                entry[1] += d
-        if taus:
-            tau = np.array(sorted(taus))
-            dof = np.array([taus[t][1] for t in tau])
-            avar = np.array([taus[t][0] / taus[t][1] for t in tau])
+        tau, avar, dof = pooled_allan_variance([(segment_samples[k][:, c], segments[k].sample_rate)
+                                                for k in static])
+        if tau.size:
             white, bias_instability, random_walk = fit_allan(tau, avar, dof)
         else:
             tau = avar = dof = np.zeros(0)
