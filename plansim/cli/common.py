@@ -1,0 +1,77 @@
+"""What every command shares: exit statuses, signals as exceptions, the commands' one-line help."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import threading
+
+EXIT_BAD_INPUT = 2
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+#: the signals that end a command cleanly, and the word it says
+SIGNAL_WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+
+
+
+class Interrupted(KeyboardInterrupt):
+    """Raised in the main thread when SIGINT or SIGTERM arrives, so that every ``finally`` and ``except
+    BaseException`` on the way out runs (temporary files removed, a compile process killed).
+
+    A subclass of KeyboardInterrupt: code that lets Ctrl-C through lets SIGTERM through too.
+    """
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+
+def _raise_interrupted(signum, frame):
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def signals_as_exceptions():
+    """While a command runs, SIGINT and SIGTERM raise :class:`Interrupted` in the main thread.
+
+    A signal the caller ignores (``nohup``, a background job without job control) stays ignored; the
+    previous handlers are restored at the end. Outside the main thread nothing changes (Python runs
+    signal handlers there only).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {}
+    try:
+        for signum in SIGNAL_WORDS:
+            if signal.getsignal(signum) is not signal.SIG_IGN:
+                previous[signum] = signal.signal(signum, _raise_interrupted)
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _silence_stdout() -> None:
+    """The reader of stdout is gone: send what is still buffered, and anything later, to /dev/null (so the
+    interpreter's last flush at exit does not fail again)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout without a file descriptor (captured, say)
+        pass
+
+
+
+#: one line per command in ``plansim --help`` (at most 52 characters: one line in an 80-column terminal)
+COMMANDS = {
+    "run": "Monte Carlo of a calibration vs JJF 2003 Appendix A",
+    "validate": "GUM budgets validated by adaptive Monte Carlo",
+    "scenarios": "list the built-in scenarios",
+    "record": "write one simulated trial's raw samples",
+    "import": "a plain CSV log to a recording with segments",
+    "fit": "fit a recording: parameters, noise, uncertainty",
+    "bench": "measure speed and memory on this machine",
+}

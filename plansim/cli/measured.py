@@ -1,0 +1,122 @@
+"""``plansim import`` and ``plansim fit``: measured data in (docs/measured-data.md, docs/fitting.md)."""
+
+from __future__ import annotations
+
+import json
+import os
+
+from plansim.cli.common import COMMANDS
+from plansim.io.files import OutputSet, check_output_path
+
+
+def _cmd_import(args) -> int:
+    from plansim.io.log_import import format_summary, import_log
+    from plansim.io.recording import write_recording
+    from plansim.io.recording_csv import segment_table_path
+
+    target = check_output_path(args.out, "--out", (".nc", ".csv"))
+    outputs = [target]
+    if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
+        outputs.append(check_output_path(segment_table_path(target), "--out's segment table"))
+    if any(os.path.exists(args.log) and os.path.exists(out) and os.path.samefile(args.log, out) for out in outputs):
+        raise ValueError(f"--out {args.out!r} would overwrite the log {args.log!r}; write the recording elsewhere")
+    columns = None if args.columns is None else tuple(name.strip() for name in args.columns.split(","))
+    options = {name: getattr(args, name) for name in ("window", "min_static") if getattr(args, name) is not None}
+    result = import_log(args.log, columns=columns, time_column=args.time, time_unit=args.time_unit,
+                        units=args.units, scale=args.scale, sample_rate=args.sample_rate,
+                        temperature_column=args.temperature_column, temperature=args.temperature,
+                        latitude=args.latitude, height=args.height, **options)
+    write_recording(result.recording, args.out)  # whole or not at all
+    print(format_summary(result))
+    print(f"\nwrote recording: {args.out} (review its segment table: docs/measured-data.md)")
+    return 0
+
+
+def _add_import_command(sub) -> None:
+    p = sub.add_parser(
+        "import", help=COMMANDS["import"],
+        description="Read a plain CSV log (six channels; a time column or a sample rate) and write a recording "
+                    "whose segment table (static poses, rotations, moves) is found from the data, for you to "
+                    "review (docs/measured-data.md)")
+    p.add_argument("log", help="the CSV log: a header line of column names, one row per sample")
+    p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
+    p.add_argument("--time", default=None, metavar="COL", help="the time column (default: none; give --sample-rate)")
+    p.add_argument("--time-unit", default="s", choices=("s", "ms", "us", "ns", "samples"),
+                   help="unit of the time column (samples: a sample counter, with --sample-rate); default s")
+    p.add_argument("--columns", default=None, metavar="GX,GY,GZ,AX,AY,AZ",
+                   help="the six channel columns in this order (default gx,gy,gz,ax,ay,az); other columns are "
+                        "then ignored")
+    p.add_argument("--units", default=None,
+                   help="the channels' units: gyro,accelerometer (e.g. deg/s,m/s^2) or one per channel; with "
+                        "--scale, the unit the counts are per; default rad/s,m/s^2")
+    p.add_argument("--scale", default=None,
+                   help="counts per unit, gyro,accelerometer or one per channel (e.g. 16.4,2048 with --units deg/s,g)")
+    p.add_argument("--sample-rate", type=float, default=None, metavar="HZ",
+                   help="sample rate; required without --time (default: from the time column)")
+    p.add_argument("--temperature-column", default=None, metavar="COL", help="a temperature column in degC")
+    p.add_argument("--temperature", type=float, default=None, metavar="DEGC",
+                   help="the lab's temperature, for a log without a temperature column (default 20, noted as assumed)")
+    p.add_argument("--latitude", type=float, default=None, metavar="DEG", help="site latitude (site_latitude_deg)")
+    p.add_argument("--height", type=float, default=None, metavar="M", help="site height (site_height_m)")
+    p.add_argument("--window", type=float, default=None, metavar="S",
+                   help="window of the rest detector (default 0.5 s)")
+    p.add_argument("--min-static", type=float, default=None, metavar="S",
+                   help="shortest static pose kept (default 1 s)")
+    p.set_defaults(func=_cmd_import)
+
+
+def _cmd_fit(args) -> int:
+    from plansim.fit import fit_recording, resolve_site
+    from plansim.fit.result import fit_dataset, fit_json
+    from plansim.io.recording import read_recording
+    from plansim.io.scenario_file import load_scenario
+    from plansim.report.fit import fit_report
+
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".nc",))
+    scenario = load_scenario(args.scenario) if args.scenario is not None else None
+    recording = read_recording(args.recording)
+    site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
+    options = {}
+    if scenario is not None:
+        options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
+                       reference_gravity=scenario.reduction.reference_gravity,
+                       omega_squared_sign=scenario.reduction.omega_squared_sign)
+    result = fit_recording(recording, site, **options)
+    with OutputSet() as outputs:
+        if args.out is not None:
+            fit_dataset(result).to_netcdf(outputs.stage(args.out, "--out", (".nc",)), engine="h5netcdf")
+        outputs.commit()
+    if args.json:
+        print(json.dumps(fit_json(result), indent=2))
+    else:
+        print(fit_report(result, residuals=not args.no_residuals))
+        if args.out is not None:
+            print(f"\nwrote fit: {args.out}")
+    return 0
+
+
+def _add_fit_command(sub) -> None:
+    p = sub.add_parser(
+        "fit", help=COMMANDS["fit"],
+        description="Fit a recording: which of the 39 JJF 2003 parameters its segments identify, their estimates by "
+                    "the specification's estimators (where the procedure is complete) and by one joint weighted "
+                    "least squares, the noise from the data (Allan deviation), and each parameter's standard "
+                    "uncertainty (docs/fitting.md)")
+    p.add_argument("recording", help="recording file (.nc, or the samples .csv beside its .segments.csv)")
+    p.add_argument("--latitude", type=float, default=None, metavar="DEG",
+                   help="site latitude (default: the recording's site_latitude_deg, else the scenario's)")
+    p.add_argument("--height", type=float, default=None, metavar="M", help="site height, with --latitude")
+    p.add_argument("--scenario", default=None,
+                   help="the lab's scenario (name or TOML path): its site, turntable/fixture grade and reduction "
+                        "(default: JJF 2003 Table 1 and the recording's attributes)")
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the report")
+    p.add_argument("--out", default=None, help="write the fit as a NetCDF file (.nc)")
+    p.add_argument("--no-residuals", action="store_true", help="leave the per-segment residual table out of the report")
+    p.set_defaults(func=_cmd_fit)
+
+
+
+def add_commands(sub) -> None:
+    _add_import_command(sub)
+    _add_fit_command(sub)

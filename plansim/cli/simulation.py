@@ -1,0 +1,219 @@
+"""``plansim run``, ``validate``, ``scenarios`` and ``record``: the simulator's commands."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+
+from plansim.cli.common import COMMANDS
+from plansim.io.files import OutputSet, check_output_path
+from plansim.report.plot import FIGURE_SUFFIXES
+from plansim.report.progress import end_progress_line
+
+
+def _cmd_run(args) -> int:
+    from plansim.config import saturation_report
+    from plansim.io.results import write_results
+    from plansim.io.scenario_file import load_scenario
+    from plansim.report.progress import stderr_progress
+    from plansim.report.summary import appendix_a_comparisons
+    from plansim.report.table import appendix_a_table, header, parameter_summary, parameter_table
+    from plansim.runner import run, run_summary
+    from plansim.uncertainty import compare_with_appendix_a
+
+    # every check before any work: the outputs, the scenario, the numbers
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".nc",))
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    scenario = load_scenario(args.scenario)
+    saturation = saturation_report(scenario)  # empty unless acquisition.allow_saturation let it load
+    trials = scenario.trials if args.trials is None else args.trials
+    if trials < 1:
+        raise ValueError(f"--trials {trials}: must be >= 1")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    if args.plot is not None and trials < 2:
+        raise ValueError(f"--plot {args.plot!r}: the error histograms need at least 2 trials (trials = {trials})")
+
+    # the outputs are staged beside their targets and committed together at the end, or not at all
+    with OutputSet() as outputs:
+        out = outputs.stage(args.out, "--out", (".nc",)) if args.out is not None else None
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        progress = None if args.quiet else stderr_progress(f"plansim run {scenario.name}")
+        start = time.perf_counter()
+        if plot is not None:  # the histograms need every trial's error: keep the trials (run checks the memory)
+            results = run(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size, progress=progress,
+                          path=args.path)
+            elapsed = time.perf_counter() - start
+            comparisons = compare_with_appendix_a(results["truth"].values, results["estimate"].values, scenario)
+            if out is not None:
+                write_results(results, out)
+            from plansim.report.plot import appendix_a_histograms
+
+            appendix_a_histograms(results, scenario, comparisons, plot,
+                                  format=os.path.splitext(args.plot)[1].lstrip("."))
+        else:  # only the statistics, streamed; --out streams every trial to the file
+            results = run_summary(scenario, trials=trials, seed=args.seed, chunk_size=args.chunk_size,
+                                  progress=progress, path=args.path, out=out)
+            elapsed = time.perf_counter() - start
+            comparisons = appendix_a_comparisons(results, scenario)
+        outputs.commit()
+
+    if args.json:
+        print(json.dumps({
+            "scenario": scenario.name, "seed": results.attrs["seed"], "trials": trials,
+            "plansim_version": results.attrs["plansim_version"], "elapsed_s": elapsed,
+            "parameters": [{k: r[k] for k in ("name", "unit", "mean_error", "std_error")}
+                           for r in parameter_summary(results)],
+            "appendix_a": [c.as_dict() for c in comparisons],
+            "saturation": saturation,
+        }, indent=2))
+    else:
+        print(header(results, elapsed))
+        print()
+        if saturation:
+            print("Saturation (acquisition.allow_saturation = true): these outputs clip, and the estimates that "
+                  "use them are biased")
+            print("\n".join(f"  {line}" for line in saturation))
+            print()
+        print(parameter_table(results))
+        if comparisons:
+            print()
+            print(appendix_a_table(comparisons))
+        for label, path in (("results", args.out), ("figure", args.plot)):
+            if path:
+                print(f"\nwrote {label}: {path}")
+    return 0
+
+
+def _cmd_scenarios(args) -> int:
+    import tomllib
+
+    from plansim.io.scenario_file import builtin_scenarios
+
+    descriptions = {}
+    for name, path in builtin_scenarios().items():
+        with open(path, "rb") as fh:
+            descriptions[name] = tomllib.load(fh).get("description", "")
+    width = max(map(len, descriptions), default=0)
+    for name, description in descriptions.items():
+        print(f"{name:{width}s}  {description}".rstrip())
+    return 0
+
+
+def _cmd_record(args) -> int:
+    from plansim.io.recording import write_recording
+    from plansim.io.recording_csv import segment_table_path
+    from plansim.io.scenario_file import load_scenario
+    from plansim.runner import simulate_and_record
+
+    target = check_output_path(args.out, "--out", (".nc", ".csv"))
+    if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
+        check_output_path(segment_table_path(target), "--out's segment table")
+    scenario = load_scenario(args.scenario)
+    seed = scenario.seed if args.seed is None else args.seed
+    rec = simulate_and_record(scenario, seed=seed, trial=args.trial)
+    write_recording(rec, args.out)
+    print(f"wrote recording of trial {args.trial} of {scenario.name!r} (seed {seed}): "
+          f"{rec.samples.shape[0]} samples in {len(rec.schedule)} segments -> {args.out}")
+    return 0
+
+
+
+def _cmd_validate(args) -> int:
+    from plansim.io.claims import load_claims
+    from plansim.io.scenario_file import load_scenario
+    from plansim.report.progress import mark_progress_line
+    from plansim.report.validation import format_report, stderr_block_progress, validation_json
+    from plansim.runner import validate
+
+    scenario = load_scenario(args.scenario)
+    claims = load_claims(args.claims, scenario) if args.claims else None
+    for option, value, minimum in (("--trials-per-block", args.trials_per_block, 2),
+                                   ("--max-trials", args.max_trials, 1), ("--digits", args.digits, 1)):
+        if value < minimum:
+            raise ValueError(f"{option} {value}: must be >= {minimum}")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    progress = None
+    if not (args.quiet or args.json):
+        block_progress = stderr_block_progress(f"plansim validate {scenario.name}")
+
+        def progress(*state) -> None:  # the block progress line is open until the report starts
+            block_progress(*state)
+            mark_progress_line(True)
+
+    report = validate(scenario, claims, digits=args.digits, trials_per_block=args.trials_per_block,
+                      max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
+    end_progress_line()
+    if args.json:
+        print(json.dumps(validation_json(report), indent=2))
+    else:
+        print(format_report(report, details=not args.summary))
+    return 0
+
+
+def _add_validate_command(sub) -> None:
+    from plansim.uncertainty.metrology.monte_carlo import DEFAULT_DIGITS, DEFAULT_TRIALS_PER_BLOCK
+    from plansim.uncertainty.validation import DEFAULT_MAX_TRIALS
+
+    p = sub.add_parser(
+        "validate", help="GUM budgets validated by adaptive Monte Carlo",
+        description="GUM budget from the schedule, validated by adaptive Monte Carlo (JCGM 101/102); "
+                    "checks a claimed budget (default: JJF 2003 Appendix A)")
+    p.add_argument("scenario", nargs="?", default="jjf2003",
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+    p.add_argument("--claims", default=None,
+                   help="TOML file of claimed expanded uncertainties ([items.\"A.2\"] U = ...; [parameters.Bgx] "
+                        "U = \"10 deg/h\"; k = 2 by default); default: the Appendix A budgets as printed")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the text report")
+    p.add_argument("--trials-per-block", type=int, default=DEFAULT_TRIALS_PER_BLOCK,
+                   help=f"M, Monte Carlo trials per block (JCGM 101 7.9.4 b); default {DEFAULT_TRIALS_PER_BLOCK}")
+    p.add_argument("--max-trials", type=int, default=DEFAULT_MAX_TRIALS,
+                   help=f"stop the adaptive procedure here at the latest (default {DEFAULT_MAX_TRIALS})")
+    p.add_argument("--seed", type=int, default=None, help="root seed of the block seeds (default: the scenario's)")
+    p.add_argument("--digits", type=int, default=DEFAULT_DIGITS,
+                   help="n_dig, significant digits of the numerical tolerance δ "
+                        f"(JCGM 101 7.9.2; default {DEFAULT_DIGITS})")
+    p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
+                   help="simulation path: auto takes the segment-statistics path only where it is exact")
+    p.add_argument("--summary", action="store_true", help="text report without the per-parameter budgets")
+    p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
+    p.set_defaults(func=_cmd_validate)
+
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser("run", help=COMMANDS["run"],
+                       description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A")
+    p.add_argument("scenario", nargs="?", default="jjf2003",
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+    p.add_argument("--trials", type=int, default=None,
+                   help="number of simulated calibrations (default: the scenario's)")
+    p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's)")
+    p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
+    p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg)")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
+    p.add_argument("--chunk-size", type=int, default=4096,
+                   help="trials per kernel call (results do not depend on it; memory grows with it)")
+    p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
+                   help="simulation path: auto takes the segment-statistics path only where it is exact")
+    p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
+    p.set_defaults(func=_cmd_run)
+
+    _add_validate_command(sub)
+
+    p = sub.add_parser("scenarios", help=COMMANDS["scenarios"], description="List the built-in scenarios "
+                       "(the folder scenarios/, installed as plansim.scenarios) with their descriptions.")
+    p.set_defaults(func=_cmd_scenarios)
+
+    p = sub.add_parser("record", help=COMMANDS["record"],
+                       description="Write one simulated trial's raw samples as a recording (NetCDF or CSV)")
+    p.add_argument("scenario", nargs="?", default="jjf2003")
+    p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
+    p.add_argument("--seed", type=int, default=None)
+    p.add_argument("--trial", type=int, default=0, help="which trial of the seed's Monte Carlo to record")
+    p.set_defaults(func=_cmd_record)
+
