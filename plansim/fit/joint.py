@@ -116,6 +116,22 @@ class FitResult:
     between: tuple[BetweenSegments, ...]
     attrs: dict = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    #: the fit's internals, for what builds on it (plansim diagnose): the model of the used segments, the
+    #: solution θ̂ (39, every entry; the unidentified ones at their nominal value) and the nuisance vector, the
+    #: covariance V (6S, 6S) of the observed means' errors (noise, quantisation, table, site, angle), the
+    #: whitening W (n_fitted, 6S) of the fitted rows, the design D (6S, rank + extra) of the fitted
+    #: combinations at the solution, the fitted rows (6S,) and each used segment's middle time (S,), s
+    model: MeanModel | None = field(default=None, repr=False)
+    theta: np.ndarray | None = field(default=None, repr=False)
+    nuisance: np.ndarray | None = field(default=None, repr=False)
+    covariance: np.ndarray | None = field(default=None, repr=False)
+    whitening: np.ndarray | None = field(default=None, repr=False)
+    design: np.ndarray | None = field(default=None, repr=False)
+    rows: np.ndarray | None = field(default=None, repr=False)
+    segment_times: np.ndarray | None = field(default=None, repr=False)
+    #: extra unknowns fitted with θ (``fit_recording(extra=…)``): their names, estimates, u and ν
+    extra: Method | None = None
+    extra_names: tuple[str, ...] = ()
 
     @property
     def residuals(self) -> np.ndarray:
@@ -303,8 +319,8 @@ def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray,
     """θ̂ = gain · m: u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent sources."""
     contributions = gain @ sources.matrix()  # (39, n)
     dofs = np.asarray(sources.dof)
-    u = np.full(len(PARAMETER_NAMES), math.nan)
-    nu = np.full(len(PARAMETER_NAMES), math.nan)
+    u = np.full(gain.shape[0], math.nan)
+    nu = np.full(gain.shape[0], math.nan)
     for k in np.flatnonzero(mask):
         u[k], nu[k] = combine(contributions[k], dofs)
     by_kind = {}
@@ -312,7 +328,7 @@ def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray,
     for kind in dict.fromkeys(sources.kind):
         part = np.sqrt(np.sum(contributions[:, kinds == kind] ** 2, axis=1))
         by_kind[kind] = np.where(mask, part, math.nan)
-    return Method(name, np.full(len(PARAMETER_NAMES), math.nan), u, nu, by_kind, note)
+    return Method(name, np.full(gain.shape[0], math.nan), u, nu, by_kind, note)
 
 
 #: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
@@ -330,7 +346,7 @@ def whitening(V: np.ndarray) -> np.ndarray:
 
 
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
-           W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True):
+           W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None):
     """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
 
     The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
@@ -340,20 +356,33 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     Returns θ̂ (39,), the tilts (n_placed, 2), the gain A (39, 6S) of θ̂ on the means, the design of the
     identified combinations D (6S, rank) at the solution and the gain G (rank, 6S) of z (the fit's hat matrix
     is D·G), and χ² = ‖W·(m − model)‖².
+
+    ``extra`` (6S, m): further unknowns c that add ``extra·c`` to the means (an effect beyond eq. (1)/(2),
+    linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
     """
     n = len(theta0)
+    extra = np.zeros((len(observed), 0)) if extra is None else np.asarray(extra, dtype=float)
+    if extra.shape[1]:
+        basis = np.block([[basis, np.zeros((basis.shape[0], extra.shape[1]))],
+                          [np.zeros((extra.shape[1], basis.shape[1])), np.eye(extra.shape[1])]])
     if basis.shape[1] == 0:
         empty = np.zeros((len(observed), 0))
         chi2 = float(np.sum((W @ (observed - J_linear @ theta0)) ** 2)) if model.n_tilts == 0 else \
             float(np.sum((W @ (observed - model.means(theta0, tilts0).ravel())) ** 2))
-        return theta0.copy(), tilts0.copy(), np.zeros((n, len(observed))), empty, empty.T, chi2
+        return theta0.copy(), tilts0.copy(), np.zeros((n, len(observed))), empty, empty.T, chi2, np.zeros(0)
+
+    m = extra.shape[1]
+    nt = basis.shape[0] - m  # θ and the nuisance parameters
 
     def unpack(z):
-        step = basis @ z
+        step = basis[:nt] @ z
         return theta0 + step[:n], tilts0 + step[n:].reshape(tilts0.shape)
 
+    def shift(z):
+        return extra @ z[basis.shape[1] - m:] if m else 0.0
+
     if model.n_tilts == 0:
-        design = J_linear @ basis[:n]
+        design = np.hstack([J_linear, extra]) @ basis
         X = W @ design
         y = W @ (observed - J_linear @ theta0)
         result = least_squares(lambda z: X @ z - y, np.zeros(basis.shape[1]), jac=lambda z: X, method="lm",
@@ -361,11 +390,11 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     else:
         def design_at(z):
             theta, tilts = unpack(z)
-            return np.hstack([model.parameter_jacobian(tilts=tilts), model.tilt_jacobian(theta, tilts)]) @ basis
+            return np.hstack([model.parameter_jacobian(tilts=tilts), model.tilt_jacobian(theta, tilts), extra]) @ basis
 
         def residual(z):
             theta, tilts = unpack(z)
-            return W @ (model.means(theta, tilts).ravel() - observed)
+            return W @ (model.means(theta, tilts).ravel() + shift(z) - observed)
 
         # start from the linear solution with the tilts held at their first guess, then free them together
         z0 = np.zeros(basis.shape[1])
@@ -380,11 +409,12 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         X = W @ design
     gain_z = np.linalg.lstsq(X, W, rcond=None)[0]
     theta, tilts = unpack(result.x)
-    return theta, tilts, basis[:n] @ gain_z, design, gain_z, 2.0 * float(result.cost)
+    return theta, tilts, basis[:n] @ gain_z, design, gain_z, 2.0 * float(result.cost), result.x[len(result.x) - m:]
 
 
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
-                  reference_gravity: float | None = None, omega_squared_sign: str = "model") -> FitResult:
+                  reference_gravity: float | None = None, omega_squared_sign: str = "model",
+                  lever_arm=None, extra: dict | None = None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -402,6 +432,13 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         of :func:`~plansim.fit.site.unknown_site_inputs` when the site is not known).
     omega_squared_sign : {"model", "as_printed"}
         Eq. (12)'s sign (:func:`plansim.estimate.jjf2003.rate_sensitivity`).
+    lever_arm : (3, 3) array_like, optional
+        The accelerometers' known lever arms from the table axis, m (row i: accelerometer i), a known input of
+        the model (:class:`~plansim.fit.model.MeanModel`); default none, and P absorbs them.
+    extra : dict, optional
+        Further unknowns fitted jointly with θ: name -> (S_used, 6) array, the change of each used segment's
+        means per unit of the unknown (an effect beyond eq. (1)/(2) that is linear in its size; see
+        :mod:`plansim.diagnose`). Their estimates, u and ν are ``FitResult.extra``.
 
     Returns
     -------
@@ -435,9 +472,16 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         site_inputs = (u_gravity, u_earth)
         notes.append(f"site not known: gravity {gravity:.6f} ± {u_gravity:.4f} m/s² and the Earth rate over every "
                      "latitude enter as Type B inputs (give --latitude/--height)")
-    model = MeanModel(model_schedule, gravity, earth, hand_axes=use.hand_axes)
+    model = MeanModel(model_schedule, gravity, earth, hand_axes=use.hand_axes, lever_arm=lever_arm)
     means_all = np.asarray(recording.segment_means(), dtype=float)
     observed = means_all[used]
+    extra = dict(extra or {})
+    for name, columns in extra.items():
+        if np.shape(columns) != observed.shape or not np.all(np.isfinite(columns)):
+            raise ValueError(f"extra[{name!r}]: expected finite values of shape {observed.shape} (used segments x "
+                             f"channels), got shape {np.shape(columns)}")
+    E = np.column_stack([np.asarray(c, dtype=float).ravel() for c in extra.values()]) if extra else None
+    n_extra = len(extra)
     theta0 = nominal_parameters()
     tilts0 = model.initial_tilts(observed[:, 3:])
     # at the nominal point: the nominal parameters and every pose as named (a hand-placed pose untilted), so that
@@ -473,7 +517,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts)
         V = sources.covariance()
         W = whitening(V[np.ix_(rows, rows)]) @ select  # only the fitted rows
-        theta, tilts, gain, design, gain_z, chi2 = _solve(model, basis, theta0, tilts0, m, W, J)
+        theta, tilts, gain, design, gain_z, chi2, c = _solve(model, basis, theta0, tilts0, m, W, J, extra=E)
         rank = ident.rank
         if model.n_tilts:
             # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
@@ -483,14 +527,14 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                     nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
             if local.rank > rank:
                 try:
-                    second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False)
+                    second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E)
                 except ValueError:
                     second = None
-                if second is not None and chi2 - second[-1] > _chi2_quantile(local.rank - rank, 0.99):
-                    theta, tilts, gain, design, gain_z, chi2 = second
+                if second is not None and chi2 - second[5] > _chi2_quantile(local.rank - rank, 0.99):
+                    theta, tilts, gain, design, gain_z, chi2, c = second
                     rank = local.rank
         J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
-        fitted = model.means(theta, tilts)
+        fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
         levels = (fitted, np.sqrt(np.maximum(np.diag(hat @ V @ hat.T), 0.0)).reshape(observed.shape))
@@ -501,7 +545,13 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     residual_cov = project @ V @ project.T
     residual_sd = np.where(rows, np.sqrt(np.maximum(np.diag(residual_cov), 0.0)), math.nan).reshape(observed.shape)
     chi2 = float(np.sum((W @ residual) ** 2))
-    chi2_dof = int(rows.sum()) - rank
+    chi2_dof = int(rows.sum()) - rank - n_extra
+    extra_method = None
+    if n_extra:
+        every = np.ones(n_extra, dtype=bool)
+        extra_method = _propagate("joint_wls_extra", gain_z[gain_z.shape[0] - n_extra:], sources, every)
+        extra_method = Method("joint_wls_extra", np.asarray(c, dtype=float), extra_method.u, extra_method.dof,
+                              extra_method.contributions)
 
     # the specification's estimators where the procedure is complete
     spec, spec_note = None, ""
@@ -543,7 +593,18 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
                      spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,
                      chi2_verdict=_chi2_verdict(chi2, chi2_dof), between=between,
-                     attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes)
+                     attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes,
+                     model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
+                     covariance=V, whitening=W, design=design, rows=rows,
+                     segment_times=_middle_times(recording, used), extra=extra_method,
+                     extra_names=tuple(extra))
+
+
+def _middle_times(recording, used) -> np.ndarray:
+    """The middle time of each used segment from the recording's first sample, s."""
+    segments = recording.schedule.segments
+    return np.array([(int(recording.first_sample[k]) + 0.5 * segments[k].samples) / segments[k].sample_rate
+                     for k in used], dtype=float)
 
 
 def _repeat_groups(schedule: Schedule) -> list[list[int]]:

@@ -111,9 +111,13 @@ class MeanModel:
     hand_axes : sequence of int
         Body axes (0 x, 1 y, 2 z) turned by hand: the turn's axis in the case frame is then not known exactly,
         and its two small misalignment angles are nuisance parameters.
+    lever_arm : (3, 3) array_like, optional
+        Known position of each accelerometer (row i: accelerometer i) from the table axis, m: its centripetal
+        acceleration ω×(ω×r) enters as a known input (the lab's fixture drawing, ``[mimu.effects]
+        accel_lever_arm`` of its scenario). Default none: the ω²-sensitivities P then absorb it (docs/fitting.md).
     """
 
-    def __init__(self, schedule: Schedule, gravity: float, earth_enu, hand_axes=()):
+    def __init__(self, schedule: Schedule, gravity: float, earth_enu, hand_axes=(), lever_arm=None):
         for k, s in enumerate(schedule.segments):
             if not s.rate_known:
                 raise ValueError(f"segment {k} ({s.label!r}): the mean model needs a known rate, got {s.rate!r}")
@@ -130,6 +134,11 @@ class MeanModel:
         scenario = dataclasses.replace(_template(), schedule=known)
         args = as_float_arrays(kernel_arguments(scenario))
         self._args = {k: args[k] for k in _KEEP}
+        if lever_arm is not None:
+            lever = np.ascontiguousarray(lever_arm, dtype=float)
+            if lever.shape != (3, 3) or not np.all(np.isfinite(lever)):
+                raise ValueError(f"lever_arm: expected a finite 3x3 array (m), got {lever_arm!r}")
+            self._args["lever"] = lever
         self.gravity = float(gravity)
         self.earth_enu = np.ascontiguousarray(earth_enu, dtype=float)
         self.rotating = np.array([s.is_rotating for s in schedule.segments])
@@ -169,12 +178,25 @@ class MeanModel:
         return np.concatenate([out.ravel(), np.zeros(2 * len(self.hand_axes))])
 
     # ------------------------------------------------------------------ evaluation
-    def evaluate(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
-        """Noise-free segment means (n, S, 6) of draws vectors (n, D), at the given table angles."""
+    def evaluate(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None,
+                 effects: dict | None = None) -> np.ndarray:
+        """Noise-free segment means (n, S, 6) of draws vectors (n, D), at the given table angles.
+
+        ``effects`` overrides the kernel's effect arguments (every effect beyond eq. (1)/(2) is off otherwise):
+        ``sensor`` (len(EFFECT_ROWS), 3) per :data:`plansim.kernels.layout.EFFECT_ROWS`, ``S2`` (3, 3) the gyros'
+        g²-sensitivity, rad/s per (m/s²)², ``lever`` (3, 3) the accelerometers' lever arms, m.
+        """
         draws = np.ascontiguousarray(np.atleast_2d(draws), dtype=float)
         if draws.shape[1] != draws_length(self.n_segments):
             raise ValueError(f"draws: expected shape (n, {draws_length(self.n_segments)}), got {draws.shape}")
         args = dict(self._args)
+        for name, value in (effects or {}).items():
+            if name not in ("sensor", "S2", "lever"):
+                raise ValueError(f"effects: unknown kernel effect {name!r}; allowed 'sensor', 'S2', 'lever'")
+            value = np.ascontiguousarray(value, dtype=float)
+            if value.shape != args[name].shape:
+                raise ValueError(f"effects[{name!r}]: expected shape {args[name].shape}, got {value.shape}")
+            args[name] = value
         args["gravity"] = self.gravity if gravity is None else float(gravity)
         args["earth_enu"] = self.earth_enu if earth_enu is None else np.ascontiguousarray(earth_enu, dtype=float)
         out = np.empty((draws.shape[0], self.n_segments, 6))
@@ -211,15 +233,21 @@ class MeanModel:
             out[:, columns] = composed.reshape(out.shape[0], turned.size, 3)
         return out
 
-    def averaged(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None) -> np.ndarray:
+    def averaged(self, draws: np.ndarray, gravity: float | None = None, earth_enu=None,
+                 effects: dict | None = None) -> np.ndarray:
         """Segment means (n, S, 6) averaged over the unrecorded start angle of each rotating segment."""
         draws = np.atleast_2d(draws)
-        values = self.evaluate(self._at_angles(draws), gravity, earth_enu)
+        values = self.evaluate(self._at_angles(draws), gravity, earth_enu, effects)
         return values.reshape(draws.shape[0], ANGLES, self.n_segments, 6).mean(axis=1)
 
-    def means(self, theta: np.ndarray, tilts=None) -> np.ndarray:
-        """The model's segment means (S, 6) for parameters *theta* (39,) and the hand-placed poses' *tilts*."""
-        return self.averaged(self.draws(theta, tilts))[0]
+    def means(self, theta: np.ndarray, tilts=None, effects: dict | None = None) -> np.ndarray:
+        """The model's segment means (S, 6) for parameters *theta* (39,) and the hand-placed poses' *tilts*, with
+        the kernel's *effects* (see :meth:`evaluate`) on."""
+        return self.averaged(self.draws(theta, tilts), effects=effects)[0]
+
+    def effect_arguments(self) -> dict:
+        """The kernel's effect arguments as this model uses them (copies): ``sensor``, ``S2``, ``lever``."""
+        return {name: np.array(self._args[name]) for name in ("sensor", "S2", "lever")}
 
     # ------------------------------------------------------------------ the design
     def parameter_jacobian(self, earth_rate: bool = True, tilts=None) -> np.ndarray:
