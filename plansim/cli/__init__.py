@@ -19,7 +19,7 @@ import signal
 import sys
 
 import plansim
-from plansim.cli import bench_command, measured, simulation
+from plansim.cli import bench_command, checks, diagnose, measured, simulation
 from plansim.cli.common import (
     COMMANDS,
     EXIT_BAD_INPUT,
@@ -53,7 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Monte Carlo calibration planning for MEMS IMUs under JJF 2003-2022.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {plansim.__version__}")
     sub = parser.add_subparsers(dest="command", required=True, title="commands", metavar="COMMAND")
-    for module in (simulation, measured, bench_command):
+    for module in (simulation, measured, diagnose, checks, bench_command):
         module.add_commands(sub)
     return parser
 
