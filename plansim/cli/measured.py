@@ -82,6 +82,8 @@ def _cmd_fit(args) -> int:
         options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
                        reference_gravity=scenario.reduction.reference_gravity,
                        omega_squared_sign=scenario.reduction.omega_squared_sign)
+        if scenario.effects.accel_lever_arm.any():  # the fixture's known lever arms: a model input, not absorbed by P
+            options["lever_arm"] = scenario.effects.accel_lever_arm
     result = fit_recording(recording, site, **options)
     with OutputSet() as outputs:
         if args.out is not None:
