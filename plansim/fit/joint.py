@@ -72,6 +72,119 @@ class Method:
 
 
 @dataclass(frozen=True)
+class BetweenSegmentNoise:
+    """Noise of the segment means beyond the predicted, per channel (gx gy gz ax ay az), from the fit's residuals.
+
+    ``variance`` (6,) σ_c², SI², zero where the residuals show none; ``correlation_time`` (6,) τ_c, s, of its
+    correlation exp(−|t_s − t_r|/τ_c) between segments (0: independent); ``dof`` (6,) the degrees of freedom
+    of σ_c²; ``ratio`` (6,) the mean of r_i²/d_i over the channel's fitted rows (1 when the prediction holds).
+    """
+
+    variance: np.ndarray
+    correlation_time: np.ndarray
+    dof: np.ndarray
+    ratio: np.ndarray
+
+    def covariance(self, c: int, times: np.ndarray) -> np.ndarray:
+        """(S, S) covariance of channel *c*'s term over segments at middle *times* (s)."""
+        return self.variance[c] * _time_correlation(times, self.correlation_time[c])
+
+
+#: the likelihood-ratio statistic 2·Δlog L (against σ² = 0) above which the between-segment noise is taken:
+#: calibrated by simulation — 5 % of the channels of recordings with no such noise (scenario linear_gaussian,
+#: 40 recordings × 6 channels) exceed 2.95; the asymptotic ½χ²₀ + ½χ²₁ mixture has its 95 % point at 2.71,
+#: and the best of the six correlation times adds a little
+BETWEEN_LR_THRESHOLD = 3.0
+#: correlation times tried for the between-segment noise, s (0: independent segments); the likelihood picks one
+BETWEEN_CORRELATION_TIMES = (0.0, 30.0, 100.0, 300.0, 1000.0, 3000.0)
+
+
+def _time_correlation(times: np.ndarray, tau: float) -> np.ndarray:
+    lag = np.abs(np.asarray(times, dtype=float)[:, None] - np.asarray(times, dtype=float)[None, :])
+    return np.eye(lag.shape[0]) if tau <= 0 else np.exp(-lag / tau)
+
+
+def between_segment_noise(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, rows: np.ndarray,
+                          times: np.ndarray) -> BetweenSegmentNoise:
+    """The noise σ_c² (correlated over τ_c in time) of each channel's segment means that the residuals show
+    beyond V.
+
+    Segment means carry noise their own samples cannot show: a bias-instability process whose correlation
+    time is longer than a segment moves each segment's mean by up to its stationary σ, while within a 30 s
+    segment it hardly varies, so neither the scatter nor the Allan deviation of the segments sees it. The
+    residuals *between* segments do. Model for channel c: an added term b_s with Cov(b_s, b_r) =
+    σ_c²·exp(−|t_s − t_r|/τ_c) (t the segments' middle times); the residuals r = R·(e + b), R = I − H (H
+    the fit's hat matrix), have covariance Ω = R_c V R_cᵀ + σ_c²·R_cc Σ(τ_c) R_ccᵀ on the channel's fitted
+    rows. σ_c² is the restricted maximum likelihood on the residual subspace (the eigenvectors of R V Rᵀ
+    that carry variance), for each τ of :data:`BETWEEN_CORRELATION_TIMES`, and τ_c the one of largest
+    likelihood; σ_c² = 0 when the data show nothing beyond V. ν_c = Σ(1 − H_ii) over the channel's rows.
+
+    This is the "dark uncertainty" of interlaboratory comparisons (a random effect estimated from the
+    scatter beyond the stated uncertainties), per channel and correlated in time; it enters the segment
+    means' covariance as a Type A input. docs/fitting.md.
+    """
+    from scipy.optimize import minimize_scalar
+
+    R = np.eye(residual.size) - hat
+    C = R @ V @ R.T
+    variance, taus, dof, ratio = np.zeros(6), np.zeros(6), np.zeros(6), np.ones(6)
+    for c in range(6):
+        segments = np.flatnonzero(rows[:, c])
+        idx = segments * 6 + c
+        if idx.size < 2:
+            continue
+        block = C[np.ix_(idx, idx)]
+        d = np.diag(block)
+        if not np.all(d > 0):
+            continue
+        ratio[c] = float(np.mean(residual[idx] ** 2 / d))
+        dof[c] = max(float(np.sum(1.0 - np.diag(hat)[idx])), 1.0)
+        values, vectors = np.linalg.eigh(block)
+        keep = values > 1e-9 * values.max()
+        U = vectors[:, keep] / np.sqrt(values[keep])  # whitens the predicted residual covariance
+        y = U.T @ residual[idx]
+        Rcc = R[np.ix_(idx, idx)]
+        scale = float(np.median(d))  # σ² is searched relative to the predicted residual variance
+        best = (0.0, 0.0, -0.5 * float(y @ y))  # σ² = 0: the prediction alone
+        for tau in BETWEEN_CORRELATION_TIMES:
+            A = U.T @ Rcc @ _time_correlation(times[segments], tau) @ Rcc.T @ U
+            lam, Q = np.linalg.eigh(A)
+            lam = np.maximum(lam, 0.0)
+            z2 = (Q.T @ y) ** 2
+            if lam.max() <= 0:
+                continue
+
+            def negative_log_likelihood(log_ratio, lam=lam, z2=z2, scale=scale):
+                s2 = scale * math.exp(log_ratio)
+                return 0.5 * float(np.sum(np.log1p(s2 * lam) + z2 / (1.0 + s2 * lam)))
+
+            # σ² relative to the predicted scale; search over 12 decades below to 6 above
+            result = minimize_scalar(negative_log_likelihood, bounds=(-12 * math.log(10), 6 * math.log(10)),
+                                     method="bounded")
+            log_likelihood = -float(result.fun)
+            if log_likelihood > best[2]:
+                best = (scale * math.exp(result.x), tau, log_likelihood)
+        gain = best[2] + 0.5 * float(y @ y)  # log-likelihood ratio against σ² = 0
+        if best[0] > 0 and 2.0 * gain > BETWEEN_LR_THRESHOLD:
+            variance[c], taus[c] = best[0], best[1]
+    return BetweenSegmentNoise(variance, taus, dof, ratio)
+
+
+def _add_between_segment_noise(sources: _Sources, slow: BetweenSegmentNoise, rows: np.ndarray,
+                               times: np.ndarray) -> None:
+    """Independent Type A inputs (kind ``between``) carrying each channel's between-segment covariance."""
+    S = rows.shape[0]
+    for c in np.flatnonzero(slow.variance > 0):
+        segments = np.flatnonzero(rows[:, c])
+        values, vectors = np.linalg.eigh(slow.covariance(c, times[segments]))
+        for value, vector in zip(values, vectors.T):
+            if value > 1e-12 * values.max():
+                column = np.zeros((S, 6))
+                column[segments, c] = vector
+                sources.add(column.ravel(), math.sqrt(value), slow.dof[c], "between")
+
+
+@dataclass(frozen=True)
 class BetweenSegments:
     """Repeated settings of one channel: the data's scatter between segments against the prediction."""
 
@@ -129,6 +242,10 @@ class FitResult:
     design: np.ndarray | None = field(default=None, repr=False)
     rows: np.ndarray | None = field(default=None, repr=False)
     segment_times: np.ndarray | None = field(default=None, repr=False)
+    #: V without the between-segment noise estimated from the residuals (what the noise model predicts)
+    covariance_predicted: np.ndarray | None = field(default=None, repr=False)
+    #: the between-segment noise per channel the residuals show beyond the prediction (:func:`between_segment_noise`)
+    between_noise: BetweenSegmentNoise | None = None
     #: extra unknowns fitted with θ (``fit_recording(extra=…)``): their names, estimates, u and ν
     extra: Method | None = None
     extra_names: tuple[str, ...] = ()
@@ -263,8 +380,9 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
     # a quantiser the noise does not dither: the error of a segment mean is a function of its level μ_s,
     # e_s = Σ_k (−1)^k b_k sin(2πk(μ_s + v)/q) with the channel's offset v unknown (uniform over a step), so
     # segments at nearly the same level (a repeated setting; the rate test's accelerometers) share it:
-    # Cov(e_s, e_r) = Σ_k b_k,s b_k,r/2 · cos(2πk(μ_s − μ_r)/q) · d_k,s d_k,r (+ the variance lost to the
-    # damping on the diagonal), d_k,s = exp(−2π²k²u(μ_s)²/q²) for a level known to u(μ_s) (docs/fitting.md).
+    # Cov(e_s, e_r) = Σ_k b_k,s b_k,r/2 · cos(2πk(μ̂_s − μ̂_r)/q) · exp(−2π²k²·Var(δ_s − δ_r)/q²), δ the
+    # error of the fitted level μ̂: what matters is how well the *difference* of two levels is known, not
+    # each level (an unknown bias moves both alike and leaves their errors shared) (docs/fitting.md).
     # Without levels (the first pass) each segment's error is taken independent.
     for c, channel in enumerate(noise.channels):
         q = channel.quantisation_step
@@ -276,16 +394,18 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
                 column[k, c] = 1.0
                 sources.add(column.ravel(), math.sqrt(quantisation[k, c]), math.inf, "quantisation")
             continue
-        mu, u_mu = levels
+        mu, level_cov = levels
         b = quantisation_harmonics(q, noise.quantisation_sigma[:, c])  # (K, S)
         b[:, quantisation[:, c] <= 0] = 0.0
-        k = np.arange(1, b.shape[0] + 1)[:, None]
-        damping = np.exp(-2.0 * math.pi**2 * k**2 * (u_mu[None, :, c] / q) ** 2)
-        phase = 2.0 * math.pi * k * mu[None, :, c] / q
-        shared = b * damping
-        cov = 0.5 * ((shared * np.cos(phase)).T @ (shared * np.cos(phase))
-                     + (shared * np.sin(phase)).T @ (shared * np.sin(phase)))
-        cov += np.diag(0.5 * np.sum(b**2 * (1.0 - damping**2), axis=0))
+        idx = np.arange(S) * 6 + c
+        block = level_cov[np.ix_(idx, idx)]
+        var_diff = np.maximum(np.diag(block)[:, None] + np.diag(block)[None, :] - 2.0 * block, 0.0)  # Var(δ_s − δ_r)
+        difference = mu[:, c][:, None] - mu[:, c][None, :]
+        cov = np.zeros((S, S))
+        for kk in range(b.shape[0]):
+            k = kk + 1
+            damping = np.exp(-2.0 * math.pi**2 * k**2 * var_diff / q**2)
+            cov += 0.5 * np.outer(b[kk], b[kk]) * np.cos(2.0 * math.pi * k * difference / q) * damping
         values, vectors = np.linalg.eigh(cov)
         for value, vector in zip(values, vectors.T):
             if value > 1e-12 * values.max():
@@ -511,12 +631,30 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                           all_noise.quantisation_sigma[keep], all_noise.notes)
 
     m = observed.ravel()
+    times = _middle_times(recording, used)
     basis = ident.basis
     theta, tilts, levels = theta0, tilts0, None
-    for _ in range(2):  # Type B sensitivities at the nominal point, then at the estimate
+    slow = None
+    # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
+    # noise the residuals show beyond the prediction (slow noise the segments are too short to show)
+    for iteration in range(3):
         sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts)
+        if iteration == 1:
+            V_predicted = sources.covariance()
+        if slow is not None:
+            _add_between_segment_noise(sources, slow, rows.reshape(observed.shape), times)
         V = sources.covariance()
-        W = whitening(V[np.ix_(rows, rows)]) @ select  # only the fitted rows
+        # the weights: a working covariance with each segment's quantisation error on its own. The full V (errors
+        # of segments at nearly the same level shared, through the quantiser's harmonics) is what u propagates
+        # through, for any weights; as weights its fine structure would let the fit cancel errors by contrasts
+        # that hold only as exactly as the levels, the dither and the offset model do (docs/fitting.md)
+        working = V
+        if levels is not None and np.any(noise.quantisation_variance > 0):
+            work = _build_sources(model, theta, noise, turntable, site_inputs, held, J, None, tilts)
+            if slow is not None:
+                _add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
+            working = work.covariance()
+        W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
         theta, tilts, gain, design, gain_z, chi2, c = _solve(model, basis, theta0, tilts0, m, W, J, extra=E)
         rank = ident.rank
         if model.n_tilts:
@@ -537,14 +675,20 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
-        levels = (fitted, np.sqrt(np.maximum(np.diag(hat @ V @ hat.T), 0.0)).reshape(observed.shape))
+        levels = (fitted, hat @ V @ hat.T)
+        if iteration == 1:
+            slow = between_segment_noise(m - fitted.ravel(), V, hat, rows.reshape(observed.shape), times)
+            if not np.any(slow.variance > 0):
+                break
     joint = _propagate(METHOD_JOINT, gain, sources, mask)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
     residual_cov = project @ V @ project.T
     residual_sd = np.where(rows, np.sqrt(np.maximum(np.diag(residual_cov), 0.0)), math.nan).reshape(observed.shape)
-    chi2 = float(np.sum((W @ residual) ** 2))
+    # χ² against the predicted noise (the within-segment model, quantisation, table, site), not against the
+    # between-segment part estimated from these same residuals
+    chi2 = float(np.sum((whitening(V_predicted[np.ix_(rows, rows)]) @ select @ residual) ** 2))
     chi2_dof = int(rows.sum()) - rank - n_extra
     extra_method = None
     if n_extra:
@@ -583,7 +727,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                     spec_bias = spec_gain @ fitted.ravel() - theta
     if spec is None and not spec_note:
         spec_note = "not run"
-    between = _between_segments(used_schedule, residual, residual_cov, project, sources)
+    # repeated settings against the prediction (not against the between-segment noise fitted to these residuals)
+    between = _between_segments(used_schedule, residual, project @ V_predicted @ project.T, project, sources)
     return FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
                      tilts=np.asarray(tilts)[:2 * int(model.placed.sum())].reshape(-1, 2),
                      placed=tuple(np.asarray(used)[model.placed].tolist()),
@@ -596,8 +741,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes,
                      model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
                      covariance=V, whitening=W, design=design, rows=rows,
-                     segment_times=_middle_times(recording, used), extra=extra_method,
-                     extra_names=tuple(extra))
+                     segment_times=times, extra=extra_method,
+                     extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow)
 
 
 def _middle_times(recording, used) -> np.ndarray:
@@ -657,6 +802,7 @@ def _between_segments(schedule: Schedule, residual: np.ndarray, residual_cov: np
             verdict = "the data scatter less than predicted"
         else:
             verdict = "consistent"
+        observed, expected = max(observed, 0.0), max(expected, 0.0)  # quadratic forms, ≥ 0 but for rounding
         out.append(BetweenSegments(name, len(groups), dof, math.sqrt(observed / dof), math.sqrt(expected / dof),
                                    math.sqrt(noise_part / dof), math.sqrt(table_part / dof),
                                    math.sqrt(max(observed - noise_part, 0.0) / dof), ratio, verdict))
