@@ -9,6 +9,7 @@ slow test).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 from pathlib import Path
@@ -168,6 +169,78 @@ def test_zero_noise_with_the_earth_rate_the_joint_fit_is_within_its_uncertainty_
     deg_h_g = math.radians(1) / 3600 / 9.80665
     assert np.all(np.abs(spec_error[gii] / deg_h_g - 9.7) < 0.1)
     assert np.all(np.abs(spec_error - result.spec_bias) <= 3 * result.spec.u)
+
+
+def _with_effects(scenario, **effects):
+    return dataclasses.replace(scenario, effects=dataclasses.replace(scenario.effects, **effects))
+
+
+def test_a_lever_arm_is_absorbed_by_p_unless_the_fit_is_told_it():
+    """Zero noise, accelerometers 3–4 mm off the table axis: accelerometer i at r⁽ⁱ⁾ turning about body axis j
+    feels the centripetal −ω²(r⁽ⁱ⁾ − (r⁽ⁱ⁾·e_j)e_j), read through row i of Ka, which is linear in ω_j² exactly
+    almost exactly as p_ij: without the lever arm the fit gives p_ij − Σ_{k≠j} Ka_ik r⁽ⁱ⁾_k (to 0.1 % of that
+    shift, the rest left in residuals of a few µm/s²); told the lever arm (``plansim fit --scenario``), it gives
+    p itself, exactly."""
+    lever = np.array([[3e-3, 4e-3, 2e-3], [-2e-3, 3e-3, 4e-3], [4e-3, -3e-3, 2e-3]])
+    scenario = _with_effects(load_scenario("ideal"), accel_lever_arm=lever)
+    told, truth = _fit_simulated(scenario, seed=1, trial=0, lever_arm=lever)
+    for method in told.methods[1:]:  # the specification's eq. (12)-(13) know nothing of a lever arm
+        assert np.max(np.abs(method.estimate - truth)) < 1e-9
+    blind, _ = _fit_simulated(scenario, seed=1, trial=0)
+    Ka = truth[21:30].reshape(3, 3)
+    expected = truth.copy()
+    for name in ("pxy", "pxz", "pyx", "pyz", "pzx", "pzy"):
+        i, j = "xyz".index(name[1]), "xyz".index(name[2])
+        expected[PARAMETER_NAMES.index(name)] -= sum(Ka[i, k] * lever[i, k] for k in range(3) if k != j)
+    shift = np.abs(expected - truth)
+    p = slice(33, 39)
+    assert np.all(shift[p] > 1e-3)
+    assert np.all(np.abs(blind.joint.estimate - expected)[p] < 1e-3 * shift[p])
+    assert 1e-7 < np.max(np.abs(blind.residuals[blind.fitted_rows])) < 1e-4
+    assert np.max(np.abs(told.residuals[told.fitted_rows])) < 1e-9
+
+
+def test_extra_unknowns_are_fitted_jointly_with_theta():
+    """Zero noise with a gyro scale asymmetry the 39 parameters lack: the base fit leaves a residual; with the
+    asymmetry's signature (the kernel's own, per unit, at the true θ) as extra unknowns the fit returns the
+    asymmetry and θ to 1e-9 and no residual."""
+    from plansim.kernels.layout import EFF_GYRO_ASYMMETRY
+
+    asymmetry = np.array([2e-3, -1e-3, 5e-4])
+    scenario = _with_effects(load_scenario("ideal"), gyro_asymmetry=asymmetry)
+    base, truth = _fit_simulated(scenario, seed=1, trial=0)
+    assert np.max(np.abs(base.residuals)) > 1e-6
+    off = base.model.means(truth)
+    extra = {}
+    for axis in range(3):
+        sensor = base.model.effect_arguments()["sensor"]
+        sensor[EFF_GYRO_ASYMMETRY, axis] = 1.0
+        extra[f"gyro_asymmetry[{'xyz'[axis]}]"] = base.model.means(truth, effects={"sensor": sensor}) - off
+    refit, _ = _fit_simulated(scenario, seed=1, trial=0, extra=extra)
+    assert refit.extra_names == tuple(extra)
+    assert np.max(np.abs(refit.extra.estimate - asymmetry)) < 1e-9
+    assert np.max(np.abs(refit.joint.estimate - truth)) < 1e-9
+    assert refit.chi2_dof == base.chi2_dof - 3
+    with pytest.raises(ValueError, match=r"extra\['bad'\]: expected finite values of shape"):
+        fit_recording(simulate_and_record(scenario, seed=1, trial=0), extra={"bad": np.zeros(3)})
+
+
+def test_slow_noise_between_segments_is_estimated_from_the_residuals():
+    """jjf2003's gyro bias instability is a Gauss–Markov process of σ = 1.076·2 °/h with a 100 s correlation
+    time: within a 30 s segment it hardly moves (the Allan fit finds no bias instability there), yet it moves
+    every segment's mean. The fit finds it between segments on at least two of the three gyros (correlated in
+    time on at least one), at a σ within a factor 2 of the truth (38 degrees of freedom: a relative standard error of
+    ~12 % on σ). On linear_gaussian (no such noise) at most one of the six channels takes it (5 % each)."""
+    scenario = load_scenario("jjf2003")
+    result, _ = _fit_simulated(scenario, seed=5, trial=0, lever_arm=scenario.effects.accel_lever_arm)
+    assert all(channel.bias_instability == 0 for channel in result.noise.channels[:3])
+    found = result.between_noise.variance[:3] > 0
+    assert found.sum() >= 2
+    sigma = math.radians(1.076 * 2 / 3600)
+    assert np.all(np.abs(np.log(np.sqrt(result.between_noise.variance[:3][found]) / sigma)) < math.log(2))
+    assert np.any(result.between_noise.correlation_time[:3][found] > 0)  # τ is loosely determined by 45 segments
+    clean, _ = _fit_simulated(load_scenario("linear_gaussian"), seed=5, trial=0)
+    assert np.sum(clean.between_noise.variance > 0) <= 1
 
 
 def test_a_six_position_log_fits_what_it_identifies_and_says_what_not():
@@ -354,10 +427,10 @@ def test_quantisation_step_from_the_data():
 # ------------------------------------------------------------------------------------------ uncertainty
 
 
-def _coverage(scenario, trials, seed, methods=("jjf2003", "joint_wls"), correct_spec_bias=False):
+def _coverage(scenario, trials, seed, methods=("jjf2003", "joint_wls"), correct_spec_bias=False, **options):
     covered = {m: [] for m in methods}
     for trial in range(trials):
-        result, truth = _fit_simulated(scenario, seed=seed, trial=trial)
+        result, truth = _fit_simulated(scenario, seed=seed, trial=trial, **options)
         for method in result.methods:
             if method.name not in covered:
                 continue
@@ -391,6 +464,40 @@ def test_coverage_over_many_simulated_recordings():
         assert np.all(np.abs(per_parameter - 0.95) <= coverage_tolerance(200, 0.95, 4.0))
     earth = dataclasses.replace(scenario, environment=dataclasses.replace(scenario.environment, earth_rate=True))
     _assert_covers(_coverage(earth, trials=100, seed=42, correct_spec_bias=True))
+
+
+#: the joint fit's parameters that cover on jjf2003 recordings; the accelerometers' cross-couplings and P do not yet
+#: (see test_the_joint_fit_under_covers_accelerometer_cross_terms_under_coarse_quantisation)
+_JOINT_COVERS = [k for k, name in enumerate(PARAMETER_NAMES)
+                 if name[:2] in ("Kg", "Bg", "Ba") or name[0] == "g" or name in ("Kaxx", "Kayy", "Kazz")]
+_JOINT_SHORT = [k for k in range(len(PARAMETER_NAMES)) if k not in _JOINT_COVERS]
+
+
+@functools.lru_cache(maxsize=1)
+def _jjf2003_coverage(trials):
+    scenario = load_scenario("jjf2003")
+    return _coverage(scenario, trials=trials, seed=43, correct_spec_bias=True,
+                     lever_arm=scenario.effects.accel_lever_arm)
+
+
+@pytest.mark.slow
+def test_jjf2003_recordings_fit_back_within_the_stated_uncertainty():
+    """40 recordings of the default scenario — bias instability with a 100 s correlation time, a 12-bit
+    non-dithered quantiser, Table 1 table errors, Earth rate, lever arms given as in ``plansim fit --scenario``:
+    the specification's estimators (less their predicted Earth-rate bias) cover at 95 % pooled over the 39
+    parameters, and the joint fit over the gyro parameters, the accelerometer scale factors and biases
+    (binomial tolerance at z = 3 for the pooled count; within-recording correlation makes it optimistic)."""
+    covered = _jjf2003_coverage(40)
+    _assert_covers({"jjf2003": covered["jjf2003"]})
+    _assert_covers({"joint_wls": covered["joint_wls"][:, _JOINT_COVERS]})
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="known limitation: under a quantiser the noise does not dither, the joint "
+                   "fit's u of the accelerometer cross-couplings and P is too small (docs/fitting.md)")
+def test_the_joint_fit_under_covers_accelerometer_cross_terms_under_coarse_quantisation():
+    covered = _jjf2003_coverage(40)
+    _assert_covers({"joint_wls": covered["joint_wls"][:, _JOINT_SHORT]})
 
 
 def test_repeated_settings_show_table_errors_larger_than_the_stated_grade():
