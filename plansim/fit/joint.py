@@ -677,6 +677,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
         levels = (fitted, hat @ V @ hat.T)
         if iteration == 1:
+            residual_predicted = m - fitted.ravel()  # the fit with the predicted noise alone, for its χ²
             slow = between_segment_noise(m - fitted.ravel(), V, hat, rows.reshape(observed.shape), times)
             if not np.any(slow.variance > 0):
                 break
@@ -686,9 +687,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     project = np.eye(len(m)) - hat
     residual_cov = project @ V @ project.T
     residual_sd = np.where(rows, np.sqrt(np.maximum(np.diag(residual_cov), 0.0)), math.nan).reshape(observed.shape)
-    # χ² against the predicted noise (the within-segment model, quantisation, table, site), not against the
-    # between-segment part estimated from these same residuals
-    chi2 = float(np.sum((whitening(V_predicted[np.ix_(rows, rows)]) @ select @ residual) ** 2))
+    # χ² of the fit with the predicted noise (the within-segment model, quantisation, table, site) against it,
+    # not against the between-segment part estimated from these same residuals
+    chi2 = float(np.sum((whitening(V_predicted[np.ix_(rows, rows)]) @ select @ residual_predicted) ** 2))
     chi2_dof = int(rows.sum()) - rank - n_extra
     extra_method = None
     if n_extra:

@@ -42,6 +42,14 @@ def fit_json(result: FitResult) -> dict:
                       "rate_random_walk": _number(ch.rate_random_walk),
                       "rate_random_walk_unit": units["rate_random_walk"],
                       "quantisation_step": _number(ch.quantisation_step), "quantisation_step_unit": units["mean"]})
+    between = result.between_noise
+    if between is not None:
+        for c, entry in enumerate(noise):  # the segment means' noise beyond the within-segment model (docs/fitting.md)
+            entry["between_segment_sd"] = _number(math.sqrt(between.variance[c]))
+            entry["between_segment_sd_unit"] = UNITS_SI[channel_kind(c)]["mean"]
+            entry["between_segment_correlation_time"] = _number(between.correlation_time[c])
+            entry["between_segment_correlation_time_unit"] = "s"
+            entry["between_segment_dof"] = _number(between.dof[c])
     residuals = []
     for s, k in enumerate(result.used):
         for c, channel in enumerate(CHANNELS):
@@ -97,6 +105,13 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
                                   {"long_name": long_name,
                                    "units": "; ".join(f"{ch.channel}: {ch.units().get(field, ch.units()['mean'])}"
                                                       for ch in result.noise.channels)})
+    if result.between_noise is not None:
+        data["between_noise_sd"] = ("channel", np.sqrt(result.between_noise.variance),
+                                    {"long_name": "noise of the segment means beyond the within-segment model, "
+                                                  "estimated from the residuals (0: none shown)", "units": "SI"})
+        data["between_noise_correlation_time"] = ("channel", result.between_noise.correlation_time,
+                                                  {"long_name": "its correlation time between segments (0: "
+                                                                "independent)", "units": "s"})
     if result.between:
         for field in ("observed_sd", "predicted_sd", "predicted_noise_sd", "predicted_table_sd", "component_sd",
                       "ratio"):

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 from plansim.units import KINDS
@@ -99,6 +101,17 @@ def fit_report(result, residuals: bool = True) -> str:
         lines += ["", "Turns by hand: fitted misalignment of the turned axis (two small angles; deg)"]
         for axis, (first, second) in zip(result.hand_axes, result.axis_tilts):
             lines.append(f"  about {'xyz'[axis]}: {math.degrees(first):+.3f} {math.degrees(second):+.3f}")
+
+    between = result.between_noise
+    if between is not None and np.any(between.variance > 0):
+        lines += ["", "Noise between segments beyond the within-segment model (from the residuals; slow noise such "
+                  "as a bias instability longer than a segment): a Type A input of every u above"]
+        for c in np.flatnonzero(between.variance > 0):
+            unit, factor = OUTPUT_UNITS[_kind(c)]
+            tau = between.correlation_time[c]
+            lines.append(f"  {CHANNELS[c]}: sd = {_g(math.sqrt(between.variance[c]) / factor, 3)} {unit}, "
+                         + (f"correlated over {tau:g} s" if tau > 0 else "independent between segments")
+                         + f", nu = {_dof(between.dof[c])}")
 
     ratio = result.chi2 / result.chi2_dof if result.chi2_dof > 0 else math.nan
     lines += ["", f"chi2/dof = {_g(result.chi2, 5)}/{result.chi2_dof} = {_g(ratio, 4)}: {result.chi2_verdict}"]
