@@ -1,0 +1,107 @@
+"""The catalogue of candidate effects: each one's signature in the segment means of a fitted recording.
+
+A signature is the change of every used segment's means per unit size of each component of the effect,
+(S, 6, m), SI. Where the simulator has the effect, the signature is computed through the simulator's own
+noise-free physics (:meth:`plansim.fit.model.MeanModel.means` with the kernel's effect arrays), at the fit's
+solution θ̂: one model of the world, not two. The effects enter the kernel linearly in their size at a fixed
+input, so one step gives the exact column (:data:`STEP` is only a scale).
+
+=========================  =================================================  ======================
+effect                     component / unit                                   scenario field
+=========================  =================================================  ======================
+gyro_scale_asymmetry       per gyro axis: (K+ − K−)/K, 1                       gyro_asymmetry
+gyro_scale_nonlinearity    per gyro axis: quadratic 1/(rad/s), cubic 1/(rad/s)² gyro_nonlinearity_*
+gyro_g2_sensitivity        gyro i × (f_j f_k): rad/s per (m/s²)²              gyro_g2_sensitivity
+accel_quadratic            per accelerometer: K2, 1/(m/s²)                    accel_second_order
+bias_drift                 per channel: a linear drift in time, SI/s          (none)
+lever_arm                  accelerometer i × axis k: m                        accel_lever_arm
+=========================  =================================================  ======================
+
+``saturation`` is a property of samples, not of segment means: the within-segment tests look for it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from plansim.kernels.layout import (
+    CHANNELS,
+    EFF_ACCEL_SECOND_ORDER,
+    EFF_GYRO_ASYMMETRY,
+    EFF_GYRO_CUBIC,
+    EFF_GYRO_QUADRATIC,
+)
+
+#: size of the unit step each signature is taken with, relative to the effect's unit (the kernel is linear in it)
+STEP = 1.0
+#: the catalogue's effect names, in the order they are reported
+EFFECTS = ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
+           "bias_drift", "lever_arm")
+AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class Signature:
+    """One candidate effect's signature in the segment means of a fit."""
+
+    effect: str
+    components: tuple[str, ...]
+    unit: str  # SI unit of one component's size
+    columns: np.ndarray  # (S, 6, m)
+    scenario_field: str | None
+    description: str
+    #: components in the same unit share a group (the excitation test compares like with like); default one group
+    unit_groups: tuple[int, ...] | None = None
+
+    def groups(self) -> np.ndarray:
+        return np.zeros(len(self.components), dtype=int) if self.unit_groups is None else np.asarray(self.unit_groups)
+
+
+def _kernel_columns(fit, argument: str, entries) -> np.ndarray:
+    """Columns (S, 6, m) of the kernel's effect array *argument* at each (row, column) of *entries*."""
+    model, theta, tilts = fit.model, fit.theta, fit.nuisance
+    base = model.means(theta, tilts)
+    out = []
+    for index in entries:
+        effects = model.effect_arguments()
+        effects[argument][index] += STEP
+        out.append((model.means(theta, tilts, effects={argument: effects[argument]}) - base) / STEP)
+    return np.stack(out, axis=-1)
+
+
+def signatures(fit) -> tuple[Signature, ...]:
+    """The catalogue's signatures in the segment means of *fit* (a :class:`plansim.fit.FitResult`)."""
+    if fit.model is None or fit.theta is None:
+        raise ValueError("fit: it carries no model (a FitResult from plansim.fit.fit_recording is needed)")
+    S = fit.observed.shape[0]
+    out = [
+        Signature("gyro_scale_asymmetry", tuple(AXES), "1",
+                  _kernel_columns(fit, "sensor", [(EFF_GYRO_ASYMMETRY, a) for a in range(3)]), "gyro_asymmetry",
+                  "the scale factor differs between positive and negative rates: (K+ − K−)/K per gyro"),
+        Signature("gyro_scale_nonlinearity", tuple(f"{a}2" for a in AXES) + tuple(f"{a}3" for a in AXES),
+                  "1/(rad/s) (x2 y2 z2), 1/(rad/s)^2 (x3 y3 z3)",
+                  np.concatenate([_kernel_columns(fit, "sensor", [(EFF_GYRO_QUADRATIC, a) for a in range(3)]),
+                                  _kernel_columns(fit, "sensor", [(EFF_GYRO_CUBIC, a) for a in range(3)])], axis=-1),
+                  "gyro_nonlinearity_quadratic, gyro_nonlinearity_cubic",
+                  "the gyro output has terms in ω² and ω³ of its own rate", (0, 0, 0, 1, 1, 1)),
+        Signature("gyro_g2_sensitivity", tuple(f"{i}{j}" for i in AXES for j in AXES), "rad/s/(m/s^2)^2",
+                  _kernel_columns(fit, "S2", [(i, j) for i in range(3) for j in range(3)]), "gyro_g2_sensitivity",
+                  "the gyro output has terms in products of the specific-force components (g²-sensitivity)"),
+        Signature("accel_quadratic", tuple(AXES), "1/(m/s^2)",
+                  _kernel_columns(fit, "sensor", [(EFF_ACCEL_SECOND_ORDER, a) for a in range(3)]),
+                  "accel_second_order", "the accelerometer output has a term K2·f² in its own specific force"),
+    ]
+    times = np.asarray(fit.segment_times, dtype=float)
+    drift = np.zeros((S, 6, 6))
+    for c in range(6):
+        drift[:, c, c] = times - times.mean()
+    out.append(Signature("bias_drift", CHANNELS, "rad/s/s (gyros), m/s^2/s (accelerometers)", drift, None,
+                         "a bias that drifts linearly in time over the recording (per channel)", (0, 0, 0, 1, 1, 1)))
+    out.append(Signature("lever_arm", tuple(f"{i}{k}" for i in AXES for k in AXES), "m",
+                         _kernel_columns(fit, "lever", [(i, k) for i in range(3) for k in range(3)]), "accel_lever_arm",
+                         "accelerometer i sits off the turning axis: the centripetal acceleration ω×(ω×r)"))
+    for signature in out:  # rows the fit does not fit (a hand turn's accelerometers) carry no signature
+        signature.columns[~fit.fitted_rows] = 0.0
+    return tuple(out)
