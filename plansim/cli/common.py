@@ -73,5 +73,6 @@ COMMANDS = {
     "record": "write one simulated trial's raw samples",
     "import": "a plain CSV log to a recording with segments",
     "fit": "fit a recording: parameters, noise, uncertainty",
+    "diagnose": "find the effect a recording's fit lacks",
     "bench": "measure speed and memory on this machine",
 }

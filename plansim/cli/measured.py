@@ -66,24 +66,13 @@ def _add_import_command(sub) -> None:
 
 
 def _cmd_fit(args) -> int:
-    from plansim.fit import fit_recording, resolve_site
+    from plansim.fit import fit_recording
     from plansim.fit.result import fit_dataset, fit_json
-    from plansim.io.recording import read_recording
-    from plansim.io.scenario_file import load_scenario
     from plansim.report.fit import fit_report
 
     if args.out is not None:
         check_output_path(args.out, "--out", (".nc",))
-    scenario = load_scenario(args.scenario) if args.scenario is not None else None
-    recording = read_recording(args.recording)
-    site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
-    options = {}
-    if scenario is not None:
-        options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
-                       reference_gravity=scenario.reduction.reference_gravity,
-                       omega_squared_sign=scenario.reduction.omega_squared_sign)
-        if scenario.effects.accel_lever_arm.any():  # the fixture's known lever arms: a model input, not absorbed by P
-            options["lever_arm"] = scenario.effects.accel_lever_arm
+    recording, site, options = recording_and_fit_options(args)
     result = fit_recording(recording, site, **options)
     with OutputSet() as outputs:
         if args.out is not None:
@@ -98,6 +87,37 @@ def _cmd_fit(args) -> int:
     return 0
 
 
+def recording_and_fit_options(args):
+    """The recording, the site and the fit's options from a command's RECORDING, --latitude/--height and
+    --scenario (its turntable grade, reduction and known lever arms), as ``plansim fit`` and ``plansim diagnose``
+    take them."""
+    from plansim.fit import resolve_site
+    from plansim.io.recording import read_recording
+    from plansim.io.scenario_file import load_scenario
+
+    scenario = load_scenario(args.scenario) if args.scenario is not None else None
+    recording = read_recording(args.recording)
+    site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
+    options = {}
+    if scenario is not None:
+        options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
+                       reference_gravity=scenario.reduction.reference_gravity,
+                       omega_squared_sign=scenario.reduction.omega_squared_sign)
+        if scenario.effects.accel_lever_arm.any():  # the fixture's known lever arms: a model input, not absorbed by P
+            options["lever_arm"] = scenario.effects.accel_lever_arm
+    return recording, site, options
+
+
+def add_site_and_scenario_options(p) -> None:
+    """--latitude, --height and --scenario, as ``plansim fit`` and ``plansim diagnose`` take them."""
+    p.add_argument("--latitude", type=float, default=None, metavar="DEG",
+                   help="site latitude (default: the recording's site_latitude_deg, else the scenario's)")
+    p.add_argument("--height", type=float, default=None, metavar="M", help="site height, with --latitude")
+    p.add_argument("--scenario", default=None,
+                   help="the lab's scenario (name or TOML path): its site, turntable/fixture grade, reduction and "
+                        "known lever arms (default: JJF 2003 Table 1 and the recording's attributes)")
+
+
 def _add_fit_command(sub) -> None:
     p = sub.add_parser(
         "fit", help=COMMANDS["fit"],
@@ -106,12 +126,7 @@ def _add_fit_command(sub) -> None:
                     "least squares, the noise from the data (Allan deviation), and each parameter's standard "
                     "uncertainty (docs/fitting.md)")
     p.add_argument("recording", help="recording file (.nc, or the samples .csv beside its .segments.csv)")
-    p.add_argument("--latitude", type=float, default=None, metavar="DEG",
-                   help="site latitude (default: the recording's site_latitude_deg, else the scenario's)")
-    p.add_argument("--height", type=float, default=None, metavar="M", help="site height, with --latitude")
-    p.add_argument("--scenario", default=None,
-                   help="the lab's scenario (name or TOML path): its site, turntable/fixture grade and reduction "
-                        "(default: JJF 2003 Table 1 and the recording's attributes)")
+    add_site_and_scenario_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the report")
     p.add_argument("--out", default=None, help="write the fit as a NetCDF file (.nc)")
     p.add_argument("--no-residuals", action="store_true", help="leave the per-segment residual table out of the report")

@@ -1,0 +1,90 @@
+"""The text report of ``plansim diagnose``: the verdict first, then the candidates, then before and after.
+
+Residuals in °/h (gyros) and µg (accelerometers); parameters in their display units
+(:mod:`plansim.model.parameters`); effect sizes in SI with their unit.
+"""
+
+from __future__ import annotations
+
+import math
+
+from plansim.diagnose.procedure import absorbed
+from plansim.kernels.layout import CHANNELS
+from plansim.model.parameters import PARAMETERS
+from plansim.report.fit import OUTPUT_UNITS, _g, _kind
+
+
+def _p(value: float) -> str:
+    return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
+
+
+def diagnose_report(d) -> str:
+    """The whole report of a :class:`plansim.diagnose.procedure.Diagnosis` as text."""
+    lines = ["plansim diagnose — closing the loop (docs/closing-the-loop.md)", ""]
+    lof = d.lack_of_fit
+    lines.append(f"Lack of fit of the base model (segment means, simulated null): statistic {_g(lof.statistic, 5)}, "
+                 f"p = {_p(lof.p_value)} -> {'FLAGGED' if lof.flagged else 'not flagged'} at alpha = {d.alpha:g}")
+    if d.selected:
+        lines.append(f"Found (closed testing, family-wise alpha = {d.alpha:g}):")
+        for effect in d.selected:
+            size = d.sizes[effect]
+            parts = ", ".join(f"{c} = {v:.4g} ± {u:.2g}" for c, v, u in zip(size["components"], size["value"],
+                                                                              size["u"]))
+            lines.append(f"  {effect}: {parts} ({size['unit']}; ± standard uncertainty)")
+    else:
+        lines.append("Found: no catalogue effect is significant.")
+    after = d.lack_of_fit_after
+    if d.unexplained["flagged"]:
+        lines.append(f"UNEXPLAINED residual after the refit (p = {_p(after.p_value)}): not named after any "
+                     "catalogue effect; where it sits:")
+        for where in d.unexplained["where"]:
+            c = CHANNELS.index(where["channel"])
+            unit, factor = OUTPUT_UNITS[_kind(c)]
+            segs = "; ".join(f"{s['segment']} {s['label']} ({s['residual'] / factor:+.3g} {unit}, z = {s['z']:+.1f})"
+                             for s in where["segments"]) or "spread over the segments, none beyond 3u"
+            lines.append(f"  {where['channel']} (p = {_p(where['p_value'])}): {segs}")
+    else:
+        lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
+    lines.append("Within segments (trends, steps, periodic components, samples stuck at a rail): not tested by "
+                 "this version.")
+    lines += ["", "Candidates (first round; adjusted p: Westfall–Young min-p over the identifiable ones)",
+              f"{'effect':25s} {'identifiable':>12s} {'dof':>4s} {'statistic':>10s} {'p':>9s} {'adjusted p':>10s}  "
+              "aliased with / would be separated by"]
+    for s in d.candidates:
+        note = ", ".join(s.aliased_with)
+        if not s.identifiable:
+            note = (f"aliased with {note}; " if note else "") + f"separate it with {s.separating}"
+        lines.append(f"{s.effect:25s} {'yes' if s.identifiable else 'no':>12s} {s.dof:>4d} {_g(s.statistic, 4):>10s} "
+                     f"{_p(s.p_value):>9s} {_p(s.adjusted_p_value):>10s}  {note}")
+    lines += ["", "Before and after (residual r.m.s. per channel; gyros deg/h, accelerometers ug)",
+              f"{'':22s} " + " ".join(f"{c:>10s}" for c in CHANNELS)]
+    for label, fit, hold in (("residual, before", d.before, d.holdout["before"]),
+                             ("residual, after", d.after, d.holdout["after"])):
+        values = []
+        holdout = []
+        for c in range(6):
+            rows = fit.fitted_rows[:, c]
+            rms = math.sqrt(float((fit.residuals[rows, c] ** 2).mean())) if rows.any() else math.nan
+            factor = OUTPUT_UNITS[_kind(c)][1]
+            values.append(_g(rms / factor, 3))
+            holdout.append(_g(hold["rms"][CHANNELS[c]] / factor, 3))
+        lines.append(f"{label:22s} " + " ".join(f"{v:>10s}" for v in values))
+        lines.append(f"{label.replace('residual', 'held out'):22s} " + " ".join(f"{v:>10s}" for v in holdout))
+    for label, fit in (("before", d.before), ("after", d.after)):
+        ratio = fit.chi2 / fit.chi2_dof if fit.chi2_dof > 0 else math.nan
+        info = d.information[label]
+        lines.append(f"chi2/dof {label}: {_g(ratio, 4)} (AIC {_g(info['aic'], 5)}, BIC {_g(info['bic'], 5)}: "
+                     "information only)")
+    lines.append(f"held out: {d.holdout['after']['scheme']}")
+    moved = absorbed(d)
+    if d.selected:
+        lines += ["", "Parameters that absorbed the effect (moved by more than their u): "
+                  + (", ".join(moved) if moved else "none"),
+                  f"{'name':8s} {'unit':>14s} {'before':>14s} {'after':>14s} {'u after':>10s}"]
+        for k, p in enumerate(PARAMETERS):
+            if p.name not in moved:
+                continue
+            f = p.display_factor
+            lines.append(f"{p.name:8s} {p.display_unit:>14s} {_g(d.before.joint.estimate[k] / f, 8):>14s} "
+                         f"{_g(d.after.joint.estimate[k] / f, 8):>14s} {_g(d.after.joint.u[k] / f, 3):>10s}")
+    return "\n".join(lines)
