@@ -74,5 +74,6 @@ COMMANDS = {
     "import": "a plain CSV log to a recording with segments",
     "fit": "fit a recording: parameters, noise, uncertainty",
     "diagnose": "find the effect a recording's fit lacks",
+    "diagnose-check": "check diagnose blind on simulated recordings",
     "bench": "measure speed and memory on this machine",
 }

@@ -127,6 +127,27 @@ def _where(fit, lof: LackOfFit) -> list[dict]:
     return out
 
 
+def _largest_model_columns(fit) -> dict:
+    """Every identifiable direction of the catalogue as extra columns (components that survive the base model and
+    are excited; a candidate's components kept only while they add rank)."""
+    from plansim.diagnose.scores import score_candidates
+
+    sigs = signatures(fit)
+    scores = score_candidates(fit, sigs, null_draws=19, method="holm")
+    columns, stack = {}, [np.asarray(fit.design)]
+    for sig, score in zip(sigs, scores):
+        for j, component in enumerate(sig.components):
+            if score.usable is None or not score.usable[j]:
+                continue
+            column = sig.columns[:, :, j]
+            trial = np.hstack(stack + [column.reshape(-1, 1)])
+            if np.linalg.matrix_rank(trial[np.asarray(fit.rows)]) > np.linalg.matrix_rank(
+                    np.hstack(stack)[np.asarray(fit.rows)]):
+                stack.append(column.reshape(-1, 1))
+                columns[f"{sig.effect}[{component}]"] = column
+    return columns
+
+
 def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed: int = 0,
              null_draws: int = NULL_DRAWS, lever_arm=None, reference_gravity=None, omega_squared_sign: str = "model",
              turntable_source: str = "") -> Diagnosis:
@@ -156,6 +177,13 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         raise ValueError(f"null_draws = {null_draws!r}: must be a whole number >= 19 (p resolves to 1/(B + 1))")
     options = dict(site=site, turntable=turntable, turntable_source=turntable_source,
                    reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm)
+    # the noise between segments (slow noise the segments are too short to show) is estimated once, from the
+    # largest model — the base one with every identifiable candidate — so that it does not absorb the effects
+    # being tested; every fit below then takes it as given
+    first_fit = fit_recording(recording, **options)
+    largest = _largest_model_columns(first_fit)
+    options["between_noise"] = fit_recording(recording, **options, extra=largest).between_noise if largest \
+        else first_fit.between_noise
     before = fit_recording(recording, **options)
     sigs = signatures(before)
     null = null_residuals(before, null_draws, seed)

@@ -96,7 +96,7 @@ class BetweenSegmentNoise:
 #: and the best of the six correlation times adds a little
 BETWEEN_LR_THRESHOLD = 3.0
 #: correlation times tried for the between-segment noise, s (0: independent segments); the likelihood picks one
-BETWEEN_CORRELATION_TIMES = (0.0, 30.0, 100.0, 300.0, 1000.0, 3000.0)
+BETWEEN_CORRELATION_TIMES = (0.0, 30.0, 100.0, 300.0)
 
 
 def _time_correlation(times: np.ndarray, tau: float) -> np.ndarray:
@@ -534,7 +534,8 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
 
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
-                  lever_arm=None, extra: dict | None = None) -> FitResult:
+                  lever_arm=None, extra: dict | None = None,
+                  between_noise: BetweenSegmentNoise | None = None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -559,6 +560,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         Further unknowns fitted jointly with θ: name -> (S_used, 6) array, the change of each used segment's
         means per unit of the unknown (an effect beyond eq. (1)/(2) that is linear in its size; see
         :mod:`plansim.diagnose`). Their estimates, u and ν are ``FitResult.extra``.
+    between_noise : BetweenSegmentNoise, optional
+        The noise between segments beyond the prediction, given rather than estimated from this fit's residuals
+        (``plansim diagnose`` estimates it once from the largest model, so that it does not absorb the effects
+        it tests for).
 
     Returns
     -------
@@ -678,7 +683,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         levels = (fitted, hat @ V @ hat.T)
         if iteration == 1:
             residual_predicted = m - fitted.ravel()  # the fit with the predicted noise alone, for its χ²
-            slow = between_segment_noise(m - fitted.ravel(), V, hat, rows.reshape(observed.shape), times)
+            slow = between_noise if between_noise is not None else \
+                between_segment_noise(m - fitted.ravel(), V, hat, rows.reshape(observed.shape), times)
             if not np.any(slow.variance > 0):
                 break
     joint = _propagate(METHOD_JOINT, gain, sources, mask)

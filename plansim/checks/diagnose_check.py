@@ -1,0 +1,209 @@
+"""``plansim diagnose-check``: the diagnosis run blind on recordings simulated with and without effects.
+
+Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simulate_and_record`, truth from
+:func:`plansim.simulate.chunks.simulate_recording`):
+
+- **null**: the scenario as it is (for ``jjf2003``: bias instability that does not average down, a 12-bit quantiser
+  the noise does not dither, the Table 1 table errors);
+- **catalogue effects**: one component of each effect at k × its noise-equivalent size (k = 2, 5, 10 by default),
+  the size taken from the diagnosis of a null recording of the same schedule
+  (:attr:`plansim.diagnose.scores.CandidateScore.noise_equivalent_size`), injected through the scenario's
+  ``[mimu.effects]`` field so that the simulator makes it (``bias_drift`` has no field: a ramp in time is added to
+  the samples). The component is the first one the schedule identifies;
+- **effects outside the catalogue**, added to the simulated samples: a step in the x gyro's bias half-way through
+  the recording, of k × the standard deviation of a segment mean of that channel, and a lever arm of 5 mm on
+  the x accelerometer that the fit is not told (aliased with P in JJF 2003: it must never be attributed).
+
+``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, or
+the lack of fit flagged), detection (anything flagged) and correct attribution (the injected effect selected,
+and only it), the confusion of injected against selected, how often an out-of-catalogue effect is flagged as
+an unexplained residual, and the parameters' error against the truth before and after the refit (r.m.s. of
+(estimate − truth)/u, and the 95 % coverage of the after-fit). Each recording's seed is a hash of the root
+seed, the case and the index, so the numbers do not depend on the order of the cases.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import binom
+
+from plansim.diagnose.procedure import diagnose
+from plansim.fit import resolve_site
+from plansim.runner import simulate_and_record
+from plansim.simulate.chunks import simulate_recording
+from plansim.uncertainty.metrology.propagation import coverage_factor
+
+#: the scenario field of each catalogue effect's components (bias_drift is added to the samples)
+FIELDS = {"gyro_scale_asymmetry": "gyro_asymmetry", "gyro_scale_nonlinearity": None, "gyro_g2_sensitivity":
+          "gyro_g2_sensitivity", "accel_quadratic": "accel_second_order", "lever_arm": "accel_lever_arm"}
+OUT_OF_CATALOGUE = ("bias_step", "unknown_lever_arm")
+
+
+def case_seed(root: int, case: str, index: int) -> int:
+    """The seed of one recording: a hash of the root seed, the case and its index."""
+    digest = hashlib.sha256(f"{root}/{case}/{index}".encode()).digest()
+    return int.from_bytes(digest[:4], "little")
+
+
+def _inject(scenario, effect: str, component: str, size: float):
+    """The scenario with one component of a catalogue effect set to *size* (SI), or None for bias_drift."""
+    e = scenario.effects
+    axes = "xyz"
+    if effect == "gyro_scale_asymmetry":
+        value = np.array(e.gyro_asymmetry, dtype=float)
+        value[axes.index(component)] += size
+        return dataclasses.replace(scenario, effects=dataclasses.replace(e, gyro_asymmetry=value))
+    if effect == "gyro_scale_nonlinearity":
+        name = "gyro_nonlinearity_quadratic" if component.endswith("2") else "gyro_nonlinearity_cubic"
+        value = np.array(getattr(e, name), dtype=float)
+        value[axes.index(component[0])] += size
+        return dataclasses.replace(scenario, effects=dataclasses.replace(e, **{name: value}))
+    if effect == "gyro_g2_sensitivity":
+        value = np.array(e.gyro_g2_sensitivity, dtype=float)
+        value[axes.index(component[0]), axes.index(component[1])] += size
+        return dataclasses.replace(scenario, effects=dataclasses.replace(e, gyro_g2_sensitivity=value))
+    if effect == "accel_quadratic":
+        value = np.array(e.accel_second_order, dtype=float)
+        value[axes.index(component)] += size
+        return dataclasses.replace(scenario, effects=dataclasses.replace(e, accel_second_order=value))
+    if effect == "lever_arm":
+        value = np.array(e.accel_lever_arm, dtype=float)
+        value[axes.index(component[0]), axes.index(component[1])] += size
+        return dataclasses.replace(scenario, effects=dataclasses.replace(e, accel_lever_arm=value))
+    return None
+
+
+@dataclass
+class CheckReport:
+    scenario: str
+    alpha: float
+    null: dict = field(default_factory=dict)
+    effects: list = field(default_factory=list)
+    out_of_catalogue: list = field(default_factory=list)
+
+
+def _run(scenario, recording, truth, lever, alpha, null_draws, seed):
+    d = diagnose(recording, resolve_site(scenario=scenario), scenario.turntable, lever_arm=lever, alpha=alpha,
+                 null_draws=null_draws, seed=seed)
+    z = {}
+    for label, fit in (("before", d.before), ("after", d.after)):
+        m = fit.joint
+        ok = np.isfinite(m.estimate) & (m.u > 0)
+        zz = (m.estimate[ok] - truth[ok]) / m.u[ok]
+        k = np.array([coverage_factor(nu) for nu in m.dof[ok]])
+        z[label] = (float(np.sqrt(np.mean(zz**2))), float(np.mean(np.abs(zz) <= k)))
+    return d, z
+
+
+def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes=(2.0, 5.0, 10.0),
+                       alpha: float = 0.05, seed: int = 0, null_draws: int = 500, progress=None) -> CheckReport:
+    """Run the check (module docstring) and return its figures."""
+    for name, value, low in (("null", null, 1), ("per_effect", per_effect, 0), ("null_draws", null_draws, 19)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+            raise ValueError(f"{name} = {value!r}: must be a whole number >= {low}")
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha = {alpha!r}: must be between 0 and 1")
+    sizes = tuple(float(k) for k in sizes)
+    if not sizes or any(not k > 0 for k in sizes):
+        raise ValueError(f"sizes = {sizes!r}: each must be > 0")
+    lever = scenario.effects.accel_lever_arm if scenario.effects.accel_lever_arm.any() else None
+    report = CheckReport(scenario.name, alpha)
+    total = null + per_effect * (len(sizes) * 6 + len(sizes) + 1)
+    done = 0
+
+    def tick():
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, total)
+
+    # the null
+    alarms, selections, z_before = 0, 0, []
+    reference = None
+    for i in range(null):
+        s = case_seed(seed, "null", i)
+        recording = simulate_and_record(scenario, seed=s, trial=0)
+        _, _, truth = simulate_recording(scenario, s, 0)
+        d, z = _run(scenario, recording, truth, lever, alpha, null_draws, s)
+        reference = reference or d
+        selections += bool(d.selected)
+        alarms += bool(d.selected) or d.lack_of_fit.flagged
+        z_before.append(z["before"])
+        tick()
+    report.null = {"recordings": null, "false_alarms": alarms, "rate": alarms / null,
+                   "selections": selections, "selection_rate": selections / null,
+                   "binomial_99_upper_count": int(binom.ppf(0.99, null, alpha)),
+                   "rms_z": float(np.mean([v[0] for v in z_before])),
+                   "coverage_95": float(np.mean([v[1] for v in z_before]))}
+    if reference is None or per_effect == 0:
+        return report
+    nes = {c.effect: c for c in reference.candidates}
+    for effect in ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
+                   "bias_drift", "lever_arm"):
+        candidate = nes[effect]
+        usable = np.flatnonzero(np.isfinite(candidate.noise_equivalent_size))
+        if effect == "lever_arm" or not usable.size:
+            component, base = ("xx", 5e-3) if effect == "lever_arm" else (candidate.components[0], math.nan)
+        else:
+            component, base = candidate.components[usable[0]], float(candidate.noise_equivalent_size[usable[0]])
+        for k in (sizes if effect != "lever_arm" else (1.0,)):
+            size = base * k if effect != "lever_arm" else base
+            counts = {"detected": 0, "attributed": 0, "selected": {}, "rms_z_before": [], "rms_z_after": [],
+                      "coverage_after": []}
+            for i in range(per_effect):
+                s = case_seed(seed, f"{effect}/{k}", i)
+                injected = _inject(scenario, effect, component, size) if effect != "bias_drift" else scenario
+                recording = simulate_and_record(injected, seed=s, trial=0)
+                _, _, truth = simulate_recording(injected, s, 0)
+                if effect == "bias_drift":
+                    c = "gx gy gz ax ay az".split().index(component)
+                    rate = recording.schedule.segments[0].sample_rate
+                    t = np.arange(recording.samples.shape[0]) / rate
+                    samples = np.array(recording.samples, dtype=float)
+                    samples[:, c] += size * (t - t.mean())
+                    recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
+                d, z = _run(injected, recording, truth, lever, alpha, null_draws, s)
+                counts["detected"] += bool(d.selected) or d.lack_of_fit.flagged
+                counts["attributed"] += d.selected == (effect,)
+                key = "+".join(d.selected) or "(none)"
+                counts["selected"][key] = counts["selected"].get(key, 0) + 1
+                counts["rms_z_before"].append(z["before"][0])
+                counts["rms_z_after"].append(z["after"][0])
+                counts["coverage_after"].append(z["after"][1])
+                tick()
+            report.effects.append({
+                "effect": effect, "component": component, "times_noise_equivalent": k if effect != "lever_arm"
+                else None, "size": size, "identifiable": candidate.identifiable, "recordings": per_effect,
+                "detection": counts["detected"] / per_effect, "attribution": counts["attributed"] / per_effect,
+                "confusion": counts["selected"], "rms_z_before": float(np.mean(counts["rms_z_before"])),
+                "rms_z_after": float(np.mean(counts["rms_z_after"])),
+                "coverage_after": float(np.mean(counts["coverage_after"]))})
+    # outside the catalogue: a bias step in gx half-way, k × the sd of a segment mean of gx
+    sd = float(np.sqrt(np.median(reference.before.noise.mean_variance[:, 0])))
+    for k in sizes:
+        flagged, named = 0, 0
+        for i in range(per_effect):
+            s = case_seed(seed, f"bias_step/{k}", i)
+            recording = simulate_and_record(scenario, seed=s, trial=0)
+            _, _, truth = simulate_recording(scenario, s, 0)
+            samples = np.array(recording.samples, dtype=float)
+            samples[samples.shape[0] // 2:, 0] += k * sd
+            recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
+            d, _ = _run(scenario, recording, truth, lever, alpha, null_draws, s)
+            flagged += d.unexplained["flagged"] or d.lack_of_fit.flagged
+            named += bool(d.selected)
+            tick()
+        report.out_of_catalogue.append({"effect": "bias_step", "times_sd": k, "size": k * sd, "unit": "rad/s",
+                                        "recordings": per_effect, "flagged_unexplained": flagged / per_effect,
+                                        "named_after_a_candidate": named / per_effect})
+    return report
+
+
+def check_json(report: CheckReport) -> dict:
+    return {"scenario": report.scenario, "alpha": report.alpha, "null": report.null, "effects": report.effects,
+            "out_of_catalogue": report.out_of_catalogue}
