@@ -5,8 +5,9 @@
 2. **Lack of fit** of M0 at segment level, against its simulated null (:func:`plansim.diagnose.scores.lack_of_fit`).
 3. **Candidates** (:mod:`plansim.diagnose.catalogue`): identifiability first, then score tests with the family-wise
    error over the catalogue held at α by the simulated min-p null (:func:`plansim.diagnose.scores.score_candidates`).
-4. **Closed testing** (Marcus, Peritz & Gabriel 1976): the candidate with the smallest adjusted p-value, if it is
-   below α, is added to the model — its identifiable components as extra unknowns fitted jointly with θ
+4. **Closed testing** (Marcus, Peritz & Gabriel 1976): of the candidates whose adjusted p-value is below α, the
+   one whose refit best predicts held-out segments (leave-one-segment-out) is added to the model — its
+   identifiable components as extra unknowns fitted jointly with θ
    (``fit_recording(extra=…)``) — and the remaining candidates are scored again against the new fit; the
    procedure stops when none is significant. Each step tests the intersection hypothesis of the candidates
    still out with a min-p test at level α, so the family-wise error of the selections stays ≤ α (the
@@ -127,6 +128,13 @@ def _where(fit, lof: LackOfFit) -> list[dict]:
     return out
 
 
+def _holdout_score(rms: dict, reference: dict) -> float:
+    """Σ over channels of (held-out r.m.s. / the reference's)²: lower predicts the held-out segments better."""
+    ratios = [(rms[c] / reference[c]) ** 2 for c in rms
+              if math.isfinite(rms[c]) and math.isfinite(reference.get(c, math.nan)) and reference[c] > 0]
+    return float(np.sum(ratios)) if ratios else math.inf
+
+
 def _largest_model_columns(fit) -> dict:
     """Every identifiable direction of the catalogue as extra columns (components that survive the base model and
     are excited; a candidate's components kept only while they add rank)."""
@@ -199,13 +207,25 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         open_ = [s for s in scores if s.identifiable and s.adjusted_p_value < alpha]
         if not open_:
             break
-        best = min(open_, key=lambda s: (s.adjusted_p_value, s.p_value))
-        signature = by_effect[best.effect]
-        for j, component in enumerate(signature.components):
-            if best.usable[j]:
-                extra[f"{best.effect}[{component}]"] = signature.columns[:, :, j]
+        # which of the significant candidates: the one whose refit predicts held-out segments best (each
+        # significant one is a valid next step of the closed test; the choice is attribution, made by
+        # cross-validation rather than by the p-values' order, which favours the candidate with fewer degrees of
+        # freedom when two alias in part, as ω² and |ω| do over one-signed rate points)
+        reference = holdout(current)["rms"]
+        best, best_score, best_fit, best_extra = None, math.inf, None, None
+        for candidate in open_:
+            signature = by_effect[candidate.effect]
+            trial = dict(extra)
+            for j, component in enumerate(signature.components):
+                if candidate.usable[j]:
+                    trial[f"{candidate.effect}[{component}]"] = signature.columns[:, :, j]
+            refit = fit_recording(recording, **options, extra=trial)
+            score = _holdout_score(holdout(refit)["rms"], reference) if len(open_) > 1 else 0.0
+            if score < best_score:
+                best, best_score, best_fit, best_extra = candidate, score, refit, trial
+        extra = best_extra
         selected.append(best.effect)
-        current = fit_recording(recording, **options, extra=extra)
+        current = best_fit
         # the signatures were taken at the base fit's θ̂, which the effect had biased: take them again at the new
         # solution and refit (a Gauss–Newton step on the product of the effect and θ), twice
         for _ in range(2):
