@@ -80,6 +80,7 @@ def test_zero_noise_an_injected_effect_is_selected_and_the_parameters_after_are_
     assert not d.unexplained["flagged"]
 
 
+@pytest.mark.slow
 def test_an_asymmetry_at_five_times_its_noise_equivalent_size_is_found_in_jjf2003():
     """jjf2003 (bias instability, 12-bit quantiser, Table 1 errors): the noise-equivalent size of the x gyro's
     asymmetry from a null recording, ×5, injected: selected, its size within 3u of the truth, and the gx residual
@@ -97,6 +98,7 @@ def test_an_asymmetry_at_five_times_its_noise_equivalent_size_is_found_in_jjf200
     assert j["after"]["holdout_rms"]["gx"] < j["before"]["holdout_rms"]["gx"]
 
 
+@pytest.mark.slow
 def test_false_alarms_on_null_recordings_are_within_alpha():
     """10 linear_gaussian recordings (the noise model exact): recordings with anything selected or a lack of fit
     flagged at most binom.ppf(0.99, 10, 2·0.05) (two tests at 5 % each) — a weak check, 10 recordings; the slow
@@ -111,11 +113,12 @@ def test_false_alarms_on_null_recordings_are_within_alpha():
 
 @pytest.mark.slow
 def test_false_alarms_over_many_null_recordings():
-    """60 jjf2003 recordings (bias instability that does not average down, a 12-bit quantiser the noise does not
-    dither, Table 1 table errors): the family-wise rate of a selection is ≤ α within its binomial 99 % bound."""
+    """30 jjf2003 recordings (bias instability that does not average down, a 12-bit quantiser the noise does not
+    dither, Table 1 table errors): the family-wise rate of a selection is ≤ α within its binomial 99 % bound (4 of
+    30; a weak check: plansim diagnose-check counts 100)."""
     scenario = load_scenario("jjf2003")
-    selections = sum(bool(_diagnose(scenario, seed=22, trial=t, null_draws=300).selected) for t in range(60))
-    assert selections <= binom.ppf(0.99, 60, 0.05)
+    selections = sum(bool(_diagnose(scenario, seed=22, trial=t, null_draws=300).selected) for t in range(30))
+    assert selections <= binom.ppf(0.99, 30, 0.05)
 
 
 def test_json_keys_and_the_command(tmp_path, capsys):
