@@ -78,8 +78,8 @@ def holdout(fit) -> dict:
 
     For each used segment s, the linearised fit of the others — Δz = (D_oᵀ V_oo⁻¹ D_o)⁺ D_oᵀ V_oo⁻¹ r_o, D the fit's
     design, V its covariance, r the residuals — predicts segment s's residual as D_s Δz; the error is r_s − D_s Δz.
-    A segment whose removal lowers the design's rank (the only one to identify a combination) is skipped and
-    counted.
+    A segment whose removal lowers the design's rank (the only one to identify a combination), and a pose placed by
+    hand (its tilt is fitted from it alone), are skipped and counted.
     """
     S = fit.observed.shape[0]
     rows = np.asarray(fit.rows, dtype=bool)
@@ -87,7 +87,11 @@ def holdout(fit) -> dict:
     full_rank = np.linalg.matrix_rank(D[rows]) if D.shape[1] else 0
     errors = np.full((S, 6), np.nan)
     skipped = 0
+    placed = set(getattr(fit, "placed", ()) or ())
     for s in range(S):
+        if int(fit.used[s]) in placed:  # a pose placed by hand: its own tilt is fitted from it, nothing to predict
+            skipped += 1
+            continue
         other = rows.copy()
         other[6 * s:6 * s + 6] = False
         mine = np.zeros_like(rows)
@@ -213,7 +217,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         # freedom when two alias in part, as ω² and |ω| do over one-signed rate points)
         reference = holdout(current)["rms"]
         best, best_score, best_fit, best_extra = None, math.inf, None, None
-        for candidate in open_:
+        # (where no segment can be held out — every pose placed by hand — the p-values' order decides)
+        for candidate in sorted(open_, key=lambda c: (c.adjusted_p_value, c.p_value)):
             signature = by_effect[candidate.effect]
             trial = dict(extra)
             for j, component in enumerate(signature.components):
@@ -221,7 +226,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                     trial[f"{candidate.effect}[{component}]"] = signature.columns[:, :, j]
             refit = fit_recording(recording, **options, extra=trial)
             score = _holdout_score(holdout(refit)["rms"], reference) if len(open_) > 1 else 0.0
-            if score < best_score:
+            if best is None or score < best_score:
                 best, best_score, best_fit, best_extra = candidate, score, refit, trial
         extra = best_extra
         selected.append(best.effect)
