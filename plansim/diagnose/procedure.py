@@ -76,42 +76,43 @@ def _information(fit) -> dict:
 def holdout(fit) -> dict:
     """Leave-one-segment-out prediction error of the fitted segment means, r.m.s. per channel (SI).
 
-    For each used segment s, the linearised fit of the others — Δz = (D_oᵀ V_oo⁻¹ D_o)⁺ D_oᵀ V_oo⁻¹ r_o, D the fit's
-    design, V its covariance, r the residuals — predicts segment s's residual as D_s Δz; the error is r_s − D_s Δz.
-    A segment whose removal lowers the design's rank (the only one to identify a combination), and a pose placed by
-    hand (its tilt is fitted from it alone), are skipped and counted.
+    For generalised least squares with covariance V the prediction error of a held-out block s, predicted from the
+    fit of all the others (their estimate of z and, through V, their correlated noise), has the closed form
+    e_s = (P_ss)⁻¹ (P r)_s with P = V⁻¹ − V⁻¹D (DᵀV⁻¹D)⁺ DᵀV⁻¹ (D the fit's design, r its residuals; the
+    cross-validation residuals of kriging and mixed models, Rao 1973), on the fitted rows. A block whose P_ss is
+    singular (the segment alone identifies a combination) and a pose placed by hand (its tilt is fitted from it
+    alone) cannot be held out; they are counted.
     """
     S = fit.observed.shape[0]
     rows = np.asarray(fit.rows, dtype=bool)
-    D, V, r = np.asarray(fit.design), np.asarray(fit.covariance), (fit.observed - fit.fitted).ravel()
-    full_rank = np.linalg.matrix_rank(D[rows]) if D.shape[1] else 0
+    index = np.flatnonzero(rows)
+    D = np.asarray(fit.design)[rows]
+    V = np.asarray(fit.covariance)[np.ix_(rows, rows)]
+    r = (fit.observed - fit.fitted).ravel()[rows]
+    Vi = np.linalg.pinv(V, hermitian=True)
+    if D.shape[1]:
+        ViD = Vi @ D
+        P = Vi - ViD @ np.linalg.pinv(D.T @ ViD) @ ViD.T
+    else:
+        P = Vi
+    Pr = P @ r
+    segment_of = index // 6
     errors = np.full((S, 6), np.nan)
     skipped = 0
     placed = set(getattr(fit, "placed", ()) or ())
     for s in range(S):
-        if int(fit.used[s]) in placed:  # a pose placed by hand: its own tilt is fitted from it, nothing to predict
+        block = np.flatnonzero(segment_of == s)
+        if block.size == 0:
+            continue
+        Pss = P[np.ix_(block, block)]
+        values = np.linalg.eigvalsh(Pss)
+        if int(fit.used[s]) in placed or values.min() <= 1e-9 * max(values.max(), 1e-300):
             skipped += 1
             continue
-        other = rows.copy()
-        other[6 * s:6 * s + 6] = False
-        mine = np.zeros_like(rows)
-        mine[6 * s:6 * s + 6] = rows[6 * s:6 * s + 6]
-        if not np.any(mine):
-            continue
-        Do = D[other]
-        if D.shape[1] and np.linalg.matrix_rank(Do) < full_rank:
-            skipped += 1
-            continue
-        if D.shape[1]:
-            Vinv = np.linalg.pinv(V[np.ix_(other, other)], hermitian=True)
-            dz = np.linalg.pinv(Do.T @ Vinv @ Do) @ (Do.T @ Vinv @ r[other])
-            predicted = D[mine] @ dz
-        else:
-            predicted = 0.0
-        errors[s, rows[6 * s:6 * s + 6]] = r[mine] - predicted
+        errors[s, index[block] % 6] = np.linalg.solve(Pss, Pr[block])
     rms = {name: (float(np.sqrt(np.nanmean(errors[:, c] ** 2))) if np.any(np.isfinite(errors[:, c])) else math.nan)
            for c, name in enumerate(CHANNELS)}
-    return {"rms": rms, "skipped": skipped, "scheme": "leave one segment out (linearised GLS)"}
+    return {"rms": rms, "skipped": skipped, "scheme": "leave one segment out (GLS cross-validation residuals)"}
 
 
 def _where(fit, lof: LackOfFit) -> list[dict]:
