@@ -46,8 +46,8 @@ OUT_OF_CATALOGUE = ("bias_step", "unknown_lever_arm")
 
 def case_seed(root: int, case: str, index: int) -> int:
     """The seed of one recording: a hash of the root seed, the case and its index."""
-    digest = hashlib.sha256(f"{root}/{case}/{index}".encode()).digest()
-    return int.from_bytes(digest[:4], "little")
+    hashed = hashlib.sha256(f"{root}/{case}/{index}".encode()).hexdigest()
+    return int.from_bytes(bytes.fromhex(hashed[:8]), "little")
 
 
 def _inject(scenario, effect: str, component: str, size: float):
