@@ -30,6 +30,7 @@ from plansim.fit.noise import (
     pooled_allan_variance,
     quantisation_error_variance,
     quantisation_step,
+    quantised_noise_sigma,
 )
 from plansim.fit.result import JSON_KEYS, fit_json
 from plansim.io.recording import Recording, write_recording
@@ -422,6 +423,33 @@ def test_quantisation_step_from_the_data():
     assert quantisation_step([np.full(100, 1.0), np.full(100, 2.0)]) == 0.0  # no variation: no step to see
     assert float(quantisation_error_variance(q, 0.0)) == pytest.approx(q**2 / 12, rel=1e-3)
     assert float(quantisation_error_variance(q, q)) < 1e-12 * q**2  # dithered
+
+
+
+@pytest.mark.parametrize("ratio", [0.25, 0.5, 1.0])
+def test_the_noise_before_the_quantiser_by_maximum_likelihood(ratio):
+    """12 static segments of 3000 samples, σ = ratio·q before the quantiser: the level-by-level likelihood finds σ
+    within 10 % (the grid's spacing is 6 %; the statistical relative u with 36 000 samples is below 1 %). The
+    scatter with Sheppard's correction, per segment, does not: at σ = q/4 a segment's scatter depends on where its
+    level sits in the step."""
+    rng = np.random.default_rng(11)
+    q = 0.0383
+    levels = rng.uniform(-5 * q, 5 * q, 12)
+    segments = [q * np.round((level + ratio * q * rng.normal(size=3000)) / q) for level in levels]
+    assert quantised_noise_sigma(q, segments) == pytest.approx(ratio * q, rel=0.10)
+    if ratio == 0.25:
+        sheppard = [math.sqrt(max(np.var(x, ddof=1) - q**2 / 12, 0.0)) for x in segments]
+        assert max(sheppard) - min(sheppard) > 0.5 * ratio * q
+
+
+def test_the_noise_before_a_quantiser_it_does_not_dither():
+    """Segments that never leave their level say only that σ is small: 0 is returned (the quantiser taken as not
+    dithered, its error at its largest, q²/12); no step, no segments: 0."""
+    q = 0.0383
+    segments = [np.full(500, k * q) for k in range(-3, 4)]
+    assert quantised_noise_sigma(q, segments) == 0.0
+    assert quantised_noise_sigma(0.0, segments) == 0.0
+    assert quantised_noise_sigma(q, []) == 0.0
 
 
 # ------------------------------------------------------------------------------------------ uncertainty

@@ -18,7 +18,9 @@ For each channel (gx gy gz ax ay az):
 3. **Quantisation**: a channel whose values are whole multiples of one step q (found from the data)
    is quantised; where the noise is too small to dither it (σ ≲ q/2), a segment mean carries a
    systematic error of r.m.s. √(Σ_k (q/πk)² e^{−4π²k²σ²/q²} / 2) (q/√12 without noise), which no
-   scatter shows.
+   scatter shows. σ is the noise before the quantiser, one per channel, by maximum likelihood over the
+   static segments' levels (:func:`quantised_noise_sigma`; the scatter cannot tell it below q/2); a
+   turning segment takes the larger of it and its own scatter less q²/12 (Sheppard).
 
 **The variance of a segment mean** of duration T is then the Allan variance at τ = T — the mean square
 difference between two adjacent such means — from the fitted model: N²/T + (2 ln 2/π)B² + K²T/3. The
@@ -236,6 +238,71 @@ def quantisation_error_variance(step: float, sigma) -> np.ndarray:
     return 0.5 * np.sum(quantisation_harmonics(step, sigma) ** 2, axis=0)
 
 
+#: the grid of σ/q over which :func:`quantised_noise_sigma` maximises the likelihood (log-spaced), and of the
+#: level's position within a step (per segment, profiled out)
+SIGMA_GRID = np.geomspace(0.02, 2.0, 81)
+LEVEL_GRID = np.linspace(-1.0, 1.0, 401)
+#: log-likelihood below its maximum still taken as consistent with the data (a 1-parameter 62 % interval's edge)
+LIKELIHOOD_MARGIN = 0.5
+
+
+def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
+    """The noise σ *before* a quantiser of step q, from static segments' quantised samples, by maximum likelihood.
+
+    Each segment's samples are taken as a constant level μ_s plus Gaussian noise N(0, σ²), then quantised: a
+    sample falls on level j (a whole number of steps from the segment's first sample) with probability
+    Φ((j + ½ − μ_s/q)/(σ/q)) − Φ((j − ½ − μ_s/q)/(σ/q)). The likelihood of all segments is maximised over one
+    σ (a sensor's noise) with each μ_s profiled out, on the grids :data:`SIGMA_GRID` × :data:`LEVEL_GRID`
+    (steps) about the segment's sample mean.
+
+    Why not the scatter: below σ ≈ q/2 a segment's sample scatter tells where its level sits in a step rather
+    than how noisy the sensor is (a level mid-step shows no scatter, one near a step's edge shows about q/2
+    whatever σ), and Sheppard's correction s² − q²/12 fails there. The level-by-level likelihood has no such
+    bias: a segment that never leaves its level bounds σ from above, one that toggles between two levels
+    fixes it from how often.
+
+    Where few segments toggle, the likelihood is flat below some σ (a segment sitting mid-step says only that
+    σ is small): the smallest σ whose log-likelihood is within :data:`LIKELIHOOD_MARGIN` of the maximum is
+    returned, the end that takes the quantiser as least dithered and its error as largest. With dithering
+    noise the likelihood is sharp and this is the maximum-likelihood value.
+
+    Returns 0.0 when no segment leaves its level (σ ≪ q: the quantiser is not dithered at all) and the
+    largest grid value times q when σ ≥ 2q (the dither is then complete and the exact value no longer matters).
+    """
+    from scipy.special import log_ndtr, ndtr
+
+    if step <= 0 or not segments:
+        return 0.0
+    tables = []
+    for values in segments:
+        values = np.asarray(values, dtype=float)
+        if values.size < 2:
+            continue
+        j = np.rint((values - values[0]) / step).astype(np.int64)
+        levels, counts = np.unique(j, return_counts=True)
+        tables.append((levels.astype(float), counts.astype(float), float(np.mean(j))))
+    if not tables or all(t[0].size == 1 for t in tables):
+        return 0.0
+    width = max(t[0].size for t in tables)
+    levels = np.zeros((len(tables), width))
+    counts = np.zeros((len(tables), width))
+    centres = np.array([t[2] for t in tables])
+    for k, (lv, ct, _) in enumerate(tables):
+        levels[k, : lv.size] = lv
+        counts[k, : ct.size] = ct
+    m = centres[:, None] + LEVEL_GRID[None, :]  # (S, M) candidate levels, steps
+    totals = np.empty(SIGMA_GRID.size)
+    for i, r in enumerate(SIGMA_GRID):
+        upper = (levels[:, None, :] + 0.5 - m[:, :, None]) / r
+        lower = (levels[:, None, :] - 0.5 - m[:, :, None]) / r
+        # log(Φ(u) − Φ(l)) stably: on the upper tail use the mirrored form
+        p = np.where(lower > 0, ndtr(-lower) - ndtr(-upper), ndtr(upper) - ndtr(lower))
+        with np.errstate(divide="ignore"):
+            logp = np.where(p > 0, np.log(np.maximum(p, 1e-300)), log_ndtr(-np.abs(lower)) - 700.0)
+        totals[i] = np.sum(np.max(np.sum(counts[:, None, :] * logp, axis=2), axis=1))
+    return float(SIGMA_GRID[np.flatnonzero(totals >= totals.max() - LIKELIHOOD_MARGIN)[0]] * step)
+
+
 @dataclass(frozen=True)
 class ChannelNoise:
     """The noise of one channel, SI (see :data:`UNITS_SI`)."""
@@ -348,6 +415,8 @@ def estimate_noise(segment_samples: list[np.ndarray], segments) -> NoiseEstimate
         notes.append("no static segment: white noise from the within-segment scatter only; bias instability and "
                      "random walk not estimated (NaN)")
 
+    sigma_before = [quantised_noise_sigma(ch.quantisation_step, [segment_samples[k][:, c] for k in static])
+                    if ch.quantisation_step > 0 and static else math.nan for c, ch in enumerate(channels)]
     variance = np.zeros((S, 6))
     variance_dof = np.full((S, 6), math.inf)
     quantisation = np.zeros((S, 6))
@@ -367,7 +436,12 @@ def estimate_noise(segment_samples: list[np.ndarray], segments) -> NoiseEstimate
                     white, white_dof = own, max(within_dof[k], 1)
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             if ch.quantisation_step > 0:
-                dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
+                # static: the sensor's own σ (the likelihood over all static segments); turning: its scatter
+                # about the turning model as well (the signal itself sweeps the quantiser's levels)
+                dither[k, c] = sigma_before[c]
+                if s.is_rotating or math.isnan(sigma_before[c]):
+                    sheppard = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
+                    dither[k, c] = sheppard if math.isnan(sigma_before[c]) else max(sheppard, sigma_before[c])
                 quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
             floor = (RELATIVE_FLOOR * rms[c]) ** 2
             total = white + slow + quantisation[k, c] + floor
