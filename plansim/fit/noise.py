@@ -18,9 +18,10 @@ For each channel (gx gy gz ax ay az):
 3. **Quantisation**: a channel whose values are whole multiples of one step q (found from the data)
    is quantised; where the noise is too small to dither it (σ ≲ q/2), a segment mean carries a
    systematic error of r.m.s. √(Σ_k (q/πk)² e^{−4π²k²σ²/q²} / 2) (q/√12 without noise), which no
-   scatter shows. σ is the noise before the quantiser, one per channel, by maximum likelihood over the
-   static segments' levels (:func:`quantised_noise_sigma`; the scatter cannot tell it below q/2); a
-   turning segment takes the larger of it and its own scatter less q²/12 (Sheppard).
+   scatter shows. In a static segment, the error is taken given where its samples fall on the levels
+   (:func:`quantisation_error_given_levels`), at the channel's noise before the quantiser, found by
+   maximum likelihood over the static segments (:func:`quantised_noise_sigma`; the scatter cannot tell
+   it below q/2). A turning segment takes its scatter less q²/12 (Sheppard) as its dither.
 
 **The variance of a segment mean** of duration T is then the Allan variance at τ = T — the mean square
 difference between two adjacent such means — from the fitted model: N²/T + (2 ln 2/π)B² + K²T/3. The
@@ -269,18 +270,9 @@ def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
     Returns 0.0 when no segment leaves its level (σ ≪ q: the quantiser is not dithered at all) and the
     largest grid value times q when σ ≥ 2q (the dither is then complete and the exact value no longer matters).
     """
-    from scipy.special import log_ndtr, ndtr
-
     if step <= 0 or not segments:
         return 0.0
-    tables = []
-    for values in segments:
-        values = np.asarray(values, dtype=float)
-        if values.size < 2:
-            continue
-        j = np.rint((values - values[0]) / step).astype(np.int64)
-        levels, counts = np.unique(j, return_counts=True)
-        tables.append((levels.astype(float), counts.astype(float), float(np.mean(j))))
+    tables = [_level_table(values, step) for values in segments if np.asarray(values).size >= 2]
     if not tables or all(t[0].size == 1 for t in tables):
         return 0.0
     width = max(t[0].size for t in tables)
@@ -291,16 +283,63 @@ def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
         levels[k, : lv.size] = lv
         counts[k, : ct.size] = ct
     m = centres[:, None] + LEVEL_GRID[None, :]  # (S, M) candidate levels, steps
-    totals = np.empty(SIGMA_GRID.size)
-    for i, r in enumerate(SIGMA_GRID):
-        upper = (levels[:, None, :] + 0.5 - m[:, :, None]) / r
-        lower = (levels[:, None, :] - 0.5 - m[:, :, None]) / r
-        # log(Φ(u) − Φ(l)) stably: on the upper tail use the mirrored form
-        p = np.where(lower > 0, ndtr(-lower) - ndtr(-upper), ndtr(upper) - ndtr(lower))
-        with np.errstate(divide="ignore"):
-            logp = np.where(p > 0, np.log(np.maximum(p, 1e-300)), log_ndtr(-np.abs(lower)) - 700.0)
-        totals[i] = np.sum(np.max(np.sum(counts[:, None, :] * logp, axis=2), axis=1))
+    totals = np.array([np.sum(np.max(_log_likelihood(levels, counts, m, r), axis=1)) for r in SIGMA_GRID])
     return float(SIGMA_GRID[np.flatnonzero(totals >= totals.max() - LIKELIHOOD_MARGIN)[0]] * step)
+
+
+def _level_table(values, step: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """(levels, counts, mean) of a segment's samples in whole steps from its first sample."""
+    values = np.asarray(values, dtype=float)
+    j = np.rint((values - values[0]) / step).astype(np.int64)
+    levels, counts = np.unique(j, return_counts=True)
+    return levels.astype(float), counts.astype(float), float(np.mean(j))
+
+
+def _log_likelihood(levels: np.ndarray, counts: np.ndarray, m: np.ndarray, r: float) -> np.ndarray:
+    """(S, M) log-likelihood of each segment's level counts (S, L) at true levels m (S, M), steps, noise σ/q = r."""
+    from scipy.special import log_ndtr, ndtr
+
+    upper = (levels[:, None, :] + 0.5 - m[:, :, None]) / r
+    lower = (levels[:, None, :] - 0.5 - m[:, :, None]) / r
+    # log(Φ(u) − Φ(l)) stably: on the upper tail use the mirrored form
+    p = np.where(lower > 0, ndtr(-lower) - ndtr(-upper), ndtr(upper) - ndtr(lower))
+    with np.errstate(divide="ignore"):
+        logp = np.where(p > 0, np.log(np.maximum(p, 1e-300)), log_ndtr(-np.abs(lower)) - 700.0)
+    return np.sum(counts[:, None, :] * logp, axis=2)
+
+
+#: the grid of a segment's true level (steps, about its sample mean) for :func:`quantisation_error_given_levels`
+POSTERIOR_GRID = np.linspace(-1.0, 1.0, 801)
+
+
+def quantisation_error_given_levels(step: float, values, sigma: float) -> float:
+    """Mean square error of a static segment's sample mean as its true level, given how its samples fall on the
+    quantiser's levels: E[(x̄ − μ)² | the level counts], μ uniform a priori, noise σ before the quantiser.
+
+    The likelihood of the counts at each candidate level μ (:func:`quantised_noise_sigma`'s model) is the
+    posterior of μ on :data:`POSTERIOR_GRID`. A segment that never leaves its level leaves μ anywhere in the
+    step but within a few σ of its edges, and the error is about q²/12; one that toggles between two levels
+    places μ near the edge to within about σ/√n, and its mean is nearly exact. The average over segments is the
+    unconditional Σ_k b_k²/2 (:func:`quantisation_error_variance`); per segment, this is what the data say.
+    """
+    if step <= 0:
+        return 0.0
+    levels, counts, mean = _level_table(values, step)
+    r = max(sigma / step, float(SIGMA_GRID[0]))
+    m = mean + POSTERIOR_GRID[None, :]
+    log_l = _log_likelihood(levels[None, :], counts[None, :], m, r)[0]
+    weights = np.exp(log_l - log_l.max())
+    return float(np.sum(weights * (mean - m[0]) ** 2) / np.sum(weights) * step**2)
+
+
+def dither_for_error(step: float, mean_square: float) -> float:
+    """The σ at which :func:`quantisation_error_variance` equals *mean_square* (0 at ≥ q²/12): the harmonics of
+    the quantiser's error that a conditional error (:func:`quantisation_error_given_levels`) stands for."""
+    if step <= 0 or mean_square >= step**2 / 12.0:
+        return 0.0
+    ratios = np.linspace(0.0, 2.0, 801)
+    table = quantisation_error_variance(step, ratios * step)  # decreasing in σ
+    return float(np.interp(mean_square, table[::-1], ratios[::-1]) * step)
 
 
 @dataclass(frozen=True)
@@ -435,16 +474,23 @@ def estimate_noise(segment_samples: list[np.ndarray], segments) -> NoiseEstimate
                 if s.is_rotating and s.rate_known and own > white:  # a table's rate jitter (a hand's is no noise)
                     white, white_dof = own, max(within_dof[k], 1)
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
+            own_quantisation = 0.0
             if ch.quantisation_step > 0:
-                # static: the sensor's own σ (the likelihood over all static segments); turning: its scatter
-                # about the turning model as well (the signal itself sweeps the quantiser's levels)
-                dither[k, c] = sigma_before[c]
                 if s.is_rotating or math.isnan(sigma_before[c]):
-                    sheppard = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
-                    dither[k, c] = sheppard if math.isnan(sigma_before[c]) else max(sheppard, sigma_before[c])
-                quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
+                    # turning: the signal itself sweeps the levels; its scatter less q²/12 (Sheppard)
+                    dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
+                    quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
+                else:
+                    # static: the error given where the samples fall, at the sensor's σ (all static segments).
+                    # The quantiser's harmonics stand for up to q²/12 of it (shared by segments at one level);
+                    # beyond that (a segment that toggles rarely: its mean off by most of a step) the excess is
+                    # the segment's own error
+                    given = quantisation_error_given_levels(ch.quantisation_step, x[:, c], sigma_before[c])
+                    quantisation[k, c] = min(given, ch.quantisation_step**2 / 12.0)
+                    own_quantisation = given - quantisation[k, c]
+                    dither[k, c] = dither_for_error(ch.quantisation_step, quantisation[k, c])
             floor = (RELATIVE_FLOOR * rms[c]) ** 2
-            total = white + slow + quantisation[k, c] + floor
+            total = white + slow + quantisation[k, c] + own_quantisation + floor
             variance[k, c] = total
             denominator = white**2 / white_dof + slow**2 / slow_dof
             variance_dof[k, c] = total**2 / denominator if denominator > 0 else math.inf
