@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
-from plansim.checks.diagnose_check import case_seed, check_json, run_diagnose_check
+from plansim.checks.diagnose_check import _add_out_of_catalogue, case_seed, check_json, run_diagnose_check
 from plansim.cli import main
 from plansim.io.scenario_file import load_scenario
 
@@ -34,12 +35,38 @@ def test_a_small_null_run_and_its_report(tmp_path, capsys):
         run_diagnose_check(load_scenario("linear_gaussian"), null=0)
 
 
+def test_the_effects_outside_the_catalogue_are_what_they_say():
+    """A bias step from the middle sample on; a clock fast by ε reads nominal sample i·(1 + ε); a noise burst on gx
+    over 40–50 % of the run with the stated sd (20 000 samples: the sample sd within 4 %, 5.7 of its standard
+    errors); a name outside the list is refused."""
+    ramp = np.tile(np.arange(1000.0)[:, None], (1, 6))
+    step = _add_out_of_catalogue("bias_step", ramp.copy(), 2.5, 0) - ramp
+    assert np.all(step[:500] == 0) and np.all(step[500:, 0] == 2.5) and np.all(step[:, 1:] == 0)
+    fast = _add_out_of_catalogue("clock_fast", ramp.copy(), 1e-3, 0)
+    assert fast[500, 3] == pytest.approx(500.5) and fast[-1, 0] == 999.0
+    flat = np.zeros((200_000, 6))
+    burst = _add_out_of_catalogue("noise_burst", flat.copy(), 0.3, 7)
+    inside = np.zeros(200_000, dtype=bool)
+    inside[80_000:100_000] = True
+    assert np.all(burst[~inside] == 0) and np.all(burst[:, 1:] == 0)
+    assert np.std(burst[inside, 0]) == pytest.approx(0.3, rel=0.04)
+    with pytest.raises(ValueError, match="clock_slow"):
+        _add_out_of_catalogue("clock_slow", flat, 1.0, 0)
+
+
 @pytest.mark.slow
-def test_at_ten_times_the_effects_are_attributed_and_the_lever_arm_never_is():
-    """One jjf2003 recording per effect at 10x its noise-equivalent size (non-centrality 100: power ≈ 1 for each
-    test): asymmetry, g²-sensitivity and K2 are attributed to themselves; the lever arm (aliased with P) never."""
+def test_at_ten_times_the_effects_are_found_and_the_lever_arm_never_is():
+    """One jjf2003 recording per effect at 10x its noise-equivalent size (non-centrality 100: the power of each
+    candidate's test is ≈ 1 − 10⁻⁹ at α = 5 %): asymmetry, g²-sensitivity and K2 are each among the effects
+    selected; the lever arm (aliased with P) is never selected.
+
+    Exact attribution (the true effect and nothing else) is not asserted: on jjf2003 the procedure's
+    family-wise false-alarm rate is above α (tests/test_diagnose.py, docs/closing-the-loop.md), so further
+    selections besides the true one are expected in a fair share of recordings; the count is what
+    ``plansim diagnose-check`` reports."""
     report = run_diagnose_check(load_scenario("jjf2003"), null=1, per_effect=1, sizes=(10.0,), null_draws=300)
     by = {(e["effect"], e["times_noise_equivalent"]): e for e in report.effects}
     for effect in ("gyro_scale_asymmetry", "gyro_g2_sensitivity", "accel_quadratic"):
-        assert by[(effect, 10.0)]["attribution"] == 1.0, by[(effect, 10.0)]
+        selections = by[(effect, 10.0)]["confusion"]
+        assert selections and all(effect in key.split("+") for key in selections), (effect, selections)
     assert "lever_arm" not in "".join(by[("lever_arm", None)]["confusion"])
