@@ -20,6 +20,7 @@ from plansim.diagnose.scores import score_candidates
 from plansim.fit import fit_recording, resolve_site
 from plansim.io.recording import write_recording
 from plansim.io.scenario_file import load_scenario
+from plansim.model.parameters import PARAMETER_NAMES
 from plansim.runner import simulate_and_record
 from plansim.simulate.chunks import simulate_recording
 
@@ -137,8 +138,41 @@ def test_json_keys_and_the_command(tmp_path, capsys):
     assert {"residual_rms", "chi2_dof", "holdout_rms"} <= set(out["before"])
     assert {"name", "unit", "before", "after", "u_after"} <= set(out["parameters"][0])
     assert out["selected"] == ["gyro_scale_asymmetry"]
-    assert main(["diagnose", str(path), "--scenario", "linear_gaussian", "--null-draws", "200"]) == 0
+    figure = tmp_path / "diag.png"
+    assert main(["diagnose", str(path), "--scenario", "linear_gaussian", "--null-draws", "200",
+                 "--plot", str(figure)]) == 0
     assert "gyro_scale_asymmetry: x = " in capsys.readouterr().out
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(tmp_path.glob(".*.part"))  # nothing half-written left beside it
+    assert main(["diagnose", str(path), "--plot", str(tmp_path / "diag.bmp")]) == 2
+    assert "--plot" in capsys.readouterr().err
+
+
+def test_the_learned_scenario_is_the_world_the_data_showed(tmp_path, capsys):
+    """--learned: the scenario written loads back with the refit's estimates as its truth and their u as its
+    spread (exactly: SI with repr), the asymmetry found as its gyro_asymmetry, the noise from the data and the
+    base scenario's turntable; plansim run simulates it."""
+    scenario = _scenario("linear_gaussian", gyro_asymmetry=np.array([3e-3, 0.0, 0.0]))
+    recording = simulate_and_record(scenario, seed=3, trial=0)
+    path = tmp_path / "rec.nc"
+    write_recording(recording, path)
+    learned = tmp_path / "learned.toml"
+    assert main(["diagnose", str(path), "--scenario", "linear_gaussian", "--null-draws", "200", "--json",
+                 "--learned", str(learned)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    world = load_scenario(str(learned))
+    for p in out["parameters"]:
+        k = PARAMETER_NAMES.index(p["name"])
+        if p["after"] is not None and p["u_after"] is not None:
+            assert world.truth_nominal[k] == p["after"] and world.truth_spread[k] == p["u_after"]
+    found = out["candidates"][[c["effect"] for c in out["candidates"]].index("gyro_scale_asymmetry")]
+    assert world.effects.gyro_asymmetry[0] == found["size"]["x"]
+    assert world.turntable == load_scenario("linear_gaussian").turntable
+    assert world.noise.gyro_angle_random_walk[0] > 0
+    assert "gyro_scale_asymmetry" in world.description
+    assert main(["run", str(learned), "--trials", "2", "--quiet"]) == 0
+    assert main(["diagnose", str(path), "--learned", str(tmp_path / "learned.txt")]) == 2
+    assert "--learned" in capsys.readouterr().err
     assert main(["diagnose", str(path), "--alpha", "1.5"]) == 2
     assert "--alpha 1.5: must be between 0 and 1" in capsys.readouterr().err
     assert main(["diagnose", str(tmp_path / "missing.nc")]) == 2

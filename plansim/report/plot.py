@@ -78,3 +78,70 @@ def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLik
         atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=120))
     finally:
         plt.close(fig)
+
+
+def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = None) -> None:
+    """Residuals of the segment means before and after the refit, per channel, against what effects depend on.
+
+    Top row: against the channel's own reading (a gyro's segment mean is the rate ω it turns at, an
+    accelerometer's the specific force f along it), where a scale asymmetry, a nonlinearity or a K2 term shows
+    as a V, a curve or a parabola. Bottom row: against time, where a drift shows as a slope and a step as a
+    jump. Residuals in °/h and µg (:data:`plansim.report.fit.OUTPUT_UNITS`), the bars ±2u of each segment
+    mean (the fit's V: noise, quantisation, table errors, noise between segments), cut at 1.6 times the
+    largest residual. Open grey: before; filled: after the selected
+    effects (the same points when none is).
+
+    Parameters
+    ----------
+    diagnosis : plansim.diagnose.procedure.Diagnosis
+    path : str or os.PathLike
+        The figure file, written whole or not at all (:func:`plansim.io.files.atomic_write`).
+    format : {"png", "pdf", "svg"}, optional
+        Default: from the suffix of *path*.
+    """
+    from plansim.kernels.layout import CHANNELS
+    from plansim.report.fit import OUTPUT_UNITS
+
+    chosen = figure_format(path, format)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    before, after = diagnosis.before, diagnosis.after
+    times = np.asarray(before.segment_times, dtype=float)
+    reading_units = {"gyro": ("deg/s", np.pi / 180.0), "accel": ("m/s^2", 1.0)}
+    fig, axes = plt.subplots(2, 6, figsize=(19, 6.4), constrained_layout=True)
+    for c, name in enumerate(CHANNELS):
+        kind = "gyro" if c < 3 else "accel"
+        unit, factor = OUTPUT_UNITS[kind]
+        reading_unit, reading_factor = reading_units[kind]
+        rows = np.asarray(before.fitted_rows[:, c], dtype=bool)
+        u = np.sqrt(np.maximum(np.diag(after.covariance), 0.0)).reshape(-1, 6)[:, c] / factor
+        reading = np.asarray(before.observed[:, c], dtype=float) / reading_factor
+        for ax, x, label in ((axes[0, c], reading, f"{name} reading ({reading_unit})"),
+                             (axes[1, c], times, "time (s)")):
+            ax.axhline(0.0, color="0.7", lw=0.8)
+            ax.plot(x[rows], before.residuals[rows, c] / factor, "o", mfc="none", mec="0.55", ms=4,
+                    label="before")
+            ax.errorbar(x[rows], after.residuals[rows, c] / factor, yerr=2.0 * u[rows], fmt="o", ms=3,
+                        color="tab:blue", ecolor="tab:blue", elinewidth=0.6, alpha=0.8, label="after (±2u)")
+            ax.set_xlabel(label, fontsize=8)
+            ax.tick_params(labelsize=7)
+            # the residuals set the scale; a bar far longer (a turn by hand, known only by its angle) is cut
+            spread = np.nanmax(np.abs(np.concatenate([before.residuals[rows, c], after.residuals[rows, c]])),
+                               initial=0.0) / factor
+            if spread > 0:
+                ax.set_ylim(-1.6 * spread, 1.6 * spread)
+        axes[0, c].set_title(name, fontsize=9)
+        axes[0, c].set_ylabel(f"residual ({unit})", fontsize=8)
+        axes[1, c].set_ylabel(f"residual ({unit})", fontsize=8)
+    axes[0, 0].legend(fontsize=7, loc="best")
+    found = ", ".join(diagnosis.selected) if diagnosis.selected else "no catalogue effect"
+    verdict = "unexplained residual remains" if diagnosis.unexplained.get("flagged") else "no lack of fit remains"
+    fig.suptitle(f"plansim diagnose: found {found}; {verdict} (family-wise alpha = {diagnosis.alpha:g})",
+                 fontsize=10)
+    try:
+        atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=110))
+    finally:
+        plt.close(fig)
