@@ -10,8 +10,10 @@ Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simul
   (:attr:`plansim.diagnose.scores.CandidateScore.noise_equivalent_size`), injected through the scenario's
   ``[mimu.effects]`` field so that the simulator makes it (``bias_drift`` has no field: a ramp in time is added to
   the samples). The component is the first one the schedule identifies;
-- **effects outside the catalogue**, added to the simulated samples: a step in the x gyro's bias half-way through
-  the recording, of k × the standard deviation of a segment mean of that channel, and a lever arm of 5 mm on
+- **effects outside the catalogue**, added to the simulated samples (:func:`_add_out_of_catalogue`): a step in
+  the x gyro's bias half-way through the recording, of k × the standard uncertainty of a gx segment mean; a
+  sample clock that runs fast by k × 100 ppm (the segment table, in nominal time, drifts off the data); a burst
+  of extra white noise on gx over a tenth of the run, of k × its noise per sample. And a lever arm of 5 mm on
   the x accelerometer that the fit is not told (aliased with P in JJF 2003: it must never be attributed).
 
 ``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, or
@@ -41,7 +43,9 @@ from plansim.uncertainty.metrology.propagation import coverage_factor
 #: the scenario field of each catalogue effect's components (bias_drift is added to the samples)
 FIELDS = {"gyro_scale_asymmetry": "gyro_asymmetry", "gyro_scale_nonlinearity": None, "gyro_g2_sensitivity":
           "gyro_g2_sensitivity", "accel_quadratic": "accel_second_order", "lever_arm": "accel_lever_arm"}
-OUT_OF_CATALOGUE = ("bias_step", "unknown_lever_arm")
+#: effects outside the catalogue, added to the samples (:func:`_add_out_of_catalogue`); the lever arm the fit is
+#: not told is run with the catalogue effects
+OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst")
 
 
 def case_seed(root: int, case: str, index: int) -> int:
@@ -113,7 +117,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         raise ValueError(f"sizes = {sizes!r}: each must be > 0")
     lever = scenario.effects.accel_lever_arm if scenario.effects.accel_lever_arm.any() else None
     report = CheckReport(scenario.name, alpha)
-    total = null + per_effect * (len(sizes) * 6 + len(sizes) + 1)
+    sized = 5  # the catalogue effects run at each size; the lever arm once
+    total = null + per_effect * (len(sizes) * (sized + len(OUT_OF_CATALOGUE)) + 1)
     done = 0
 
     def tick():
@@ -131,6 +136,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         _, _, truth = simulate_recording(scenario, s, 0)
         d, z = _run(scenario, recording, truth, lever, alpha, null_draws, s)
         reference = reference or d
+        sample_rate = recording.schedule.segments[0].sample_rate
         selections += bool(d.selected)
         alarms += bool(d.selected) or d.lack_of_fit.flagged
         z_before.append(z["before"])
@@ -183,25 +189,67 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 "confusion": counts["selected"], "rms_z_before": float(np.mean(counts["rms_z_before"])),
                 "rms_z_after": float(np.mean(counts["rms_z_after"])),
                 "coverage_after": float(np.mean(counts["coverage_after"]))})
-    # outside the catalogue: a bias step in gx half-way, k × the sd of a segment mean of gx
-    sd = float(np.sqrt(np.median(reference.before.noise.mean_variance[:, 0])))
-    for k in sizes:
-        flagged, named = 0, 0
-        for i in range(per_effect):
-            s = case_seed(seed, f"bias_step/{k}", i)
-            recording = simulate_and_record(scenario, seed=s, trial=0)
-            _, _, truth = simulate_recording(scenario, s, 0)
-            samples = np.array(recording.samples, dtype=float)
-            samples[samples.shape[0] // 2:, 0] += k * sd
-            recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
-            d, _ = _run(scenario, recording, truth, lever, alpha, null_draws, s)
-            flagged += d.unexplained["flagged"] or d.lack_of_fit.flagged
-            named += bool(d.selected)
-            tick()
-        report.out_of_catalogue.append({"effect": "bias_step", "times_sd": k, "size": k * sd, "unit": "rad/s",
-                                        "recordings": per_effect, "flagged_unexplained": flagged / per_effect,
-                                        "named_after_a_candidate": named / per_effect})
+    # outside the catalogue, each added to the simulated samples of the null scenario (module docstring)
+    u_mean = float(np.median(np.sqrt(np.diag(reference.before.covariance)).reshape(-1, 6)[:, 0]))
+    white = reference.before.noise.channels[0].white
+    sigma_sample = float(white * math.sqrt(sample_rate)) if math.isfinite(white) else u_mean
+    for effect in OUT_OF_CATALOGUE:
+        for k in sizes:
+            size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample)
+            flagged, named = 0, 0
+            for i in range(per_effect):
+                s = case_seed(seed, f"{effect}/{k}", i)
+                recording = simulate_and_record(scenario, seed=s, trial=0)
+                _, _, truth = simulate_recording(scenario, s, 0)
+                samples = _add_out_of_catalogue(effect, np.array(recording.samples, dtype=float), size, s)
+                recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
+                d, _ = _run(scenario, recording, truth, lever, alpha, null_draws, s)
+                flagged += d.unexplained["flagged"] or d.lack_of_fit.flagged
+                named += bool(d.selected)
+                tick()
+            report.out_of_catalogue.append({"effect": effect, "times": k, "scale": scale, "size": size,
+                                            "unit": unit, "recordings": per_effect,
+                                            "flagged_unexplained": flagged / per_effect,
+                                            "named_after_a_candidate": named / per_effect})
     return report
+
+
+#: the relative error of a sample clock that runs fast, per unit of k (k = 5: 500 ppm)
+CLOCK_ERROR_PER_K = 1e-4
+
+
+def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: float) -> tuple[float, str, str]:
+    """(size, unit, what k multiplies) of an out-of-catalogue effect at multiple *k*."""
+    if effect == "bias_step":
+        return k * u_mean, "rad/s", "the standard uncertainty of a gx segment mean (the fit's V)"
+    if effect == "clock_fast":
+        return k * CLOCK_ERROR_PER_K, "1", f"{CLOCK_ERROR_PER_K:g} of relative clock error"
+    if effect == "noise_burst":
+        return k * sigma_sample, "rad/s", "the gx noise per sample"
+    raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
+
+
+def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: int) -> np.ndarray:
+    """The samples (n, 6) with an out-of-catalogue effect of *size* (:func:`_out_of_catalogue_size`) added.
+
+    ``bias_step``: gx + size from the middle sample on. ``clock_fast``: the sensor's clock runs fast by the
+    relative error *size*, so sample i holds the signal of nominal sample i·(1 + size) (linear interpolation;
+    the segment table, in nominal time, drifts off the data by up to size × the run). ``noise_burst``: white
+    noise of sd *size* added to gx over a tenth of the run, from 40 % of it.
+    """
+    n = samples.shape[0]
+    if effect == "bias_step":
+        samples[n // 2:, 0] += size
+    elif effect == "clock_fast":
+        index = np.arange(n, dtype=float)
+        where = np.minimum(index * (1.0 + size), n - 1.0)
+        samples = np.column_stack([np.interp(where, index, samples[:, c]) for c in range(samples.shape[1])])
+    elif effect == "noise_burst":
+        start, stop = int(0.4 * n), int(0.5 * n)
+        samples[start:stop, 0] += size * np.random.default_rng(seed).standard_normal(stop - start)
+    else:
+        raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
+    return samples
 
 
 def check_json(report: CheckReport) -> dict:
