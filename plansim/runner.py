@@ -342,6 +342,7 @@ def results_dataset(sc: Scenario, truth: np.ndarray, estimate: np.ndarray, seed:
         "scenario": sc.name,
         "scenario_description": sc.description,
         "scenario_source": sc.source or "a Scenario object built in Python",
+        "scenario_overrides": "; ".join(sc.overrides),
         "scenario_toml": tomli_w.dumps(sc.document),
         # NetCDF-3 attributes hold 32-bit integers only: larger seeds are kept as text
         "seed": int(seed) if int(seed) <= 2**31 - 1 else str(int(seed)),

@@ -77,3 +77,11 @@ COMMANDS = {
     "diagnose-check": "check diagnose blind on simulated recordings",
     "bench": "measure speed and memory on this machine",
 }
+
+
+def add_set_option(p) -> None:
+    """``--set KEY=VALUE`` (repeatable): a scenario field overridden, checked exactly as the file is
+    (:func:`plansim.io.scenario_file.apply_overrides`)."""
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario field, e.g. --set schedule.dwell=\"60 s\" --set schedule.positions=6 "
+                        "(dotted key as in the scenario file; repeatable; checked as the file is)")

@@ -6,7 +6,7 @@ import json
 import os
 import time
 
-from plansim.cli.common import COMMANDS
+from plansim.cli.common import COMMANDS, add_set_option
 from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
 from plansim.report.progress import end_progress_line
@@ -27,7 +27,7 @@ def _cmd_run(args) -> int:
         check_output_path(args.out, "--out", (".nc",))
     if args.plot is not None:
         check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(args.scenario, args.set)
     saturation = saturation_report(scenario)  # empty unless acquisition.allow_saturation let it load
     trials = scenario.trials if args.trials is None else args.trials
     if trials < 1:
@@ -63,7 +63,8 @@ def _cmd_run(args) -> int:
 
     if args.json:
         print(json.dumps({
-            "scenario": scenario.name, "seed": results.attrs["seed"], "trials": trials,
+            "scenario": scenario.name, "overrides": list(scenario.overrides), "seed": results.attrs["seed"],
+            "trials": trials,
             "plansim_version": results.attrs["plansim_version"], "elapsed_s": elapsed,
             "parameters": [{k: r[k] for k in ("name", "unit", "mean_error", "std_error")}
                            for r in parameter_summary(results)],
@@ -112,7 +113,7 @@ def _cmd_record(args) -> int:
     target = check_output_path(args.out, "--out", (".nc", ".csv"))
     if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
         check_output_path(segment_table_path(target), "--out's segment table")
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(args.scenario, args.set)
     seed = scenario.seed if args.seed is None else args.seed
     rec = simulate_and_record(scenario, seed=seed, trial=args.trial)
     write_recording(rec, args.out)
@@ -129,7 +130,7 @@ def _cmd_validate(args) -> int:
     from plansim.report.validation import format_report, stderr_block_progress, validation_json
     from plansim.runner import validate
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(args.scenario, args.set)
     claims = load_claims(args.claims, scenario) if args.claims else None
     for option, value, minimum in (("--trials-per-block", args.trials_per_block, 2),
                                    ("--max-trials", args.max_trials, 1), ("--digits", args.digits, 1)):
@@ -149,8 +150,10 @@ def _cmd_validate(args) -> int:
                       max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
     end_progress_line()
     if args.json:
-        print(json.dumps(validation_json(report), indent=2))
+        print(json.dumps({**validation_json(report), "overrides": list(scenario.overrides)}, indent=2))
     else:
+        if scenario.overrides:
+            print(f"Overrides (--set): {'; '.join(scenario.overrides)}")
         print(format_report(report, details=not args.summary))
     return 0
 
@@ -165,6 +168,7 @@ def _add_validate_command(sub) -> None:
                     "checks a claimed budget (default: JJF 2003 Appendix A)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+    add_set_option(p)
     p.add_argument("--claims", default=None,
                    help="TOML file of claimed expanded uncertainties ([items.\"A.2\"] U = ...; [parameters.Bgx] "
                         "U = \"10 deg/h\"; k = 2 by default); default: the Appendix A budgets as printed")
@@ -190,6 +194,7 @@ def add_commands(sub) -> None:
                        description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+    add_set_option(p)
     p.add_argument("--trials", type=int, default=None,
                    help="number of simulated calibrations (default: the scenario's)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's)")
@@ -212,6 +217,7 @@ def add_commands(sub) -> None:
     p = sub.add_parser("record", help=COMMANDS["record"],
                        description="Write one simulated trial's raw samples as a recording (NetCDF or CSV)")
     p.add_argument("scenario", nargs="?", default="jjf2003")
+    add_set_option(p)
     p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
     p.add_argument("--seed", type=int, default=None)
     p.add_argument("--trial", type=int, default=0, help="which trial of the seed's Monte Carlo to record")

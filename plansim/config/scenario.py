@@ -169,6 +169,7 @@ class Scenario:
     reduction: Reduction
     document: dict = field(repr=False, default_factory=dict)  # the parsed TOML, for provenance and saving
     source: str = ""
+    overrides: tuple[str, ...] = ()  # the KEY=VALUE overrides set in the document (plansim run --set)
 
 
 # ----------------------------------------------------------------------------- parsing helpers

@@ -10,6 +10,7 @@ file. docs/scenario-file.md explains every field.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import os
 import tomllib
 from importlib import resources
@@ -29,7 +30,64 @@ def builtin_scenarios() -> dict[str, Path]:
             if p.name.endswith(".toml")}
 
 
-def load_scenario(name_or_path: str | os.PathLike = "jjf2003") -> Scenario:
+def parse_override(text: str) -> tuple[tuple[str, ...], object]:
+    """``"schedule.dwell=60 s"`` -> (("schedule", "dwell"), "60 s"): a dotted key and a value.
+
+    The value is read as a TOML value where it is one (``6``, ``true``, ``["5 deg/s", "10 deg/s"]``,
+    ``"60 s"`` with its quotes) and as text otherwise (``60 s``: the quotes a shell takes away).
+
+    Raises
+    ------
+    ValueError
+        No ``=``, an empty key or a key part that is empty.
+    """
+    if not isinstance(text, str):
+        raise TypeError(f"override {text!r}: expected text KEY=VALUE, got {type(text).__name__}")
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    parts = tuple(part.strip() for part in key.split("."))
+    if not sep or not key or any(not part for part in parts):
+        raise ValueError(f"override {text!r}: expected KEY=VALUE with a dotted scenario key, e.g. "
+                         "schedule.dwell=\"60 s\" or schedule.positions=6")
+    raw = raw.strip()
+    try:
+        value = tomllib.loads(f"value = {raw}")["value"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return parts, value
+
+
+def apply_overrides(document: dict, overrides) -> dict:
+    """A copy of a scenario *document* with each override (``KEY=VALUE``, :func:`parse_override`) set.
+
+    Tables on the way are created where the document has none (``mimu.effects`` in a scenario without
+    effects); the result is checked by :func:`plansim.config.parse_scenario` exactly as a file is, so an
+    unknown key or a bad value is refused with the field named.
+
+    Raises
+    ------
+    ValueError
+        An override that is not KEY=VALUE, or whose key runs through a value that is not a table
+        (``schedule.dwell.x``) or replaces a whole table with a value (``schedule=6``).
+    """
+    document = copy.deepcopy(document)
+    for text in overrides:
+        parts, value = parse_override(text)
+        table = document
+        for depth, part in enumerate(parts[:-1]):
+            child = table.setdefault(part, {})
+            if not isinstance(child, dict):
+                raise ValueError(f"override {text!r}: {'.'.join(parts[:depth + 1])} is a value "
+                                 f"({child!r}), not a table with keys")
+            table = child
+        if isinstance(table.get(parts[-1]), dict) and not isinstance(value, dict):
+            raise ValueError(f"override {text!r}: {'.'.join(parts)} is a table; set one of its keys "
+                             f"({', '.join(sorted(table[parts[-1]]))})")
+        table[parts[-1]] = value
+    return document
+
+
+def load_scenario(name_or_path: str | os.PathLike = "jjf2003", overrides=()) -> Scenario:
     """Load a built-in scenario by name, or a TOML file by path.
 
     The scenario's name: a built-in one's is its own; a file's is the document's ``name`` key, else
@@ -45,11 +103,28 @@ def load_scenario(name_or_path: str | os.PathLike = "jjf2003") -> Scenario:
         No such file or built-in; the file is a folder, cannot be read, is not UTF-8 text (binary
         data, UTF-16), is empty or holds only comments, is not valid TOML, or fails
         :func:`plansim.config.parse_scenario`. The message names the file.
+
+    *overrides* (``KEY=VALUE`` texts, as ``--set`` gives them: :func:`apply_overrides`) are set in the
+    document before it is parsed; :attr:`Scenario.overrides` and :attr:`Scenario.source` say so.
     """
+    overrides = (overrides,) if isinstance(overrides, str) else tuple(overrides)
+    if not overrides:
+        return _load_scenario(name_or_path, overrides)
+    said = ", ".join(overrides)
+    try:
+        scenario = _load_scenario(name_or_path, overrides)
+    except (ValueError, TypeError) as error:
+        if str(error).startswith("override "):
+            raise
+        raise type(error)(f"{error} (scenario {str(name_or_path)!r} with {said})") from error
+    return dataclasses.replace(scenario, overrides=overrides, source=f"{scenario.source}, with {said}")
+
+
+def _load_scenario(name_or_path, overrides) -> Scenario:
     text_name = str(name_or_path)
     builtin = builtin_scenarios()
     if text_name in builtin:
-        document = _read_document(builtin[text_name])
+        document = apply_overrides(_read_document(builtin[text_name]), overrides)
         return parse_scenario(document, name=text_name, source=f"built-in scenario {text_name!r}")
     path = Path(text_name)
     if path.is_dir():
@@ -57,7 +132,7 @@ def load_scenario(name_or_path: str | os.PathLike = "jjf2003") -> Scenario:
     if not path.is_file():
         raise ValueError(f"scenario {text_name!r}: no such file and no built-in scenario of that name; "
                          f"built-in: {', '.join(builtin)}")
-    document = _read_document(path)
+    document = apply_overrides(_read_document(path), overrides)
     source = f"file {str(path)!r}"
     named = document.get("name")
     if isinstance(named, str) and named in builtin and not _same_file(path, builtin[named]):

@@ -15,8 +15,9 @@ def _g(x: float, digits: int = 4) -> str:
 def header(results: xr.Dataset, elapsed: float | None = None) -> str:
     a = results.attrs
     when = f" in {elapsed:.1f} s" if elapsed is not None else ""
+    overrides = f"Overrides (--set): {a['scenario_overrides']}\n" if a.get("scenario_overrides") else ""
     return (f"plansim {a['plansim_version']} — scenario {a['scenario']!r}: {a['trials']} trials, seed {a['seed']}, "
-            f"{a['simulation_path']} path{when}\n{a['scenario_description']}\n"
+            f"{a['simulation_path']} path{when}\n{a['scenario_description']}\n{overrides}"
             f"Reduction uses 1 g = {a['reference_gravity_m_s2']:.7f} m/s² ({a['reference_gravity_choice']}); "
             f"local gravity {a['local_gravity_m_s2']:.7f} m/s² at latitude {a['latitude_deg']:.4g}°")
 
