@@ -19,9 +19,10 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 _PUBLIC = {"run": "plansim.runner", "Scenario": "plansim.config", "parse_scenario": "plansim.config",
            "builtin_scenarios": "plansim.io.scenario_file", "load_scenario": "plansim.io.scenario_file",
-           "save_scenario": "plansim.io.scenario_file", "simulate_and_record": "plansim.runner"}
+           "save_scenario": "plansim.io.scenario_file", "simulate_and_record": "plansim.runner",
+           "predict": "plansim.planning.predict"}
 
-__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "parse_scenario", "run", "save_scenario",
+__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "parse_scenario", "predict", "run", "save_scenario",
            "simulate_and_record", "__version__"]
 
 

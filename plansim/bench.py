@@ -14,7 +14,9 @@ Figures (all per second of wall time, thread count reported):
   (the issue's acceptance: under 1 GB), and ``peak_rss_mb`` of one running :func:`plansim.run`
   with 10⁶ trials (every trial's truth, estimate and error kept: 0.94 GB of arrays);
 - cold start (first ``plansim run`` with an empty kernel cache: compiling) and warm start, both
-  for 10⁴ trials, as separate processes.
+  for 10⁴ trials, as separate processes;
+- ``predict_seconds`` — one :func:`plansim.planning.predict.predict` of the default scenario (the GUM of
+  its schedule), the planner's inner step.
 
 Method. The speed of these 2-core machines varies by up to 2× between identical runs (other
 work on the same host), so each throughput is the best of several rounds: the best round is the
@@ -141,6 +143,16 @@ def start_times(trials: int = 10_000) -> tuple[float, float]:
     return cold, warm
 
 
+def predict_seconds() -> float:
+    """Best-of-rounds time of one prediction (GUM of the default schedule), s."""
+    from plansim.io.scenario_file import load_scenario
+    from plansim.planning.predict import predict
+
+    scenario = load_scenario(SCENARIO)
+    predict(scenario)  # the first call imports and builds what later calls reuse
+    return _best_of(lambda: predict(scenario))
+
+
 def measure(quick: bool = False) -> dict:
     """Every figure in one run. *quick* shrinks the sizes (for CI correctness runs), not the method."""
     scale = 100 if quick else 1
@@ -150,6 +162,7 @@ def measure(quick: bool = False) -> dict:
     summary_rss, summary_seconds = summary_peak_rss_mb(1_000_000 // scale)
     rss, big_seconds = peak_rss_mb(1_000_000 // scale)
     cold, warm = start_times(10_000 // scale)
+    prediction = predict_seconds()
     counts = sorted(per_trial, key=int)
     return {
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_implementation()} "
@@ -172,6 +185,7 @@ def measure(quick: bool = False) -> dict:
         "cold_start_s": cold,
         "warm_start_s": warm,
         "start_trials": 10_000 // scale,
+        "predict_seconds": prediction,
     }
 
 
@@ -191,7 +205,8 @@ def format_figures(f: dict) -> str:
               f"  {f['million_trials']:,} trials, every trial kept (plansim.run): {f['million_trials_seconds']:.1f} s "
               f"in a new process, peak RSS {f['peak_rss_mb']:,.0f} MB",
               f"  plansim run, {f['start_trials']:,} trials: cold start {f['cold_start_s']:.1f} s (compiling), "
-              f"warm {f['warm_start_s']:.1f} s"]
+              f"warm {f['warm_start_s']:.1f} s",
+              f"  plansim.predict (GUM of the default schedule) {f['predict_seconds'] * 1e3:8.1f} ms"]
     return "\n".join(lines)
 
 
