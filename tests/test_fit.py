@@ -465,6 +465,21 @@ def test_the_quantisation_error_given_the_levels_is_calibrated(ratio):
     assert dither_for_error(q, e) == pytest.approx(0.2 * q, rel=1e-3)
 
 
+def test_segments_over_many_levels_are_dithered_by_their_own_scatter():
+    """A segment over more than MAX_LEVELS levels (σ = 3q, or a turn caught at a static segment's edge) takes
+    its scatter less q²/12 as its dither, at once: its conditional error is the unconditional one at that σ, and
+    alone it makes the channel's σ the top of the grid."""
+    rng = np.random.default_rng(2)
+    q = 1.0
+    wide = np.round(0.3 + 3.0 * rng.standard_normal(20_000))
+    sheppard = math.sqrt(np.var(wide, ddof=1) - q**2 / 12)
+    assert quantisation_error_given_levels(q, wide, 0.0) == pytest.approx(
+        float(quantisation_error_variance(q, sheppard)), rel=1e-12)
+    assert quantised_noise_sigma(q, [wide]) == pytest.approx(2.0 * q)
+    ramp = np.round(np.linspace(0.0, 400.0, 3000))  # a turn's edge: hundreds of levels
+    assert quantisation_error_given_levels(q, ramp, 0.05) < 1e-12
+
+
 def test_the_noise_before_a_quantiser_it_does_not_dither():
     """Segments that never leave their level say only that σ is small: 0 is returned (the quantiser taken as not
     dithered, its error at its largest, q²/12); no step, no segments: 0."""

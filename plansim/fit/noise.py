@@ -245,6 +245,9 @@ SIGMA_GRID = np.geomspace(0.02, 2.0, 81)
 LEVEL_GRID = np.linspace(-1.0, 1.0, 401)
 #: log-likelihood below its maximum still taken as consistent with the data (a 1-parameter 62 % interval's edge)
 LIKELIHOOD_MARGIN = 0.5
+#: a segment whose samples fall on more levels than this is dithered by its own scatter: the level-by-level
+#: likelihood is not needed (and grows with the levels: a turn caught at a segment's edge spans hundreds)
+MAX_LEVELS = 12
 
 
 def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
@@ -275,6 +278,11 @@ def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
     tables = [_level_table(values, step) for values in segments if np.asarray(values).size >= 2]
     if not tables or all(t[0].size == 1 for t in tables):
         return 0.0
+    # a segment over more than MAX_LEVELS levels is dithered beyond the grid (or not static at all: a turn
+    # caught at its edge, a hand's tremor); it says nothing about a σ below q and would only cost time
+    tables = [t for t in tables if t[0].size <= MAX_LEVELS]
+    if not tables:
+        return float(SIGMA_GRID[-1] * step)
     width = max(t[0].size for t in tables)
     levels = np.zeros((len(tables), width))
     counts = np.zeros((len(tables), width))
@@ -325,6 +333,9 @@ def quantisation_error_given_levels(step: float, values, sigma: float) -> float:
     if step <= 0:
         return 0.0
     levels, counts, mean = _level_table(values, step)
+    if levels.size > MAX_LEVELS:  # spread over many levels: dithered by its own scatter (Sheppard)
+        own = math.sqrt(max(float(np.var(np.asarray(values, dtype=float), ddof=1)) - step**2 / 12.0, 0.0))
+        return float(quantisation_error_variance(step, max(own, sigma)))
     r = max(sigma / step, float(SIGMA_GRID[0]))
     m = mean + POSTERIOR_GRID[None, :]
     log_l = _log_likelihood(levels[None, :], counts[None, :], m, r)[0]
