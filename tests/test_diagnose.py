@@ -122,6 +122,24 @@ def test_false_alarms_over_many_null_recordings():
     assert selections <= binom.ppf(0.99, 30, 0.05)
 
 
+def test_a_refit_never_adds_components_that_together_alias_a_parameter():
+    """The three g²-sensitivities of one gyro sum to g²·(a bias) in every static pose (f_x² + f_y² + f_z² = g²):
+    each survives the base model alone, but only two of them add rank beside Bg; a fourth lever arm or a second
+    copy of a column adds none."""
+    from plansim.diagnose.procedure import _adds_rank
+
+    scenario = load_scenario("linear_gaussian")
+    fit = fit_recording(simulate_and_record(scenario, seed=4, trial=0), resolve_site(scenario=scenario),
+                        scenario.turntable)
+    g2 = {s.effect: s for s in signatures(fit)}["gyro_g2_sensitivity"]
+    kept = []
+    for j, component in enumerate(g2.components[:3]):  # gyro x against f_x², f_y², f_z²
+        if _adds_rank(fit, kept, g2.columns[:, :, j]):
+            kept.append(g2.columns[:, :, j])
+    assert len(kept) == 2
+    assert not _adds_rank(fit, kept, kept[0])
+
+
 def test_json_keys_and_the_command(tmp_path, capsys):
     scenario = _scenario("linear_gaussian", gyro_asymmetry=np.array([3e-3, 0.0, 0.0]))
     recording = simulate_and_record(scenario, seed=3, trial=0)

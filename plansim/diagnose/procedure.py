@@ -140,6 +140,28 @@ def _holdout_score(rms: dict, reference: dict) -> float:
     return float(np.sum(ratios)) if ratios else math.inf
 
 
+def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
+    """Whether *column* (S, 6) is outside the span of the fit's design and the *columns* already added, on the
+    fitted rows (each column scaled to unit norm; singular values below RANK_TOLERANCE of the largest are zero).
+
+    Each component of a candidate survives the base model on its own, but together they can alias a parameter:
+    the three g²-sensitivities of one gyro add up to g²·(a bias) in every static pose (f_x² + f_y² + f_z² = g²),
+    and refitted together they took Bg's place (its u came out at 1e-11 rad/s beside an error of 7e-3)."""
+    from plansim.fit.identify import RANK_TOLERANCE
+
+    rows = np.asarray(fit.rows)
+
+    def rank(matrix):
+        m = matrix[rows]
+        norms = np.linalg.norm(m, axis=0)
+        m = m[:, norms > 0] / norms[norms > 0]
+        singular = np.linalg.svd(m, compute_uv=False)
+        return int(np.sum(singular > RANK_TOLERANCE * singular[0])) if singular.size else 0
+
+    stack = np.hstack([np.asarray(fit.design)] + [np.asarray(c, dtype=float).reshape(-1, 1) for c in columns])
+    return rank(np.hstack([stack, np.asarray(column, dtype=float).reshape(-1, 1)])) > rank(stack)
+
+
 def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed: int = 0,
              null_draws: int = NULL_DRAWS, lever_arm=None, reference_gravity=None, omega_squared_sign: str = "model",
              turntable_source: str = "") -> Diagnosis:
@@ -201,7 +223,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
             signature = by_effect[candidate.effect]
             trial = dict(extra)
             for j, component in enumerate(signature.components):
-                if candidate.usable[j]:
+                if candidate.usable[j] and _adds_rank(current, list(trial.values()), signature.columns[:, :, j]):
                     trial[f"{candidate.effect}[{component}]"] = signature.columns[:, :, j]
             refit = fit_recording(recording, **options, extra=trial)
             score = _holdout_score(holdout(refit)["rms"], reference) if len(open_) > 1 else 0.0
