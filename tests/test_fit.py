@@ -12,6 +12,7 @@ import dataclasses
 import functools
 import json
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -478,6 +479,19 @@ def test_segments_over_many_levels_are_dithered_by_their_own_scatter():
     assert quantised_noise_sigma(q, [wide]) == pytest.approx(2.0 * q)
     ramp = np.round(np.linspace(0.0, 400.0, 3000))  # a turn's edge: hundreds of levels
     assert quantisation_error_given_levels(q, ramp, 0.05) < 1e-12
+
+
+def test_a_segment_spanning_more_steps_than_an_integer_holds_takes_its_own_scatter_quietly():
+    """A step found far below a segment's spread (1e-25 against a unit-sized ramp) once cast overflowing
+    step counts to int64 (numpy's 'invalid value encountered in cast'); such a segment has no level table, is
+    dithered by its own scatter, and a NaN step is no step."""
+    ramp = np.linspace(0.0, 1.0, 100)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert quantised_noise_sigma(1e-25, [ramp]) == 0.0
+        assert quantisation_error_given_levels(1e-25, ramp, 0.0) == 0.0
+    assert quantised_noise_sigma(float("nan"), [ramp]) == 0.0
+    assert quantisation_error_given_levels(float("nan"), ramp, 0.0) == 0.0
 
 
 def test_the_noise_before_a_quantiser_it_does_not_dither():

@@ -273,9 +273,10 @@ def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
     Returns 0.0 when no segment leaves its level (σ ≪ q: the quantiser is not dithered at all) and the
     largest grid value times q when σ ≥ 2q (the dither is then complete and the exact value no longer matters).
     """
-    if step <= 0 or not segments:
+    if not step > 0 or not segments:  # also NaN
         return 0.0
     tables = [_level_table(values, step) for values in segments if np.asarray(values).size >= 2]
+    tables = [t for t in tables if t is not None]
     if not tables or all(t[0].size == 1 for t in tables):
         return 0.0
     # a segment over more than MAX_LEVELS levels is dithered beyond the grid (or not static at all: a turn
@@ -295,10 +296,19 @@ def quantised_noise_sigma(step: float, segments: list[np.ndarray]) -> float:
     return float(SIGMA_GRID[np.flatnonzero(totals >= totals.max() - LIKELIHOOD_MARGIN)[0]] * step)
 
 
-def _level_table(values, step: float) -> tuple[np.ndarray, np.ndarray, float]:
-    """(levels, counts, mean) of a segment's samples in whole steps from its first sample."""
+#: a segment spanning more steps than this (or holding a non-finite sample) has no level table: its steps
+#: would not fit an integer, and it is spread over far more than :data:`MAX_LEVELS` levels anyway
+MAX_SPAN_STEPS = 2.0**40
+
+
+def _level_table(values, step: float) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """(levels, counts, mean) of a segment's samples in whole steps from its first sample; None when the
+    segment spans more than :data:`MAX_SPAN_STEPS` steps or holds a non-finite sample."""
     values = np.asarray(values, dtype=float)
-    j = np.rint((values - values[0]) / step).astype(np.int64)
+    steps = (values - values[0]) / step
+    if not np.all(np.isfinite(steps)) or np.max(np.abs(steps)) > MAX_SPAN_STEPS:
+        return None
+    j = np.rint(steps).astype(np.int64)
     levels, counts = np.unique(j, return_counts=True)
     return levels.astype(float), counts.astype(float), float(np.mean(j))
 
@@ -330,12 +340,13 @@ def quantisation_error_given_levels(step: float, values, sigma: float) -> float:
     places μ near the edge to within about σ/√n, and its mean is nearly exact. The average over segments is the
     unconditional Σ_k b_k²/2 (:func:`quantisation_error_variance`); per segment, this is what the data say.
     """
-    if step <= 0:
+    if not step > 0:  # also NaN
         return 0.0
-    levels, counts, mean = _level_table(values, step)
-    if levels.size > MAX_LEVELS:  # spread over many levels: dithered by its own scatter (Sheppard)
+    table = _level_table(values, step)
+    if table is None or table[0].size > MAX_LEVELS:  # spread over many levels: dithered by its own scatter (Sheppard)
         own = math.sqrt(max(float(np.var(np.asarray(values, dtype=float), ddof=1)) - step**2 / 12.0, 0.0))
         return float(quantisation_error_variance(step, max(own, sigma)))
+    levels, counts, mean = table
     r = max(sigma / step, float(SIGMA_GRID[0]))
     m = mean + POSTERIOR_GRID[None, :]
     log_l = _log_likelihood(levels[None, :], counts[None, :], m, r)[0]
