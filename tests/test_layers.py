@@ -44,6 +44,18 @@ def test_the_contract_names_every_top_level_module():
     assert modules == named, f"not in the contract: {sorted(modules - named)}; gone: {sorted(named - modules)}"
 
 
+def test_the_distribution_ships_every_package():
+    """pyproject's package list is every folder of plansim/ with an __init__.py, and the scenarios: a
+    package left out is missing from a wheel (``pip install .``), not from the editable install the
+    tests run on (plansim.cli was, so the installed ``plansim`` command could not start)."""
+    with open(ROOT / "pyproject.toml", "rb") as fh:
+        listed = set(tomllib.load(fh)["tool"]["setuptools"]["packages"])
+    found = {".".join(p.parent.relative_to(ROOT).parts) for p in PACKAGE.rglob("__init__.py")}
+    assert listed == found | {"plansim.scenarios"}, (
+        f"missing from [tool.setuptools] packages: {sorted(found - listed)}; "
+        f"listed but absent: {sorted(listed - found - {'plansim.scenarios'})}")
+
+
 def _imports(path: Path) -> set[str]:
     tree = ast.parse(path.read_text(encoding="utf-8"))
     found = set()
