@@ -1,4 +1,5 @@
-"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``import``, ``fit``, ``bench``.
+"""Command line: ``plansim run``, ``validate``, ``scenarios``, ``record``, ``import``, ``fit``, ``diagnose``,
+``diagnose-check``, ``sweep``, ``bench``.
 
 Errors in the user's input end with ``plansim: error: …`` and exit status 2, before any work starts:
 output paths are checked first (:func:`plansim.io.files.check_output_path`). The output files of one
@@ -19,7 +20,7 @@ import signal
 import sys
 
 import plansim
-from plansim.cli import bench_command, checks, diagnose, measured, simulation
+from plansim.cli import bench_command, checks, diagnose, measured, planning, simulation
 from plansim.cli.common import (
     COMMANDS,
     EXIT_BAD_INPUT,
@@ -53,7 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Monte Carlo calibration planning for MEMS IMUs under JJF 2003-2022.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {plansim.__version__}")
     sub = parser.add_subparsers(dest="command", required=True, title="commands", metavar="COMMAND")
-    for module in (simulation, measured, diagnose, checks, bench_command):
+    for module in (simulation, measured, diagnose, checks, planning, bench_command):
         module.add_commands(sub)
     return parser
 

@@ -75,6 +75,7 @@ COMMANDS = {
     "fit": "fit a recording: parameters, noise, uncertainty",
     "diagnose": "find the effect a recording's fit lacks",
     "diagnose-check": "check diagnose blind on simulated recordings",
+    "sweep": "compare schedules over a grid of scenario fields",
     "bench": "measure speed and memory on this machine",
 }
 

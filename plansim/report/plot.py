@@ -145,3 +145,73 @@ def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = No
         atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=110))
     finally:
         plt.close(fig)
+
+
+def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> None:
+    """Uncertainty against table time, one panel per parameter group, the Pareto front marked.
+
+    Each point is a cell of the sweep: its ``table_time_s`` (minutes) and ``u_group`` (the largest
+    standard uncertainty of the group's parameters, in the group's display unit). Filled: the schedule
+    follows JJF 2003 §7.2 (``compliant_jjf2003``); open: it does not. The Pareto front (``pareto``: no
+    other cell is as short and as good, and better in one) is joined by a line, and its cells are
+    labelled with their coordinates. With a Monte Carlo, grey bars are ±1 standard error of each u_mc
+    (u/√(2(n−1)), n trials): where the group's u hardly changes across the grid, the front follows that
+    scatter and says nothing.
+
+    Parameters
+    ----------
+    sweep : xarray.Dataset
+        The output of :func:`plansim.planning.sweep.sweep` (or its NetCDF file, opened).
+    path : str or os.PathLike
+        The figure file, written whole or not at all (:func:`plansim.io.files.atomic_write`).
+    format : {"png", "pdf", "svg"}, optional
+        Default: from the suffix of *path*.
+    """
+    from plansim.model.parameters import PARAMETERS
+
+    chosen = figure_format(path, format)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    grid_dims = [d for d in sweep["table_time_s"].dims]
+    stacked = sweep[["table_time_s", "u_group", "pareto", "compliant_jjf2003"]].stack(cell=grid_dims) \
+        if grid_dims else sweep.expand_dims(cell=[0])
+    minutes = stacked["table_time_s"].values / 60.0
+    compliant = stacked["compliant_jjf2003"].values.astype(bool)
+    labels = []
+    for k in range(stacked.sizes["cell"]):
+        labels.append(", ".join(f"{d.split('.')[-1]}={stacked[d].values[k]}" for d in grid_dims))
+    labels = [label.replace("positions=", "pos=") for label in labels]
+    groups = [str(g) for g in sweep["group"].values]
+    trials = int(sweep.attrs.get("trials_per_cell", 0))
+    display = {}
+    for p in PARAMETERS:
+        display.setdefault(p.group, (p.display_unit, p.display_factor))
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5), constrained_layout=True)
+    for ax, group in zip(axes.ravel(), groups):
+        unit, factor = display[group]
+        u = stacked["u_group"].sel(group=group).values / factor
+        front = stacked["pareto"].sel(group=group).values.astype(bool)
+        if trials > 1:  # the Monte Carlo's own scatter: the standard error of a standard deviation, u/√(2(n−1))
+            ax.errorbar(minutes, u, yerr=u / np.sqrt(2.0 * (trials - 1)), fmt="none", ecolor="0.6", elinewidth=0.8)
+        ax.plot(minutes[compliant], u[compliant], "o", color="tab:blue", ms=5, label="JJF 2003 §7.2 compliant")
+        ax.plot(minutes[~compliant], u[~compliant], "o", mfc="none", mec="tab:blue", ms=5, label="not compliant")
+        order = np.argsort(minutes[front])
+        ax.plot(minutes[front][order], u[front][order], "-", color="tab:red", lw=1.2, label="Pareto front")
+        ax.plot(minutes[front], u[front], "s", mfc="none", mec="tab:red", ms=8)
+        for x, y, text in zip(minutes[front], u[front], np.array(labels, dtype=object)[front]):
+            ax.annotate(text, (x, y), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        ax.set_title(f"{group}: largest {'u_mc' if 'u_mc' in sweep else 'u_predicted'} of the group", fontsize=9)
+        ax.set_xlabel("table time (min)", fontsize=8)
+        ax.set_ylabel(f"u ({unit})", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0, 0].legend(fontsize=7, loc="best")
+    fig.suptitle(f"plansim sweep of {sweep.attrs.get('scenario', '?')}: "
+                 + (f"{trials} Monte Carlo trials per cell" if trials > 1 else "the prediction (GUM) only"),
+                 fontsize=10)
+    try:
+        atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=110))
+    finally:
+        plt.close(fig)

@@ -37,8 +37,8 @@ def end_progress_line() -> None:
         mark_progress_line(False)
 
 
-def stderr_progress(label: str = "simulating") -> ProgressCallback:
-    """A progress line on stderr, redrawn in place: trials done / total, rate, time left."""
+def stderr_progress(label: str = "simulating", unit: str = "trials") -> ProgressCallback:
+    """A progress line on stderr, redrawn in place: *unit* (trials, cells) done / total, rate, time left."""
     start = time.perf_counter()
 
     def report(done: int, total: int) -> None:
@@ -46,7 +46,8 @@ def stderr_progress(label: str = "simulating") -> ProgressCallback:
         rate = done / elapsed if elapsed > 0 else float("nan")
         left = (total - done) / rate if rate > 0 else float("nan")
         end = "\n" if done >= total else ""
-        sys.stderr.write(f"\r{label}: {done}/{total} trials ({rate:,.0f}/s, {left:4.0f} s left)   {end}")
+        shown = f"{rate:,.0f}" if rate >= 10 else f"{rate:.1f}"
+        sys.stderr.write(f"\r{label}: {done}/{total} {unit} ({shown}/s, {left:4.0f} s left)   {end}")
         sys.stderr.flush()
         mark_progress_line(done < total)
 

@@ -1,0 +1,106 @@
+"""``plansim sweep``: one scenario, a grid of schedules, compared (docs/planning.md)."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+
+from plansim.cli.common import COMMANDS, add_set_option
+from plansim.io.files import OutputSet, check_output_path
+from plansim.report.plot import FIGURE_SUFFIXES
+
+
+def _cmd_sweep(args) -> int:
+    from plansim.io.scenario_file import load_scenario
+    from plansim.planning.grid import load_grid
+    from plansim.planning.sweep import sweep
+    from plansim.report.progress import end_progress_line, stderr_progress
+    from plansim.report.sweep import sweep_json, sweep_table
+
+    # every check before any work: the outputs, the grid, the scenario and every cell
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".nc",))
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers {args.workers}: must be >= 1")
+    if args.scheduler is not None and args.executor != "dask":
+        raise ValueError(f"--scheduler {args.scheduler!r}: only with --executor dask")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    grid = load_grid(args.grid)
+    base = load_scenario(args.scenario, args.set)
+    trials = 0 if args.predict_only else (base.trials if args.trials is None else args.trials)
+    if trials < 0 or (args.trials is not None and args.trials < 1):
+        raise ValueError(f"--trials {args.trials}: must be >= 1 (--predict-only for none)")
+
+    with OutputSet() as outputs:
+        out = outputs.stage(args.out, "--out", (".nc",)) if args.out is not None else None
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        progress = None
+        if not (args.quiet or args.json):
+            progress = stderr_progress(f"plansim sweep {base.name}", unit="cells")
+        start = time.perf_counter()
+        result = sweep(args.scenario, grid, overrides=args.set, trials=trials, seed=args.seed,
+                       executor=args.executor, workers=args.workers, scheduler=args.scheduler, path=args.path,
+                       progress=progress)
+        elapsed = time.perf_counter() - start
+        end_progress_line()
+        if out is not None:
+            result.to_netcdf(out, engine="h5netcdf")
+        if plot is not None:
+            from plansim.report.plot import sweep_figure
+
+            sweep_figure(result, plot, format=os.path.splitext(args.plot)[1].lstrip("."))
+        outputs.commit()
+
+    if args.json:
+        print(json.dumps({**sweep_json(result), "elapsed_s": elapsed}, indent=2, allow_nan=False))
+    else:
+        cells = grid.size
+        what = f"{trials} trials per cell" if trials else "the prediction only (--predict-only)"
+        print(f"plansim sweep {base.name}: {cells} cells, {what}, seed {result.attrs['seed']}, "
+              f"{elapsed:.1f} s ({args.executor})")
+        if base.overrides:
+            print(f"Overrides (--set) on every cell: {'; '.join(base.overrides)}")
+        print()
+        print(sweep_table(result))
+        for label, path in (("sweep", args.out), ("figure", args.plot)):
+            if path:
+                print(f"\nwrote {label}: {path}")
+    return 0
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser(
+        "sweep", help=COMMANDS["sweep"],
+        description="Predict (GUM) and simulate (Monte Carlo) a scenario over a grid of its fields: "
+                    "uncertainty, table time and JJF 2003 compliance per cell (docs/planning.md)")
+    p.add_argument("scenario", nargs="?", default="jjf2003",
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+    p.add_argument("--grid", required=True,
+                   help="grid file (TOML): [vary] field = [values, ...], optional [zip] (docs/planning.md)")
+    add_set_option(p)
+    how = p.add_mutually_exclusive_group()
+    how.add_argument("--trials", type=int, default=None,
+                     help="Monte Carlo trials per cell (default: the scenario's)")
+    how.add_argument("--predict-only", action="store_true", help="the prediction (GUM) only, no Monte Carlo")
+    p.add_argument("--seed", type=int, default=None,
+                   help="base seed (default: the scenario's); each cell's comes from it and the cell's fields")
+    p.add_argument("--executor", choices=("serial", "threads", "dask"), default="serial",
+                   help="where cells run: serial, threads, or dask (needs plansim[dask]); results do not "
+                        "depend on it")
+    p.add_argument("--workers", type=int, default=None, help="threads or Dask worker processes (default: cores)")
+    p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (with --executor dask)")
+    p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
+                   help="simulation path, as for plansim run")
+    p.add_argument("--out", default=None, help="write the sweep Dataset to this NetCDF file (.nc)")
+    p.add_argument("--plot", default=None, help="uncertainty against table time with the Pareto front "
+                                                "(.png, .pdf or .svg)")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
+    p.set_defaults(func=_cmd_sweep)
+
+
+__all__ = ["add_commands"]
