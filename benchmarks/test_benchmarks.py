@@ -58,6 +58,8 @@ def test_bench_command_quick(capsys):
     assert main(["bench", "--quick", "--json"]) == 0
     figures = json.loads(capsys.readouterr().out)
     for key in ("numpy_normal_per_s", "samples_per_s", "calibrations_per_s", "peak_rss_mb", "summary_peak_rss_mb",
-                "summary_seconds", "cold_start_s", "warm_start_s", "seconds_per_trial", "predict_seconds"):
+                "summary_seconds", "cold_start_s", "warm_start_s", "seconds_per_trial", "predict_seconds",
+                "sweep_seconds"):
         assert key in figures
+    assert figures["sweep_cells"] == 4 and figures["sweep_seconds"] > 0
     assert figures["calibrations_per_s"] > 0 and figures["peak_rss_mb"] > 0 and figures["summary_peak_rss_mb"] > 0

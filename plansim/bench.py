@@ -16,7 +16,10 @@ Figures (all per second of wall time, thread count reported):
 - cold start (first ``plansim run`` with an empty kernel cache: compiling) and warm start, both
   for 10⁴ trials, as separate processes;
 - ``predict_seconds`` — one :func:`plansim.planning.predict.predict` of the default scenario (the GUM of
-  its schedule), the planner's inner step.
+  its schedule), the planner's inner step;
+- ``sweep_seconds`` — :func:`plansim.planning.sweep.sweep` of the default scenario over 100 cells (25 dwell
+  times × 6/12 positions × 2 ω² rates) at 10⁴ trials per cell on the thread executor, one round (the
+  planner issue's target: ≤ 60 s on a 2-core machine).
 
 Method. The speed of these 2-core machines varies by up to 2× between identical runs (other
 work on the same host), so each throughput is the best of several rounds: the best round is the
@@ -153,6 +156,19 @@ def predict_seconds() -> float:
     return _best_of(lambda: predict(scenario))
 
 
+def sweep_seconds(cells: int = 100, trials: int = 10_000) -> tuple[float, int]:
+    """Time of one sweep of the default scenario over *cells* cells (a multiple of 4) on threads, s; and the cells."""
+    from plansim.planning.sweep import sweep
+
+    dwells = [f"{10 + 5 * k} s" for k in range(max(cells // 4, 1))]
+    grid = {"vary": {"schedule.dwell": dwells, "schedule.positions": [6, 12],
+                     "schedule.omega_squared_rate": ["50 deg/s", "100 deg/s"]}}
+    sweep(SCENARIO, {"vary": {"schedule.dwell": dwells[:1]}}, trials=min(trials, 100))  # compiled before timing
+    start = time.perf_counter()
+    sweep(SCENARIO, grid, trials=trials, executor="threads")
+    return time.perf_counter() - start, 4 * len(dwells)
+
+
 def measure(quick: bool = False) -> dict:
     """Every figure in one run. *quick* shrinks the sizes (for CI correctness runs), not the method."""
     scale = 100 if quick else 1
@@ -163,6 +179,7 @@ def measure(quick: bool = False) -> dict:
     rss, big_seconds = peak_rss_mb(1_000_000 // scale)
     cold, warm = start_times(10_000 // scale)
     prediction = predict_seconds()
+    swept, cells = sweep_seconds(4 if quick else 100, 10_000 // scale)
     counts = sorted(per_trial, key=int)
     return {
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_implementation()} "
@@ -186,6 +203,9 @@ def measure(quick: bool = False) -> dict:
         "warm_start_s": warm,
         "start_trials": 10_000 // scale,
         "predict_seconds": prediction,
+        "sweep_seconds": swept,
+        "sweep_cells": cells,
+        "sweep_trials_per_cell": 10_000 // scale,
     }
 
 
@@ -206,7 +226,9 @@ def format_figures(f: dict) -> str:
               f"in a new process, peak RSS {f['peak_rss_mb']:,.0f} MB",
               f"  plansim run, {f['start_trials']:,} trials: cold start {f['cold_start_s']:.1f} s (compiling), "
               f"warm {f['warm_start_s']:.1f} s",
-              f"  plansim.predict (GUM of the default schedule) {f['predict_seconds'] * 1e3:8.1f} ms"]
+              f"  plansim.predict (GUM of the default schedule) {f['predict_seconds'] * 1e3:8.1f} ms",
+              f"  plansim sweep, {f['sweep_cells']} cells × {f['sweep_trials_per_cell']:,} trials (threads): "
+              f"{f['sweep_seconds']:.1f} s"]
     return "\n".join(lines)
 
 
