@@ -27,6 +27,16 @@ def figure_format(path: str | os.PathLike, format: str | None = None) -> str:
     return chosen
 
 
+def pyplot():
+    """matplotlib.pyplot on the non-interactive Agg backend (imported only when a figure is drawn)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLike, format: str | None = None) -> None:
     """Histogram of |error| of each Appendix A quantity (in its reading, log axis), the claimed U and the MC 95 % point.
 
@@ -45,10 +55,7 @@ def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLik
         (:class:`plansim.io.files.OutputSet`).
     """
     chosen = figure_format(path, format)
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     by_item = {c.item: c for c in comparisons}
     fig, axes = plt.subplots(1, len(APPENDIX_A), figsize=(3.4 * len(APPENDIX_A), 3.4), constrained_layout=True)
@@ -103,10 +110,7 @@ def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = No
     from plansim.report.fit import OUTPUT_UNITS
 
     chosen = figure_format(path, format)
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     before, after = diagnosis.before, diagnosis.after
     times = np.asarray(before.segment_times, dtype=float)
@@ -170,10 +174,7 @@ def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> N
     from plansim.model.parameters import PARAMETERS
 
     chosen = figure_format(path, format)
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     grid_dims = [d for d in sweep["table_time_s"].dims]
     stacked = sweep[["table_time_s", "u_group", "pareto", "compliant_jjf2003"]].stack(cell=grid_dims) \
