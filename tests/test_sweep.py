@@ -178,6 +178,27 @@ def test_a_cell_that_fails_is_named_and_nothing_is_returned(monkeypatch, executo
               executor=executor, workers=2)
 
 
+def test_a_cell_that_fails_on_a_dask_worker_is_named_whatever_its_batch():
+    """A worker's batch returns a failed cell in place of its result (and stops there); the submitting side
+    raises the named error for that cell, not for the batch."""
+    from plansim.planning import dask_executor
+
+    def cell(scenario, index):
+        if index == (1,):
+            raise ArithmeticError("a singular design")
+        return index
+
+    out = dask_executor._batch(cell, [(None, (0,)), (None, (1,)), (None, (2,))])
+    assert out[0] == (0,) and len(out) == 2
+
+    class Finished:
+        def result(self):
+            return out
+
+    with pytest.raises(ValueError, match=r"cell \(1,\): ArithmeticError: a singular design"):
+        dask_executor._gather(Finished(), lambda index, e: ValueError(f"cell {index}: {type(e).__name__}: {e}"))
+
+
 @pytest.mark.parametrize("kwargs, words", [
     ({"executor": "gpu"}, "executor = 'gpu'"), ({"workers": 0}, "workers = 0"), ({"trials": -1}, "trials = -1"),
     ({"trials": 2.5}, "trials = 2.5"), ({"scheduler": "tcp://x:1"}, "only with executor = 'dask'"),

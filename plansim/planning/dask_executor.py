@@ -19,6 +19,7 @@ Results do not depend on the workers: each cell's numbers come from its scenario
 from __future__ import annotations
 
 import math
+import os
 import time
 
 #: the least time a task should take, s
@@ -28,8 +29,23 @@ WORKER_ENVIRONMENT = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLA
                       "MKL_NUM_THREADS": "1"}
 
 
+class _Failed:
+    """A cell that raised on a worker: its index and the error, returned in place of its result so that the
+    submitting side can name the cell whatever the batch it ran in."""
+
+    def __init__(self, index: tuple, error: Exception):
+        self.index, self.error = index, error
+
+
 def _batch(function, tasks):
-    return [function(*task) for task in tasks]
+    out = []
+    for task in tasks:
+        try:
+            out.append(function(*task))
+        except Exception as error:  # named on the submitting side; an interruption ends the worker's task
+            out.append(_Failed(task[1], error))
+            break
+    return out
 
 
 def _client(workers, scheduler):
@@ -43,8 +59,6 @@ def _client(workers, scheduler):
             return Client(scheduler, timeout="30s"), None
         except (OSError, TimeoutError) as error:
             raise ValueError(f"scheduler {scheduler!r}: cannot connect ({error})") from None
-    import os
-
     cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                            dashboard_address=None, env=dict(WORKER_ENVIRONMENT), silence_logs=40)
     return Client(cluster), cluster
@@ -59,7 +73,7 @@ def run_on_dask(tasks, function, workers, scheduler, tick, name_error) -> list:
         start = time.perf_counter()
         first = client.submit(_batch, function, tasks[:1], pure=False)
         futures.append(first)
-        results = _gather(first, function, tasks[:1], name_error)
+        results = _gather(first, name_error)
         tick()
         per_cell = max(time.perf_counter() - start, 1e-3)
         size = max(1, math.ceil(BATCH_SECONDS / per_cell))
@@ -67,7 +81,7 @@ def run_on_dask(tasks, function, workers, scheduler, tick, name_error) -> list:
         batches = [rest[k:k + size] for k in range(0, len(rest), size)]
         futures = [client.submit(_batch, function, batch, pure=False) for batch in batches]
         for batch, future in zip(batches, futures):
-            results.extend(_gather(future, function, batch, name_error))
+            results.extend(_gather(future, name_error))
             for _ in batch:
                 tick()
         return results
@@ -79,19 +93,10 @@ def run_on_dask(tasks, function, workers, scheduler, tick, name_error) -> list:
             cluster.close()
 
 
-def _gather(future, function, batch, name_error) -> list:
-    try:
-        return future.result()
-    except (KeyboardInterrupt, SystemExit):
-        raise
-    except Exception as error:  # the remote error comes back as itself; name the batch's cells
-        if len(batch) == 1:
-            raise name_error(batch[0][1], error) from error
-        # run the batch's cells one by one locally to find and name the one that fails
-        for task in batch:
-            try:
-                function(*task)
-            except Exception as cell_error:
-                raise name_error(task[1], cell_error) from cell_error
-        raise ValueError(f"a batch of {len(batch)} sweep cells failed on Dask ({type(error).__name__}: {error}), "
-                         "and each succeeds when run alone") from error
+def _gather(future, name_error) -> list:
+    """A batch's results; a failed cell raises ``name_error(index, error)``."""
+    results = future.result()
+    for result in results:
+        if isinstance(result, _Failed):
+            raise name_error(result.index, result.error) from result.error
+    return results

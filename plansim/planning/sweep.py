@@ -23,6 +23,7 @@ Dataset to the last bit. A failed cell raises a ValueError naming the cell; noth
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -34,10 +35,11 @@ import xarray as xr
 from plansim.config import Scenario
 from plansim.io.recording import plansim_version
 from plansim.io.scenario_file import load_scenario
-from plansim.model.parameters import PARAMETERS
+from plansim.model.parameters import GROUPS, PARAMETERS, group_spec
 from plansim.planning.grid import ZIP_DIMENSION, Grid, cell_seed, parse_grid
 from plansim.planning.predict import predict
 from plansim.schedule.compliance import RULES, jjf2003_compliance
+from plansim.simulate.chunks import check_count
 
 EXECUTORS = ("serial", "threads", "dask")
 #: what each cell gives, over ``parameter``
@@ -74,14 +76,6 @@ def evaluate_cell(scenario: Scenario, index: tuple[int, ...], seed: int, trials:
         out.update(u_mc=nan, bias_mc=nan, coverage=nan)
     compliance = jjf2003_compliance(scenario.schedule)
     return CellResult(index, seed, out, scenario.schedule.duration, dict(compliance.rules), compliance.max_rate)
-
-
-def _check_count(name: str, value, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} = {value!r}: expected a whole number, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} = {value!r}: must be >= {minimum}")
-    return int(value)
 
 
 def cell_scenarios(scenario: str | os.PathLike, grid: Grid, overrides=()) -> list[tuple[tuple, list[str], Scenario]]:
@@ -150,28 +144,27 @@ def sweep(scenario: str | os.PathLike = "jjf2003", grid: Grid | dict | None = No
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: allowed {', '.join(EXECUTORS)}")
     if workers is not None:
-        workers = _check_count("workers", workers, 1)
+        workers = check_count("workers", workers, 1)
     if scheduler is not None and executor != "dask":
         raise ValueError(f"scheduler = {scheduler!r}: only with executor = 'dask' (got {executor!r})")
     if path not in ("auto", "sample", "segment"):
         raise ValueError(f"path = {path!r}: allowed auto, sample, segment")
     base = load_scenario(scenario, overrides)
     cells = cell_scenarios(scenario, grid, overrides)
-    trials = base.trials if trials is None else _check_count("trials", trials, 0)
-    seed = base.seed if seed is None else _check_count("seed", seed, 0)
+    trials = base.trials if trials is None else check_count("trials", trials, 0)
+    seed = base.seed if seed is None else check_count("seed", seed, 0)
     tasks = [(sc, index, cell_seed(seed, cell), trials, path, coverage_probability) for index, cell, sc in cells]
-    results = _execute(tasks, executor, workers, scheduler, progress, [cell for _, cell, _ in cells])
+    results = _execute(tasks, executor, workers, scheduler, progress, {index: cell for index, cell, _ in cells})
     return _dataset(grid, results, base, overrides, trials, seed, path, coverage_probability)
 
 
-def _named(task_cells: list[list[str]], index_of: dict, index: tuple, error: BaseException) -> ValueError:
-    return ValueError(f"sweep cell {'; '.join(task_cells[index_of[index]])} failed: "
-                      f"{type(error).__name__}: {error}")
+#: what a failing cell raises, named by the cell (anything else, an interruption say, passes as it is)
+CELL_ERRORS = (ValueError, TypeError, ArithmeticError, np.linalg.LinAlgError)
 
 
-def _execute(tasks, executor: str, workers, scheduler, progress, task_cells) -> list[CellResult]:
+def _execute(tasks, executor: str, workers, scheduler, progress, cell_of: dict) -> list[CellResult]:
+    """Every task's :class:`CellResult`, in the tasks' order; *cell_of* maps a cell's index to its overrides."""
     total = len(tasks)
-    index_of = {task[1]: k for k, task in enumerate(tasks)}
     done = 0
     results: list[CellResult] = []
 
@@ -181,44 +174,38 @@ def _execute(tasks, executor: str, workers, scheduler, progress, task_cells) -> 
         if progress is not None:
             progress(done, total)
 
-    if executor == "serial" or total == 1:
-        for task in tasks:
-            results.append(_checked(evaluate_cell, task, task_cells, index_of))
-            tick()
-        return results
-    if executor == "threads":
-        # the first cell alone compiles the kernels; the rest side by side
-        results.append(_checked(evaluate_cell, tasks[0], task_cells, index_of))
+    def named(index: tuple, error: BaseException) -> ValueError:
+        return ValueError(f"sweep cell {'; '.join(cell_of[index])} failed: {type(error).__name__}: {error}")
+
+    @contextlib.contextmanager
+    def cell(index: tuple):
+        try:
+            yield
+        except CELL_ERRORS as error:
+            raise named(index, error) from error
         tick()
-        with ThreadPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
-            futures = [pool.submit(evaluate_cell, *task) for task in tasks[1:]]
-            try:
-                for task, future in zip(tasks[1:], futures):
-                    try:
-                        results.append(future.result())
-                    except CELL_ERRORS as error:
-                        raise _named(task_cells, index_of, task[1], error) from error
-                    tick()
-            except BaseException:
-                for future in futures:
-                    future.cancel()
-                raise
+
+    if executor == "dask" and total > 1:
+        from plansim.planning.dask_executor import run_on_dask
+
+        return run_on_dask(tasks, evaluate_cell, workers, scheduler, tick, named)
+    # serial, and the first cell of threads alone: it compiles the kernels before the rest run side by side
+    for task in tasks if executor == "serial" else tasks[:1]:
+        with cell(task[1]):
+            results.append(evaluate_cell(*task))
+    if len(results) == total:
         return results
-    from plansim.planning.dask_executor import run_on_dask
-
-    return run_on_dask(tasks, evaluate_cell, workers, scheduler, tick,
-                       lambda index, error: _named(task_cells, index_of, index, error))
-
-
-#: what a failing cell raises, named by the cell (anything else, an interruption say, passes as it is)
-CELL_ERRORS = (ValueError, TypeError, ArithmeticError, np.linalg.LinAlgError)
-
-
-def _checked(function, task, task_cells, index_of):
-    try:
-        return function(*task)
-    except CELL_ERRORS as error:
-        raise _named(task_cells, index_of, task[1], error) from error
+    with ThreadPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
+        futures = [pool.submit(evaluate_cell, *task) for task in tasks[1:]]
+        try:
+            for task, future in zip(tasks[1:], futures):
+                with cell(task[1]):
+                    results.append(future.result())
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+    return results
 
 
 def pareto_front(cost, value) -> np.ndarray:
@@ -278,7 +265,7 @@ def _dataset(grid: Grid, results: list[CellResult], base: Scenario, overrides, t
     data["jjf2003_rule"] = ((*grid_dims, "rule"), verdicts, {"units": "1", "long_name": "each rule's verdict"})
     data["max_rate"] = (grid_dims, max_rate, {"units": "rad/s", "long_name": "the largest rate point"})
     data["seed"] = (grid_dims, seeds, {"units": "1", "long_name": "the cell's Monte Carlo seed (cell_seed)"})
-    groups = list(dict.fromkeys(p.group for p in PARAMETERS))
+    groups = list(GROUPS)
     member = np.array([[p.group == g for p in PARAMETERS] for g in groups])  # (group, parameter)
     u = arrays["u_mc"] if trials > 1 else arrays["u_predicted"]
     u_group = np.stack([np.max(u[..., m], axis=-1) for m in member], axis=-1)
@@ -292,7 +279,7 @@ def _dataset(grid: Grid, results: list[CellResult], base: Scenario, overrides, t
     coords: dict = {"parameter": ("parameter", names), "unit": ("parameter", [p.si_unit for p in PARAMETERS]),
                     "parameter_group": ("parameter", [p.group for p in PARAMETERS]),
                     "group": ("group", groups),
-                    "group_unit": ("group", [next(p.si_unit for p in PARAMETERS if p.group == g) for g in groups]),
+                    "group_unit": ("group", [group_spec(g).si_unit for g in groups]),
                     "rule": ("rule", rules), "rule_text": ("rule", [RULES[name] for name in rules])}
     for d in grid.dimensions:
         if d.name == ZIP_DIMENSION:
