@@ -32,7 +32,7 @@ def _cmd_sweep(args) -> int:
     grid = load_grid(args.grid)
     base = load_scenario(args.scenario, args.set)
     trials = 0 if args.predict_only else (base.trials if args.trials is None else args.trials)
-    if trials < 0 or (args.trials is not None and args.trials < 1):
+    if args.trials is not None and args.trials < 1:
         raise ValueError(f"--trials {args.trials}: must be >= 1 (--predict-only for none)")
 
     with OutputSet() as outputs:

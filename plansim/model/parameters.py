@@ -81,6 +81,8 @@ PARAMETERS: tuple[ParameterSpec, ...] = tuple(_build())
 PARAMETER_NAMES: tuple[str, ...] = tuple(p.name for p in PARAMETERS)
 PARAMETER_INDEX: dict[str, int] = {p.name: k for k, p in enumerate(PARAMETERS)}
 N_PARAMETERS = len(PARAMETERS)
+#: the parameter groups in parameter order: Kg, Bg, G, Ka, Ba, P
+GROUPS: tuple[str, ...] = tuple(dict.fromkeys(p.group for p in PARAMETERS))
 
 
 def parameter(name: str) -> ParameterSpec:
@@ -89,6 +91,14 @@ def parameter(name: str) -> ParameterSpec:
         return PARAMETERS[PARAMETER_INDEX[name]]
     except KeyError:
         raise ValueError(f"unknown parameter {name!r}; known: {', '.join(PARAMETER_NAMES)}") from None
+
+
+def group_spec(group: str) -> ParameterSpec:
+    """The first parameter of *group* (:data:`GROUPS`): its units (SI and display) are the whole group's."""
+    for p in PARAMETERS:
+        if p.group == group:
+            return p
+    raise ValueError(f"unknown parameter group {group!r}; known: {', '.join(GROUPS)}")
 
 
 def _indices(group: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -37,6 +37,14 @@ def pyplot():
     return plt
 
 
+def save(fig, path: str | os.PathLike, format: str, dpi: int) -> None:
+    """Write *fig* to *path* whole or not at all (:func:`plansim.io.files.atomic_write`), then close it."""
+    try:
+        atomic_write(path, lambda tmp: fig.savefig(tmp, format=format, dpi=dpi))
+    finally:
+        pyplot().close(fig)
+
+
 def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLike, format: str | None = None) -> None:
     """Histogram of |error| of each Appendix A quantity (in its reading, log axis), the claimed U and the MC 95 % point.
 
@@ -81,10 +89,7 @@ def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLik
     np.atleast_1d(axes)[0].legend(fontsize=7, loc="upper left")
     fig.suptitle(f"plansim: {results.attrs['scenario']} — {results.attrs['trials']} trials, seed "
                  f"{results.attrs['seed']}: JJF 2003 Appendix A claims vs Monte Carlo", fontsize=10)
-    try:
-        atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=120))
-    finally:
-        plt.close(fig)
+    save(fig, path, chosen, dpi=120)
 
 
 def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = None) -> None:
@@ -145,10 +150,7 @@ def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = No
     verdict = "unexplained residual remains" if diagnosis.unexplained.get("flagged") else "no lack of fit remains"
     fig.suptitle(f"plansim diagnose: found {found}; {verdict} (family-wise alpha = {diagnosis.alpha:g})",
                  fontsize=10)
-    try:
-        atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=110))
-    finally:
-        plt.close(fig)
+    save(fig, path, chosen, dpi=110)
 
 
 def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> None:
@@ -171,7 +173,7 @@ def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> N
     format : {"png", "pdf", "svg"}, optional
         Default: from the suffix of *path*.
     """
-    from plansim.model.parameters import PARAMETERS
+    from plansim.model.parameters import group_spec
 
     chosen = figure_format(path, format)
     plt = pyplot()
@@ -187,12 +189,10 @@ def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> N
     labels = [label.replace("positions=", "pos=") for label in labels]
     groups = [str(g) for g in sweep["group"].values]
     trials = int(sweep.attrs.get("trials_per_cell", 0))
-    display = {}
-    for p in PARAMETERS:
-        display.setdefault(p.group, (p.display_unit, p.display_factor))
     fig, axes = plt.subplots(2, 3, figsize=(13, 7.5), constrained_layout=True)
     for ax, group in zip(axes.ravel(), groups):
-        unit, factor = display[group]
+        spec = group_spec(group)
+        unit, factor = spec.display_unit, spec.display_factor
         u = stacked["u_group"].sel(group=group).values / factor
         front = stacked["pareto"].sel(group=group).values.astype(bool)
         if trials > 1:  # the Monte Carlo's own scatter: the standard error of a standard deviation, u/√(2(n−1))
@@ -212,7 +212,4 @@ def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> N
     fig.suptitle(f"plansim sweep of {sweep.attrs.get('scenario', '?')}: "
                  + (f"{trials} Monte Carlo trials per cell" if trials > 1 else "the prediction (GUM) only"),
                  fontsize=10)
-    try:
-        atomic_write(path, lambda tmp: fig.savefig(tmp, format=chosen, dpi=110))
-    finally:
-        plt.close(fig)
+    save(fig, path, chosen, dpi=110)

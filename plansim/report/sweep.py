@@ -8,18 +8,13 @@ import tomllib
 import numpy as np
 import xarray as xr
 
-from plansim.model.parameters import PARAMETERS
+from plansim.model.parameters import group_spec
 
 #: the keys of ``plansim sweep --json`` and of each of its cells
 JSON_KEYS = ("scenario", "scenario_source", "base_overrides", "grid", "trials_per_cell", "seed",
              "coverage_probability", "plansim_version", "groups", "cells")
 CELL_KEYS = ("coordinates", "seed", "table_time_s", "compliant_jjf2003", "failed_rules", "max_rate_rad_s",
              "under_covered", "u_group", "pareto", "parameters")
-
-
-def _display(group: str) -> tuple[str, float]:
-    spec = next(p for p in PARAMETERS if p.group == group)
-    return spec.display_unit, spec.display_factor
 
 
 def _grid_dims(ds: xr.Dataset) -> list[str]:
@@ -81,7 +76,7 @@ def sweep_table(ds: xr.Dataset) -> str:
                "yes" if bool(cell["compliant_jjf2003"]) else
                "no: " + ", ".join(str(r) for r, ok in zip(ds["rule"].values, cell["jjf2003_rule"].values) if not ok)]
         for g in groups:
-            _, factor = _display(g)
+            factor = group_spec(g).display_factor
             star = "*" if bool(cell["pareto"].sel(group=g)) else " "
             row.append(f"{float(cell['u_group'].sel(group=g)) / factor:.3g}{star}")
         if simulated:
@@ -89,7 +84,7 @@ def sweep_table(ds: xr.Dataset) -> str:
             row.append(", ".join(low[:4]) + (f" +{len(low) - 4}" if len(low) > 4 else "") if low else "none")
         rows.append(row)
     which = "u_mc" if simulated else "u_predicted"
-    head = ["cell", "time (min)", "JJF 2003 §7.2"] + [f"{g} ({_display(g)[0]})" for g in groups]
+    head = ["cell", "time (min)", "JJF 2003 §7.2"] + [f"{g} ({group_spec(g).display_unit})" for g in groups]
     if simulated:
         head.append("under-covered")
     widths = [max(len(r[k]) for r in [head, *rows]) for k in range(len(head))]
