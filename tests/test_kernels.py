@@ -26,12 +26,14 @@ _EXERCISE_EVERY_KERNEL = textwrap.dedent("""
     from plansim.io.scenario_file import load_scenario
     from plansim.simulate.arguments import nominal_draws, noise_free_segment_means
     from plansim.simulate.chunks import simulate_recording, simulate_segment_means
+    from plansim.uncertainty.sensitivities import segment_mean_derivatives
 
     scenario = load_scenario("jjf2003")
     simulate_segment_means(scenario, 3, 1, path="segment")
     simulate_segment_means(scenario, 3, 1, path="sample")
     simulate_recording(scenario, 1)
     noise_free_segment_means(scenario, nominal_draws(scenario)[None])
+    segment_mean_derivatives(scenario, [0, 60], [1e-3, 1e-5])
     copies = {}
     for module_info in pkgutil.iter_modules(plansim.kernels.__path__):
         module = importlib.import_module("plansim.kernels." + module_info.name)

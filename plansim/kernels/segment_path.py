@@ -49,9 +49,27 @@ import math
 import numpy as np
 
 from plansim.kernels.drift import advance_drift, drift_transition, noise_stream, segment_drift
-from plansim.kernels.layout import ACQ_STEP, N_TRUTH, NOISE_WHITE, draws_length
-from plansim.kernels.options import jit
-from plansim.kernels.physics import draw_systematic, evaluate_outputs, geometry_buffers, segment_geometry, unpack_truth
+from plansim.kernels.layout import (
+    ACQ_STEP,
+    HEAD,
+    N_TRUTH,
+    NOISE_WHITE,
+    PER_SEGMENT,
+    PERPENDICULARITY_FIRST,
+    RATE_SYSTEMATIC,
+    SEG_PHASE,
+    SEG_RATE_ERROR,
+    draws_length,
+)
+from plansim.kernels.options import inline_jit, jit
+from plansim.kernels.physics import (
+    draw_systematic,
+    evaluate_outputs,
+    geometry_buffers,
+    segment_geometry,
+    trial_frames,
+    unpack_truth,
+)
 from plansim.kernels.quantiser import channel_moments, fourier_damping, fourier_terms_needed
 from plansim.kernels.random import normal
 
@@ -60,6 +78,7 @@ DETERMINISTIC_NODES = np.int64(7)  # degree ≤ 3 in θ -> 2·3 + 1 nodes
 _ONE_NODE = np.int64(1)  # at rest: the output does not depend on θ
 _NO_EXTRA = np.int64(0)
 _JITTER_NODES = np.int64(2)  # θ0 at the rate ± h, for the response to rate jitter
+_FIRST = np.int64(0)  # the first row of a work array
 MAX_NODES = 401
 #: every approximation of the quantiser stays below this fraction of the segment mean's noise σ/√N
 RELATIVE_TOLERANCE = 1e-3
@@ -172,6 +191,38 @@ def _harmonics_needed(spread, sigma, step, coefficients, row, kmax, tolerance):
     return cap
 
 
+@inline_jit
+def segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity,
+                    earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp, frames, extra, rates, outputs, scratch):
+    """The noise-free outputs of segment *s* of one trial (*draws*, its truth unpacked in ``Kg … P``).
+
+    At rest, ``outputs[0]`` (6): the one output, whatever the table angle. Rotating, ``outputs[j]``
+    for j < 7: the outputs at the table angles θ0 + 2πj/7 at the actual rate, then *extra* rows (0 or
+    :data:`_JITTER_NODES`) at θ0 with the rate ± 1e-6 of itself (the rate-jitter response). Returns the
+    actual rate (rad/s; the commanded 0 at rest). ``u … frames`` are :func:`geometry_buffers` (the
+    trial's frames in ``frames``), ``rates`` (7 + *extra*), ``outputs`` (7 + *extra*, 6) and
+    ``scratch`` (3, 6) work space. Inlined: one output model for :func:`noise_free_nodes` and
+    :func:`noise_free_mean_differences`.
+    """
+    rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                       earth_enu, lever, g_b0, om_b0, u, perp, frames)
+    dT = seg_temp[s] - t_ref
+    if seg_rate[s] == 0.0:
+        rates[0] = 0.0
+        evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
+                         sensor, S2, outputs, scratch)
+        return 0.0
+    h = 1e-6 * abs(rate_act)
+    for j in range(DETERMINISTIC_NODES):
+        rates[j] = rate_act
+    if extra > 0:
+        rates[DETERMINISTIC_NODES] = rate_act + h
+        rates[DETERMINISTIC_NODES + 1] = rate_act - h
+    evaluate_outputs(DETERMINISTIC_NODES, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
+                     sensor, S2, outputs, scratch)
+    return rate_act
+
+
 @jit
 def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref,
                      smoothness, gravity, earth_enu, nodes_out, rates_out, jitter_out):
@@ -193,28 +244,18 @@ def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp
     outputs = np.empty((DETERMINISTIC_NODES + _JITTER_NODES, 6))
     scratch = np.empty((3, 6))
     for s in range(seg_C0.shape[0]):
-        rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                           earth_enu, lever, g_b0, om_b0, u, perp, frames)
-        dT = seg_temp[s] - t_ref
+        # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
+        rate_act = segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever,
+                                   t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp, frames,
+                                   _JITTER_NODES, rates, outputs, scratch)
+        rates_out[s] = rate_act
         if seg_rate[s] == 0.0:
-            rates[0] = 0.0
-            evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
-                             sensor, S2, outputs, scratch)
-            rates_out[s] = 0.0
             for c in range(6):
                 for j in range(DETERMINISTIC_NODES):
                     nodes_out[s, j, c] = outputs[0, c]
                 jitter_out[s, c] = 0.0
             continue
-        # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
         h = 1e-6 * abs(rate_act)
-        for j in range(DETERMINISTIC_NODES):
-            rates[j] = rate_act
-        rates[DETERMINISTIC_NODES] = rate_act + h
-        rates[DETERMINISTIC_NODES + 1] = rate_act - h
-        evaluate_outputs(DETERMINISTIC_NODES, _JITTER_NODES, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka,
-                         Ba, P, sensor, S2, outputs, scratch)
-        rates_out[s] = rate_act
         for c in range(6):
             for j in range(DETERMINISTIC_NODES):
                 nodes_out[s, j, c] = outputs[j, c]
@@ -268,6 +309,128 @@ def noise_free_means(draws, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_
                          0.0, gravity, earth_enu, nodes, rates, jitter)
         for s in range(n_seg):
             segment_mean_and_spread(nodes, s, rates[s], seg_dt[s], seg_n[s], weights, means_out[t, s], spread)
+
+
+@inline_jit
+def _segment_reads(index, s, seg_rate, seg_axis_index):
+    """Whether the noise-free means of segment *s* depend on component *index* of the draws vector.
+
+    Every segment reads the truth, the fixture and the tilt; only a rotating segment reads the
+    systematic rate error and the perpendicularity of its own rate axis (at rest the table axis
+    and the rate enter the outputs multiplied by exact zeros); a segment reads its own position
+    errors, and, rotating, its own rate error (:func:`plansim.kernels.physics.segment_geometry`).
+    """
+    if index < RATE_SYSTEMATIC:
+        return True
+    rotating = seg_rate[s] != 0.0
+    if index < HEAD:
+        return rotating and (index == RATE_SYSTEMATIC
+                             or seg_axis_index[s] == (index - PERPENDICULARITY_FIRST) // 2)
+    if (index - HEAD) // PER_SEGMENT != s:
+        return False
+    return rotating or (index - HEAD) % PER_SEGMENT < SEG_RATE_ERROR
+
+
+@jit
+def _segment_phase_means(draws, s, phases, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                         sensor, S2, lever, t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp,
+                         frames, rates, outputs, scratch, weights, spread, means_out):
+    """``means_out[j]`` (6): the noise-free mean of segment *s* with its start angle at ``phases[j]``.
+
+    The mean of :func:`noise_free_means` for *draws* with that start angle, evaluated once at rest
+    (where the angle does not enter). ``outputs`` is (7, 6), work space like ``rates`` (7),
+    ``scratch``, ``weights`` (7) and ``spread`` (6); *draws* is left as it was.
+    """
+    phase_index = HEAD + PER_SEGMENT * s + SEG_PHASE
+    saved = draws[phase_index]
+    nodes = outputs.reshape((1, DETERMINISTIC_NODES, 6))
+    for j in range(phases.shape[0]):
+        if j > 0 and seg_rate[s] == 0.0:
+            for c in range(6):
+                means_out[j, c] = means_out[0, c]
+            continue
+        draws[phase_index] = phases[j]
+        rate_act = segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever,
+                                   t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp, frames,
+                                   _NO_EXTRA, rates, outputs, scratch)
+        segment_mean_and_spread(nodes, _FIRST, rate_act, seg_dt[s], seg_n[s], weights, means_out[j], spread)
+    draws[phase_index] = saved
+
+
+@inline_jit
+def _phase_average(phase_means, out, k, s):
+    """``out[k, s] = Σ_j phase_means[j] / J``, summed in the order of j (as numpy's mean over a leading axis)."""
+    for c in range(6):
+        total = phase_means[0, c]
+        for j in range(1, phase_means.shape[0]):
+            total += phase_means[j, c]
+        out[k, s, c] = total / phase_means.shape[0]
+
+
+@jit
+def noise_free_mean_differences(base, phases, indices, steps, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
+                                seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu,
+                                phase_means_out, centre_out, plus_out, minus_out):
+    """Noise-free segment means for central differences in components of the draws vector, averaged over start angles.
+
+    With every segment's start angle at ``phases[j]`` (J angles):
+
+    - ``phase_means_out`` (J, S, 6): the means at *base* (D,), as :func:`noise_free_means` gives them
+      for the J draws vectors;
+    - ``centre_out`` (1, S, 6): their average over the J angles;
+    - ``plus_out``, ``minus_out`` (K, S, 6): the averages with ``base[indices[k]] ± steps[k]``.
+
+    Averages are summed in the order of the angles, then divided by J: numpy's mean over the angle
+    axis of the same values. Only the segments that read component ``indices[k]``
+    (:func:`_segment_reads`) are evaluated; the others get ``centre_out``, the value their
+    evaluation would give bit for bit. At rest a segment is evaluated at one angle (it does not
+    depend on it). So every mean equals :func:`noise_free_means` of the corresponding full draws
+    vector, averaged with numpy, exactly, at a fraction of the work: a position error of one
+    segment costs one segment, not S. *indices* must not be start angles (``SEG_PHASE``): those
+    are set from *phases*.
+    """
+    n_seg = seg_n.shape[0]
+    draws = base.copy()
+    Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
+    u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
+    rates = np.empty(DETERMINISTIC_NODES)
+    outputs = np.empty((DETERMINISTIC_NODES, 6))
+    scratch = np.empty((3, 6))
+    weights = np.empty(DETERMINISTIC_NODES)
+    spread = np.empty(6)
+    phase_means = np.empty((phases.shape[0], 6))
+    for s in range(n_seg):
+        _segment_phase_means(draws, s, phases, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
+                             sensor, S2, lever, t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0,
+                             perp, frames, rates, outputs, scratch, weights, spread, phase_means)
+        for j in range(phases.shape[0]):
+            for c in range(6):
+                phase_means_out[j, s, c] = phase_means[j, c]
+        _phase_average(phase_means, centre_out, _FIRST, s)
+    for k in range(indices.shape[0]):
+        index = indices[k]
+        for sign in range(2):
+            out = plus_out if sign == 0 else minus_out
+            draws[index] = base[index] + steps[k] if sign == 0 else base[index] - steps[k]
+            if index < N_TRUTH:
+                Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
+            elif index < RATE_SYSTEMATIC:
+                trial_frames(draws, frames)
+            for s in range(n_seg):
+                if not _segment_reads(index, s, seg_rate, seg_axis_index):
+                    for c in range(6):
+                        out[k, s, c] = centre_out[0, s, c]
+                    continue
+                _segment_phase_means(draws, s, phases, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index,
+                                     seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P,
+                                     u, g_b0, om_b0, perp, frames, rates, outputs, scratch, weights, spread,
+                                     phase_means)
+                _phase_average(phase_means, out, k, s)
+            draws[index] = base[index]
+        if index < N_TRUTH:
+            Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
+        elif index < RATE_SYSTEMATIC:
+            trial_frames(draws, frames)
 
 
 @jit

@@ -138,14 +138,31 @@ def nominal_draws(scenario: Scenario) -> np.ndarray:
     return draws
 
 
+#: the arguments of the noise-free kernels (:func:`plansim.kernels.segment_path.noise_free_means`,
+#: :func:`plansim.kernels.segment_path.noise_free_mean_differences`) that describe the scenario
+NOISE_FREE_ARGUMENTS = ("seg_n", "seg_dt", "seg_C0", "seg_rate", "seg_axis", "seg_axis_index", "seg_temp", "sensor",
+                        "S2", "lever", "t_ref", "gravity", "earth_enu")
+
+
+def noise_free_arguments(scenario: Scenario, arguments: dict | None = None) -> dict[str, object]:
+    """The scenario's arguments of the noise-free kernels (:data:`NOISE_FREE_ARGUMENTS`), as they take them.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    arguments : dict, optional
+        :func:`kernel_arguments` of *scenario*, if the caller has them already (they cost a
+        millisecond on the default schedule).
+    """
+    args = as_float_arrays(kernel_arguments(scenario) if arguments is None else arguments)
+    return {k: args[k] for k in NOISE_FREE_ARGUMENTS}
+
+
 def noise_free_segment_means(scenario: Scenario, draws: np.ndarray) -> np.ndarray:
     """Exact noise-free segment means (n, S, 6) for draws vectors (n, D) (layout: plansim.kernels.physics)."""
     draws = np.ascontiguousarray(draws, dtype=float)
     if draws.ndim != 2 or draws.shape[1] != draws_length(len(scenario.schedule)):
         raise ValueError(f"draws: expected shape (n, {draws_length(len(scenario.schedule))}), got {draws.shape}")
-    args = as_float_arrays(kernel_arguments(scenario))
     out = np.empty((draws.shape[0], len(scenario.schedule), 6))
-    keep = ("seg_n", "seg_dt", "seg_C0", "seg_rate", "seg_axis", "seg_axis_index", "seg_temp", "sensor", "S2",
-            "lever", "t_ref", "gravity", "earth_enu")
-    segment_path.noise_free_means(draws, **{k: args[k] for k in keep}, means_out=out)
+    segment_path.noise_free_means(draws, **noise_free_arguments(scenario), means_out=out)
     return out

@@ -18,14 +18,13 @@ import numpy as np
 from plansim.config import ErrorDistribution, Scenario
 from plansim.kernels.layout import ACCEL_CHANNELS, GYRO_CHANNELS, N_CHANNELS, NOISE_WHITE
 from plansim.model.parameters import N_PARAMETERS
-from plansim.simulate.arguments import kernel_arguments, noise_free_segment_means
+from plansim.simulate.arguments import kernel_arguments
 from plansim.uncertainty.drift import drift_covariance
 from plansim.uncertainty.quantisation import quantisation_covariance, quantisation_variance
 from plansim.uncertainty.sensitivities import (
     PHASE_NODES,
-    finite_differences,
-    phase_grid_draws,
     rate_derivatives,
+    segment_mean_derivatives,
     table_groups,
 )
 
@@ -97,19 +96,26 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     samples = np.array([s.samples for s in segments], dtype=float)
     durations = np.array([s.samples / s.sample_rate for s in segments])
     dts = np.array([1.0 / s.sample_rate for s in segments])
-    noise = kernel_arguments(scenario)["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
+    arguments = kernel_arguments(scenario)
+    noise = arguments["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
     offsets = [np.zeros((n_seg, n_seg)) for _ in range(N_CHANNELS)]  # per channel: covariance of the means' offsets
 
-    # table and fixture errors: finite differences of the noise-free means
+    # every finite difference at once (table and fixture errors, then the unit's spread): one kernel call
     groups = table_groups(scenario)
+    spread = np.asarray(scenario.truth_spread, dtype=float)
+    idx = np.flatnonzero(spread > 0)
+    indices = np.concatenate([np.array(g[2], dtype=np.int64) for g in groups] + [idx])
+    steps = np.concatenate([np.full(len(g[2]), g[1].standard_uncertainty) for g in groups] + [spread[idx]])
+    nominal, first_all, second_all = segment_mean_derivatives(scenario, indices, steps, arguments)  # (J, S, 6), …
+    n_table = len(indices) - idx.size
+
+    # table and fixture errors: finite differences of the noise-free means
     if groups:
-        indices = np.concatenate([np.array(g[2], dtype=np.int64) for g in groups])
-        steps = np.concatenate([np.full(len(g[2]), g[1].standard_uncertainty) for g in groups])
-        first, second = finite_differences(scenario, indices, steps)
+        first, second = first_all[:n_table], second_all[:n_table]
         start = 0
-        for name, error, idx, unit in groups:
-            stop = start + len(idx)
-            u = np.full(len(idx), error.standard_uncertainty)
+        for name, error, idx_g, unit in groups:
+            stop = start + len(idx_g)
+            u = np.full(len(idx_g), error.standard_uncertainty)
             d_means = first[start:stop] * u[:, None, None]  # (K, S, 6)
             for c in range(N_CHANNELS):
                 offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
@@ -123,7 +129,6 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
 
     # table start angle of the rotating segments: exact variance over the angle
     rotating = [s for s, seg in enumerate(segments) if seg.rate != 0.0]
-    nominal = noise_free_segment_means(scenario, phase_grid_draws(scenario))  # (J, S, 6)
     if rotating:
         centre = nominal.mean(axis=0)
         deviation = nominal - centre
@@ -145,10 +150,8 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     nominal = nominal.mean(axis=0)  # (S, 6): expected noise-free means
 
     # the unit under calibration: dependence of the error on the true parameters
-    spread = np.asarray(scenario.truth_spread, dtype=float)
-    idx = np.flatnonzero(spread > 0)
     if idx.size:
-        first, second = finite_differences(scenario, idx, spread[idx])
+        first, second = first_all[n_table:], second_all[n_table:]
         d_means = first * spread[idx][:, None, None]
         for c in range(N_CHANNELS):
             offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
@@ -176,7 +179,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
             note="u = N/√T (random-walk coefficient N, dwell T); ν = n − 1 samples"))
 
     # drift: exact covariance of the segment means
-    drift = drift_covariance(scenario)
+    drift = drift_covariance(scenario, arguments)
     for c in range(N_CHANNELS):
         offsets[c] += drift[c]
     for label, channels in (("drift, gyros", _GYROS), ("drift, accelerometers", _ACCELS)):
@@ -196,7 +199,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     smoothness = scenario.turntable.rate_smoothness
     jitter = np.zeros((n_seg, N_CHANNELS))
     if smoothness > 0 and rotating:
-        derivative = rate_derivatives(scenario)
+        derivative = rate_derivatives(scenario, arguments)
         jitter = smoothness * derivative
         u = np.array([smoothness / math.sqrt(samples[s]) for s in rotating])
         columns = np.stack([matrix[:, s, :] @ derivative[s] * u[i] for i, s in enumerate(rotating)], axis=1)

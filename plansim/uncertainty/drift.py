@@ -51,7 +51,7 @@ def _process_covariance(coefficients: np.ndarray, gaps: np.ndarray, sigma: float
     return cov
 
 
-def drift_covariance(scenario: Scenario) -> np.ndarray:
+def drift_covariance(scenario: Scenario, arguments: dict | None = None) -> np.ndarray:
     """Covariance of the drift part of every segment mean, ``(6, S, S)`` per channel gx … az.
 
     Derived from the model the simulator uses (:mod:`plansim.kernels.drift`): first-order
@@ -65,13 +65,15 @@ def drift_covariance(scenario: Scenario) -> np.ndarray:
     Parameters
     ----------
     scenario : Scenario
+    arguments : dict, optional
+        :func:`plansim.simulate.arguments.kernel_arguments` of *scenario*, if the caller has them.
 
     Returns
     -------
     (6, S, S) ndarray
         In (rad/s)² for the gyros, (m/s²)² for the accelerometers.
     """
-    noise = kernel_arguments(scenario)["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
+    noise = (kernel_arguments(scenario) if arguments is None else arguments)["noise"]  # (6, 4): NOISE_COLUMNS
     table = drift_coefficient_table(scenario)  # (S, 3, 5): bias instability, Gauss–Markov, random walk
     gaps = np.array([s.settle for s in scenario.schedule.segments], dtype=float)
     n = scenario.noise

@@ -5,9 +5,10 @@ functions of the inputs ``X``, reduced by ``R`` (eq. (4)-(13)).
 
 - :func:`estimator_matrix` — ``R`` is linear in the segment means; its matrix is the estimators'
   own :func:`plansim.estimate.reduction_matrix`, reshaped per segment and channel;
-- :func:`finite_differences` — ``∂m̄/∂x_i`` and ``∂²m̄/∂x_i²`` of the exact noise-free segment
-  means by central differences with step ``u(x_i)`` (JCGM 100 5.1.3 note 2), averaged over the
-  table start angle;
+- :func:`segment_mean_derivatives` (and :func:`finite_differences`) — ``∂m̄/∂x_i`` and ``∂²m̄/∂x_i²``
+  of the exact noise-free segment means by central differences with step ``u(x_i)`` (JCGM 100
+  5.1.3 note 2), averaged over the table start angle: every component in one kernel call, each
+  segment evaluated only where the component enters it;
 - :func:`table_groups` — which components of the simulator's draws vector each table and fixture
   error occupies (names of :mod:`plansim.kernels.layout`);
 - :func:`rate_derivatives` — the outputs' response to the table rate, for the rate jitter.
@@ -19,7 +20,6 @@ equally spaced angles are exact.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -28,21 +28,25 @@ from plansim.config import ErrorDistribution, Scenario
 from plansim.estimate import reduction_matrix
 from plansim.kernels.layout import (
     FIXTURE,
+    HEAD,
     N_CHANNELS,
+    PER_SEGMENT,
     RATE_SYSTEMATIC,
     SEG_PHASE,
     SEG_POSITION_ACCURACY,
     SEG_POSITION_REPEATABILITY,
     SEG_RATE_ERROR,
     TILT,
+    draws_length,
     perpendicularity_index,
     segment_base,
 )
+from plansim.kernels.segment_path import noise_free_mean_differences
 from plansim.model.parameters import N_PARAMETERS
-from plansim.simulate.arguments import noise_free_segment_means, nominal_draws
+from plansim.simulate.arguments import kernel_arguments, noise_free_arguments, nominal_draws
 
-__all__ = ["PHASE_NODES", "estimator_matrix", "finite_differences", "phase_grid_draws", "rate_derivatives",
-           "table_groups"]
+__all__ = ["PHASE_NODES", "estimator_matrix", "finite_differences", "phase_angles", "phase_grid_draws",
+           "rate_derivatives", "segment_mean_derivatives", "table_groups"]
 
 #: Start angles at which the noise-free means are evaluated: the means are trigonometric
 #: polynomials of degree ≤ 3 in the start angle, so averages of their products (degree ≤ 6) over
@@ -85,12 +89,17 @@ def estimator_matrix(scenario: Scenario) -> np.ndarray:
     return np.ascontiguousarray(matrix.T.reshape(N_PARAMETERS, len(scenario.schedule), N_CHANNELS))
 
 
+def phase_angles() -> np.ndarray:
+    """The :data:`PHASE_NODES` start angles ``2πj/J`` (rad) over which the noise-free means are averaged."""
+    return 2.0 * math.pi * np.arange(PHASE_NODES) / PHASE_NODES
+
+
 def phase_grid_draws(scenario: Scenario, draws: np.ndarray | None = None) -> np.ndarray:
     """(J, D): *draws* (default nominal) with every segment's start angle at 2πj/J, J = :data:`PHASE_NODES`."""
     base = nominal_draws(scenario) if draws is None else np.asarray(draws, dtype=float)
     n_seg = len(scenario.schedule)
     grid = np.tile(base, (PHASE_NODES, 1))
-    phases = 2.0 * math.pi * np.arange(PHASE_NODES) / PHASE_NODES
+    phases = phase_angles()
     for s in range(n_seg):
         grid[:, segment_base(s) + SEG_PHASE] = phases
     return grid
@@ -122,13 +131,70 @@ def table_groups(scenario: Scenario) -> list[tuple[str, ErrorDistribution, list[
     return [g for g in groups if g[1].standard_uncertainty > 0 and g[2]]
 
 
+def segment_mean_derivatives(scenario: Scenario, indices: np.ndarray, steps: np.ndarray,
+                             arguments: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The noise-free segment means at the nominal draws, and their first and second derivatives.
+
+    Central differences with step ``steps[k]`` around the nominal draws (JCGM 100 5.1.3 note 2),
+    averaged over the table start angle (:data:`PHASE_NODES` angles): the derivatives of the
+    expected means. One call of :func:`plansim.kernels.segment_path.noise_free_mean_differences`,
+    which evaluates a segment only where the component enters it (a position error of one segment
+    moves that segment alone), so the result is that of evaluating every perturbed draws vector in
+    full, bit for bit, at a fraction of the cost.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    indices : (K,) array of int
+        Components of the draws vector (:mod:`plansim.kernels.layout`); not start angles.
+    steps : (K,) array
+        Step of each component (its standard uncertainty).
+    arguments : dict, optional
+        :func:`plansim.simulate.arguments.kernel_arguments` of *scenario*, if the caller has them.
+
+    Returns
+    -------
+    nominal : (J, S, 6) ndarray
+        The noise-free means at the nominal draws with every start angle at ``2πj/J``
+        (:func:`phase_grid_draws`).
+    first, second : (K, S, 6) ndarray
+        ``∂m̄/∂x_k`` and ``∂²m̄/∂x_k²``, averaged over the start angle.
+
+    Raises
+    ------
+    ValueError
+        An index is out of range or is a start angle, or *steps* does not match *indices*.
+    """
+    n_seg = len(scenario.schedule)
+    indices = np.ascontiguousarray(indices, dtype=np.int64)
+    steps = np.ascontiguousarray(steps, dtype=float)
+    if indices.ndim != 1 or steps.shape != indices.shape:
+        raise ValueError(f"indices, steps: shapes {indices.shape}, {steps.shape}; expected two (K,) arrays")
+    size = draws_length(n_seg)
+    if np.any((indices < 0) | (indices >= size)) or np.any(
+            (indices >= HEAD) & ((indices - HEAD) % PER_SEGMENT == SEG_PHASE)):
+        raise ValueError(f"indices = {indices.tolist()}: expected components of the draws vector (0 … {size - 1}) "
+                         "other than the start angles")
+    n_in = len(indices)
+    nominal = np.empty((PHASE_NODES, n_seg, N_CHANNELS))
+    centre = np.empty((1, n_seg, N_CHANNELS))
+    mean_plus = np.empty((n_in, n_seg, N_CHANNELS))
+    mean_minus = np.empty((n_in, n_seg, N_CHANNELS))
+    noise_free_mean_differences(nominal_draws(scenario), phase_angles(), indices, steps,
+                                **noise_free_arguments(scenario, arguments), phase_means_out=nominal,
+                                centre_out=centre, plus_out=mean_plus, minus_out=mean_minus)
+    first = (mean_plus - mean_minus) / (2.0 * steps[:, None, None])
+    second = (mean_plus + mean_minus - 2.0 * centre) / steps[:, None, None] ** 2
+    return nominal, first, second
+
+
 def finite_differences(scenario: Scenario, indices: np.ndarray, steps: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray]:
     """First and second derivatives (K, S, 6) of the noise-free segment means w.r.t. draws components.
 
     Central differences with step ``steps[k]`` around the nominal draws (JCGM 100 5.1.3 note 2),
     averaged over the table start angle (:data:`PHASE_NODES` angles): the derivatives of the
-    expected means.
+    expected means (:func:`segment_mean_derivatives`, without the nominal means).
 
     Parameters
     ----------
@@ -138,43 +204,27 @@ def finite_differences(scenario: Scenario, indices: np.ndarray, steps: np.ndarra
     steps : (K,) array
         Step of each component (its standard uncertainty).
     """
-    grid = phase_grid_draws(scenario)  # (J, D)
-    n_in = len(indices)
-    n_seg = len(scenario.schedule)
-    if n_in == 0:
-        return np.zeros((0, n_seg, N_CHANNELS)), np.zeros((0, n_seg, N_CHANNELS))
-    plus = np.repeat(grid[None, :, :], n_in, axis=0)  # (K, J, D)
-    minus = plus.copy()
-    k = np.arange(n_in)
-    plus[k, :, indices] += steps[:, None]
-    minus[k, :, indices] -= steps[:, None]
-    d = grid.shape[1]
-    shape = (n_in, PHASE_NODES, n_seg, N_CHANNELS)
-    mean_plus = noise_free_segment_means(scenario, plus.reshape(-1, d)).reshape(shape).mean(1)
-    mean_minus = noise_free_segment_means(scenario, minus.reshape(-1, d)).reshape(shape).mean(1)
-    centre = noise_free_segment_means(scenario, grid).mean(axis=0)
-    first = (mean_plus - mean_minus) / (2.0 * steps[:, None, None])
-    second = (mean_plus + mean_minus - 2.0 * centre[None]) / steps[:, None, None] ** 2
+    _, first, second = segment_mean_derivatives(scenario, indices, steps)
     return first, second
 
 
-def rate_derivatives(scenario: Scenario) -> np.ndarray:
+def rate_derivatives(scenario: Scenario, arguments: dict | None = None) -> np.ndarray:
     """(S, 6): ``rate · ∂(segment mean)/∂(rate)`` of each rotating segment, averaged over the start angle.
 
     The response of the outputs to the per-sample rate jitter of the table: the gyro input ω·u
     (and with it P·ω²) follows the rate, the centripetal term of the lever arm does not (the
     simulator jitters the gyro input only), so the derivative is taken with the lever arm removed,
     by central differences of the noise-free means in the relative rate error of each point.
+    *arguments*: :func:`plansim.simulate.arguments.kernel_arguments` of *scenario*, if the caller has them.
     """
-    without_lever = dataclasses.replace(
-        scenario, effects=dataclasses.replace(scenario.effects, accel_lever_arm=np.zeros((3, 3))))
+    without_lever = dict(kernel_arguments(scenario) if arguments is None else arguments, lever=np.zeros((3, 3)))
     segments = scenario.schedule.segments
     rotating = [s for s, seg in enumerate(segments) if seg.rate != 0.0]
     out = np.zeros((len(segments), N_CHANNELS))
     if not rotating:
         return out
     indices = np.array([segment_base(s) + SEG_RATE_ERROR for s in rotating], dtype=np.int64)
-    first, _ = finite_differences(without_lever, indices, np.full(len(rotating), RATE_STEP))
+    _, first, _ = segment_mean_derivatives(scenario, indices, np.full(len(rotating), RATE_STEP), without_lever)
     for k, s in enumerate(rotating):
         out[s] = first[k, s]
     return out
