@@ -303,6 +303,17 @@ class MeanModel:
         lo = self.evaluate(self._at_angles(minus), self.gravity - gravity_step, earth - earth_step)
         return (hi - lo) / (2.0 * step)
 
+    def segment_sensitivity(self, theta: np.ndarray, entry: int, tilts=None) -> np.ndarray:
+        """Sensitivity (ANGLES, S, 6) of each segment's mean, at each start angle, to its own table error *entry*
+        (``SEG_POSITION_ACCURACY + 2·axis``: a rotation of the pose about East, North or Up, per rad;
+        ``SEG_RATE_ERROR``: the relative rate error of its point), by central differences (all segments at once:
+        each segment's entries move only its own mean)."""
+        if entry not in (SEG_POSITION_ACCURACY, SEG_POSITION_ACCURACY + 2, SEG_POSITION_ACCURACY + 4, SEG_RATE_ERROR):
+            raise ValueError(f"entry = {entry!r}: expected a per-segment position error (SEG_POSITION_ACCURACY + 0, "
+                             "2, 4) or SEG_RATE_ERROR")
+        step = RATE_STEP if entry == SEG_RATE_ERROR else ANGLE_STEP
+        return self._central(theta, HEAD + PER_SEGMENT * np.arange(self.n_segments) + entry, step, tilts=tilts)
+
     @staticmethod
     def _source(name: str, kind: str, u: float, at_angles: np.ndarray, segment: int | None = None) -> InputSource:
         """An input source from its sensitivities at the start angles (ANGLES, S, 6), for one segment or all."""
@@ -332,15 +343,14 @@ class MeanModel:
                                 turntable.position_repeatability.standard_uncertainty)
         if u_position > 0:
             for axis, name in enumerate("ENU"):
-                columns = HEAD + PER_SEGMENT * np.arange(S) + SEG_POSITION_ACCURACY + 2 * axis
-                d = self._central(theta, columns, ANGLE_STEP, tilts=tilts)  # (ANGLES, S, 6): each its own
+                d = self.segment_sensitivity(theta, SEG_POSITION_ACCURACY + 2 * axis, tilts)
                 for s in range(S):
                     if np.any(d[:, s]) and not self.placed[s]:
                         sources.append(self._source(f"position error about {name}, segment {s}", "table",
                                                     u_position, d, s))
         u_point = turntable.rate_error_per_point.standard_uncertainty
         if u_point > 0 and self.rotating.any():
-            d = self._central(theta, HEAD + PER_SEGMENT * np.arange(S) + SEG_RATE_ERROR, RATE_STEP, tilts=tilts)
+            d = self.segment_sensitivity(theta, SEG_RATE_ERROR, tilts)
             for s in np.flatnonzero(self.rotating):
                 sources.append(self._source(f"rate error of the point, segment {s}", "table", u_point, d, s))
         per_calibration = [
