@@ -168,3 +168,119 @@ def test_exact_rate_point_designs_match_pydoe(degree, n):
     ours = math.exp(-Criterion("D").value(information(blocks, counts / n)))
     _, info = pydoe.optimal_design(grid[:, None], n_points=n, degree=degree, criterion="D", method="fedorov")
     assert math.isclose(ours, info["score"], rel_tol=1e-9)
+
+
+# ------------------------------------------------------------------------------------- the MIMU's schedules
+import dataclasses  # noqa: E402
+
+import plansim  # noqa: E402
+from plansim.design.alias import EFFECTS, alias_matrix  # noqa: E402
+from plansim.design.catalogue import candidate_information, default_candidates, select_parameters  # noqa: E402
+from plansim.design.schedule_design import design_efficiency, exact_design, optimal_design  # noqa: E402
+
+#: a table without position errors: the closed form of the multi-position design assumes none
+PERFECT_TABLE = ['turntable.position_accuracy="0 arcsec"', 'turntable.position_repeatability="0 arcsec"']
+
+
+def multi_position_only(scenario):
+    return dataclasses.replace(scenario.schedule, segments=tuple(
+        s for s in scenario.schedule.segments if s.test == "multi_position"))
+
+
+@pytest.mark.parametrize("positions", [6, 12])
+def test_appendix_c_positions_are_d_optimal_for_the_accelerometers(positions):
+    # Ka and Ba from the accelerometers at rest: regressors (a, 1) with a = g·u; any design whose directions u
+    # have second moment I/3 and mean 0 has φ(u) = 1 + 3|u|² = 4 = p per channel on the whole sphere, so the
+    # 6 and 12 positions of Appendix C are D-optimal among all poses, tilted ones included (efficiency 1)
+    scenario = plansim.load_scenario("jjf2003", PERFECT_TABLE + [f"schedule.positions={positions}"])
+    static = [c for c in default_candidates(scenario, dwells=(30.0,)) if c.kind != "rate"]
+    efficiency, best = design_efficiency(scenario, multi_position_only(scenario), "D", ["Ka", "Ba"],
+                                         ["ax", "ay", "az"], candidates=static)
+    assert best.design.certificate.efficiency_bound >= 1 - 1e-6
+    assert efficiency == pytest.approx(1.0, abs=1e-9)
+
+
+def test_table_position_errors_make_tilted_poses_better_for_the_accelerometers():
+    # with JJF 2003 Table 1's position errors a horizontal accelerometer reads g·δ of a setting that does not
+    # average: the axis-aligned poses lose efficiency against poses tilted 45° (a finding, docs/planning.md)
+    scenario = plansim.load_scenario("jjf2003")
+    static = [c for c in default_candidates(scenario, dwells=(30.0,)) if c.kind != "rate"]
+    efficiency, best = design_efficiency(scenario, multi_position_only(scenario), "D", ["Ka", "Ba"],
+                                         ["ax", "ay", "az"], candidates=static)
+    assert efficiency < 0.9
+    assert best.support[0][0].kind == "tilted"
+
+
+def test_information_is_the_jacobian_weighted_by_the_noise():
+    scenario = plansim.load_scenario("jjf2003")
+    info = candidate_information(scenario, default_candidates(scenario, dwells=(10.0, 300.0)))
+    blocks = info.blocks()
+    k = 5
+    expected = info.jacobian[k].T @ np.linalg.solve(info.covariance[k], info.jacobian[k])
+    np.testing.assert_allclose(blocks[k], expected, rtol=1e-10, atol=1e-12 * np.abs(expected).max())
+    # a longer dwell lowers the white noise of the mean but not its drift: the variance falls by less than 30×
+    short = [i for i, c in enumerate(info.candidates) if c.kind == "pose" and c.dwell == 10.0][0]
+    long = [i for i, c in enumerate(info.candidates) if c.kind == "pose" and c.dwell == 300.0][0]
+    ratio = info.covariance[short, 0, 0] / info.covariance[long, 0, 0]
+    assert 1.0 < ratio < 30.0
+    np.testing.assert_allclose(info.costs, [c.settle + c.dwell for c in info.candidates])
+
+
+def test_optimal_design_is_certified_and_exact_design_keeps_the_budget():
+    scenario = plansim.load_scenario("jjf2003")
+    result = optimal_design(scenario, "D")
+    assert result.design.certificate.efficiency_bound >= 1 - 1e-4
+    ds = result.to_dataset()
+    assert ds.time_fraction.sum() == pytest.approx(1.0)
+    assert float(ds.derivative.max()) <= 1 / (1 - 1e-4)
+    schedule = exact_design(result, table_time=3600.0)
+    assert schedule.duration <= 3600.0 * 1.05  # rounding to whole segments may add one segment's time
+    c = optimal_design(scenario, "c", c="Kgxx")
+    kinds = {cand.kind for cand, w in c.support if w > 0.01}
+    assert "rate" in kinds  # the scale factor is measured by turning
+
+
+@pytest.mark.parametrize("bad, message", [
+    (dict(criterion="E"), "allowed: D, A, c"),
+    (dict(parameters=["Kgxq"]), "Kgxq"),
+    (dict(channels=["gw"]), "gw"),
+    (dict(criterion="c", c="Kg"), "one parameter"),
+])
+def test_design_arguments_are_checked(bad, message):
+    with pytest.raises(ValueError, match=message):
+        optimal_design(plansim.load_scenario("ideal"), **bad)
+
+
+def test_select_parameters_takes_names_and_groups():
+    assert list(select_parameters(["Bg", "Kgxx"])) == [0, 9, 10, 11]
+
+
+def test_vertical_earth_rate_aliases_into_g_ii_in_a_static_schedule():
+    # JJF 2003's multi-position estimate of g_ii: gyro i up and down reads ±(g·g_ii + Kg_ii·Ω_U), so the
+    # specification's estimator returns g_ii + Kg_ii·Ω_U/g_ref: the alias is Kg_ii/g_ref per rad/s
+    scenario = plansim.load_scenario("jjf2003")
+    spec = alias_matrix(scenario, estimator="jjf2003")
+    names = [p.name for p in plansim.model.parameters.PARAMETERS]
+    e = list(EFFECTS).index("earth_rate_up")
+    for i, axis in enumerate("xyz"):
+        kg = scenario.truth_nominal[names.index(f"Kg{axis}{axis}")]
+        assert spec.alias[e, names.index(f"g{axis}{axis}")] == pytest.approx(
+            kg / scenario.reduction.reference_gravity, rel=1e-6)
+    # in a static schedule no fit can separate it: the rates would, and are named
+    static = alias_matrix(scenario, multi_position_only(scenario), estimator="wls")
+    assert not static.separable[e]
+    assert static.separated_by[e] and static.separated_by[e][0][0].startswith("rate")
+    # with the rate test in the schedule it is separable
+    assert alias_matrix(scenario, estimator="wls").separable[e]
+
+
+def test_lever_arm_aliases_into_p_in_the_omega_squared_test():
+    # accelerometer i at r from the table axis reads −ω²·r_⊥ (centripetal), the ω² law of p: the estimate of
+    # p_ij (accelerometer i, rate about j) moves by −1 (m/s² per (rad/s)²) per metre of r_i
+    scenario = plansim.load_scenario("jjf2003")
+    spec = alias_matrix(scenario, estimator="jjf2003")
+    names = [p.name for p in plansim.model.parameters.PARAMETERS]
+    e = list(EFFECTS).index("lever_arm_x")
+    assert spec.alias[e, names.index("pxy")] == pytest.approx(-1.0, rel=1e-2)
+    assert spec.alias[e, names.index("pxz")] == pytest.approx(-1.0, rel=1e-2)
+    assert not alias_matrix(scenario, multi_position_only(scenario), estimator="wls").separable[e]

@@ -13,7 +13,8 @@ estimate from N units of the design. The criteria, each written as a quantity to
 - **D**: ``−log det M`` (the volume of the confidence ellipsoid);
 - **A**: ``tr M⁻¹`` (the sum of the parameters' variances; with a ``scale`` vector s, ``tr(S M⁻¹ S)``
   with S = diag(1/s), the sum of the squared relative uncertainties);
-- **c**: ``cᵀ M⁻¹ c`` (the variance of one linear combination cᵀθ, e.g. one parameter).
+- **c**: ``cᵀ M⁻ c`` (the variance of one linear combination cᵀθ, e.g. one parameter; M⁻ a generalised
+  inverse: a c-optimal design often leaves the other parameters unidentified, Pukelsheim 1993, §2.14).
 
 Each has a *directional derivative* ``φ_i(ξ)`` towards candidate *i* and a *bound* ``b(ξ)`` with
 ``Σ_i w_i φ_i = b``; the **Kiefer–Wolfowitz equivalence theorem** (Kiefer & Wolfowitz 1960; Pukelsheim
@@ -132,6 +133,9 @@ class Criterion:
         if self.kind == "D":
             sign, logdet = np.linalg.slogdet(M)
             return -logdet if sign > 0 else np.inf
+        if self.kind == "c":
+            x = self._solve_c(M)
+            return np.inf if x is None else float(self.c @ x)
         try:
             inverse = np.linalg.inv(M)
         except np.linalg.LinAlgError:
@@ -143,11 +147,24 @@ class Criterion:
         """Directional derivatives φ_i (n,) towards each candidate and the bound b, at *M* (nonsingular)."""
         p = M.shape[0]
         self._check(p)
+        if self.kind == "c":  # c-optimal information is often singular: M⁻c from any generalised inverse
+            x = self._solve_c(M)
+            if x is None:
+                raise ValueError("c-criterion: cᵀθ is not estimable at this design")
+            return np.einsum("j,ijk,k->i", x, blocks, x), float(self.c @ x)
         inverse = np.linalg.inv(M)
         if self.kind == "D":
             return np.einsum("jk,ikj->i", inverse, blocks), float(p)
         G = inverse @ self._weight(p) @ inverse
         return np.einsum("jk,ikj->i", G, blocks), float(np.trace(self._weight(p) @ inverse))
+
+    def _solve_c(self, M: np.ndarray) -> np.ndarray | None:
+        """x with M·x = c (a generalised-inverse solution; cᵀx does not depend on which), or None when c is not in
+        the range of M (cᵀθ not estimable): the residual above 1e-9 of |c|."""
+        x = np.linalg.lstsq(M, self.c, rcond=1e-13)[0]
+        if np.linalg.norm(M @ x - self.c) > 1e-9 * np.linalg.norm(self.c):
+            return None
+        return x
 
     def efficiency(self, M: np.ndarray, M_best: np.ndarray) -> float:
         """Efficiency of a design of information *M* relative to one of *M_best* (1 when as good), per unit weight:
