@@ -2,7 +2,8 @@
 
 The prediction is the GUM (JCGM 100) evaluation of the scenario's actual reduction and design
 (:func:`plansim.uncertainty.gum.evaluate_gum`; docs/uncertainty.md), returned as a self-describing
-Dataset. It includes what makes calibration schedules differ:
+Dataset: its figures alone (:func:`plansim.uncertainty.gum.gum_uncertainties`, the same numbers
+without building the 39 budgets behind them). It includes what makes calibration schedules differ:
 
 - **noise floors**: the segment means' noise follows the scenario's noise model, so bias instability
   and rate random walk stop averaging down with dwell (the drift covariance of
@@ -23,12 +24,11 @@ quarter step): there the Monte Carlo is the reference.
 
 from __future__ import annotations
 
-import numpy as np
 import xarray as xr
 
 from plansim.config import Scenario
 from plansim.model.parameters import PARAMETERS
-from plansim.uncertainty.gum import evaluate_gum
+from plansim.uncertainty.gum import gum_uncertainties
 
 
 def predict(scenario: Scenario, coverage_probability: float = 0.95) -> xr.Dataset:
@@ -68,7 +68,7 @@ def predict(scenario: Scenario, coverage_probability: float = 0.95) -> xr.Datase
         raise TypeError(f"scenario: expected a plansim Scenario (plansim.load_scenario), got {type(scenario).__name__}")
     if not 0 < coverage_probability < 1:
         raise ValueError(f"coverage_probability = {coverage_probability!r}: must be between 0 and 1")
-    gum = evaluate_gum(scenario, coverage_probability=coverage_probability)
+    gum = gum_uncertainties(scenario, coverage_probability=coverage_probability)
     names = [p.name for p in PARAMETERS]
     coords = {"parameter": ("parameter", names),
               "unit": ("parameter", [p.si_unit for p in PARAMETERS]),
@@ -82,9 +82,9 @@ def predict(scenario: Scenario, coverage_probability: float = 0.95) -> xr.Datase
                                                        "(systematic effects the estimators do not correct)"}),
         "U_predicted": ("parameter", gum.expanded_uncertainty,
                         {"units": per, "long_name": f"predicted expanded uncertainty, p = {coverage_probability:g}"}),
-        "coverage_factor": ("parameter", np.array([b.coverage_factor for b in gum.budgets]),
+        "coverage_factor": ("parameter", gum.coverage_factor,
                             {"units": "1", "long_name": "coverage factor k (t-distribution at nu_eff)"}),
-        "effective_dof": ("parameter", np.array([b.effective_dof for b in gum.budgets]),
+        "effective_dof": ("parameter", gum.effective_dof,
                           {"units": "1", "long_name": "Welch-Satterthwaite effective degrees of freedom"}),
         "covariance": (("parameter", "parameter_"), gum.covariance,
                        {"units": "product of the two parameters' SI units",

@@ -4,7 +4,8 @@
 - :class:`SystematicEffect` — an uncorrected effect as a bias (JCGM 100 3.2.4);
 - :class:`AppendixAView` — the JJF 2003-2022 Appendix A budget of a parameter beside this one;
 - :class:`ParameterBudget` — ``y``, the lines, ``u_c`` (5.1.2), ``ν_eff`` (G.4.1), ``k`` (G.3.4), ``U`` (6.2.1);
-- :class:`GumEvaluation` — all 39 budgets and the covariance of the errors (5.2.2; JCGM 102 6.2).
+- :class:`GumEvaluation` — all 39 budgets and the covariance of the errors (5.2.2; JCGM 102 6.2);
+- :class:`GumUncertainties` — its figures alone (``y``, ``u_c``, ``ν_eff``, ``k``, ``U``, the covariance).
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ import numpy as np
 
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
 
-__all__ = ["CATEGORIES", "AppendixAView", "GumEvaluation", "InputContribution", "ParameterBudget", "SystematicEffect"]
+__all__ = ["CATEGORIES", "AppendixAView", "GumEvaluation", "GumUncertainties", "InputContribution", "ParameterBudget",
+           "SystematicEffect"]
 
 #: Appendix A's three components, and the budget lines that belong to each.
 CATEGORIES = ("table", "acquisition", "repeatability", "unit")
@@ -258,3 +260,37 @@ class GumEvaluation:
         r = self.covariance / np.outer(scale, scale)
         np.fill_diagonal(r, np.where(u > 0, 1.0, 0.0))
         return r
+
+
+@dataclass(frozen=True)
+class GumUncertainties:
+    """The figures of a :class:`GumEvaluation` without the budgets: each an array over the 39 parameters, SI.
+
+    Attributes
+    ----------
+    scenario : str
+        Scenario name.
+    estimate : ndarray (39,)
+        ``y``: the error at the expectation of the inputs (the uncorrected systematic effects, GUM 4.1.4).
+    standard_uncertainty : ndarray (39,)
+        ``u_c`` (GUM 5.1.2, 5.2.2).
+    effective_dof : ndarray (39,)
+        ``ν_eff`` (G.4.1).
+    coverage_factor : ndarray (39,)
+        ``k_p`` (G.3.4).
+    expanded_uncertainty : ndarray (39,)
+        ``U_p = k_p·u_c`` (6.2.1).
+    covariance : ndarray (39, 39)
+        Covariance of the parameter errors (GUM 5.2.2; JCGM 102 6.2).
+    coverage_probability : float
+        ``p`` of the expanded uncertainties.
+    """
+
+    scenario: str
+    estimate: np.ndarray
+    standard_uncertainty: np.ndarray
+    effective_dof: np.ndarray
+    coverage_factor: np.ndarray
+    expanded_uncertainty: np.ndarray
+    covariance: np.ndarray
+    coverage_probability: float

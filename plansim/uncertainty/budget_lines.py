@@ -71,8 +71,14 @@ def _distribution_text(error: ErrorDistribution, unit: str) -> str:
     return f"normal, σ = {error.scale:.4g}{shown}"
 
 
-def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation: bool) -> list[Line]:
-    """Every budget line of *scenario*, for all 39 parameters at once.
+def _largest_second_order(matrix: np.ndarray, second: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """(39,): the largest ``½|∂²E/∂x_k²|·u_k²`` over the components k (*second*: (K, S, 6) ``∂²m̄/∂x_k²``)."""
+    return np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second)) * u[None, :] ** 2, axis=1)
+
+
+def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation: bool, describe: bool = True
+                ) -> tuple[list[Line], np.ndarray]:
+    """Every budget line of *scenario*, for all 39 parameters at once, and the expected segment means.
 
     Parameters
     ----------
@@ -83,12 +89,21 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         Correlate the quantisation errors of the segments of a channel
         (:func:`plansim.uncertainty.quantisation.quantisation_covariance`), or keep Appendix A's
         independent readings.
+    describe : bool
+        Also what only a budget shows: the largest second-order term of each linearised line
+        (``Line.second_order``) and the quantiser's dither regime in the distribution of its line.
+        ``False`` leaves them out (``None``; the distribution without the regime) and changes no
+        number: the prediction (:func:`plansim.uncertainty.gum.gum_uncertainties`) needs none of them.
 
     Returns
     -------
-    list of Line
+    lines : list of Line
         In the order table and fixture errors, start angle, unit-to-unit spread, white noise, drift,
         rate smoothness, quantisation.
+    expected_means : (S, 6) ndarray
+        The noise-free segment means at the expectation of the inputs (nominal draws), averaged over
+        the table start angle: the linearisation point, whose reduction is the predicted bias
+        (:func:`plansim.uncertainty.systematic.expected_error`).
     """
     lines: list[Line] = []
     segments = scenario.schedule.segments
@@ -123,8 +138,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
                 name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
                 u=u, input_unit=unit, columns=np.einsum("psc,ksc->pk", matrix, d_means),
                 note="c by central differences of the noise-free segment means, step u(x)",
-                second_order=np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second[start:stop]))
-                                    * u[None, :] ** 2, axis=1)))
+                second_order=_largest_second_order(matrix, second[start:stop], u) if describe else None))
             start = stop
 
     # table start angle of the rotating segments: exact variance over the angle
@@ -138,8 +152,11 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         for s in rotating:
             d = np.einsum("pc,jc->jp", matrix[:, s, :], deviation[:, s, :])  # (J, 39)
             cov += d.T @ d / PHASE_NODES
-            for c in range(N_CHANNELS):
-                offsets[c][s, s] += float(np.mean(deviation[:, s, c] ** 2))
+        # the variance over the angle of each rotating segment's mean, per channel (the angle last: the
+        # same pairwise sum as the mean of each segment and channel alone)
+        squares = np.mean(np.ascontiguousarray(np.moveaxis(deviation[:, rotating, :] ** 2, 0, -1)), axis=-1)
+        for c in range(N_CHANNELS):
+            offsets[c][rotating, rotating] += squares[:, c]
         if np.any(np.diag(cov) > 0):
             lines.append(Line(
                 name="table start angle", category="table", evaluation="B",
@@ -161,15 +178,14 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
             name="unit-to-unit spread", category="unit", evaluation="B", distribution="normal (mimu.truth_spread)",
             u=spread[idx], input_unit="SI of each parameter", columns=columns, mixed_units=True,
             note="∂E/∂Y = R·∂m/∂Y − 1: the error's dependence on the true value",
-            second_order=np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second)) * spread[idx][None, :] ** 2,
-                                axis=1)))
+            second_order=_largest_second_order(matrix, second, spread[idx]) if describe else None))
 
     # white noise of the segment means (type A, ν = n − 1)
     for label, channels in (("white noise, gyros", _GYROS), ("white noise, accelerometers", _ACCELS)):
-        u = np.array([[noise[c, NOISE_WHITE] / math.sqrt(durations[s]) for c in channels] for s in range(n_seg)])
+        u = noise[channels, NOISE_WHITE][None, :] / np.sqrt(durations)[:, None]  # (S, 3)
         if not np.any(u > 0):
             continue
-        columns = np.stack([matrix[:, s, c] * u[s, i] for s in range(n_seg) for i, c in enumerate(channels)], axis=1)
+        columns = (matrix[:, :, channels] * u[None]).reshape(N_PARAMETERS, -1)  # component (s, channel), s-major
         dof = np.repeat(samples - 1.0, len(channels))
         dof = np.where(dof > 0, dof, np.inf)
         unit = "rad/s" if label.endswith("gyros") else "m/s^2"
@@ -214,7 +230,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         for label, channels, step in (("quantisation, gyros", _GYROS, a.gyro_step),
                                       ("quantisation, accelerometers", _ACCELS, a.accel_step)):
             cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
-            fractions, u_means = [], []
+            sigmas, u_means = [], []
             for c in channels:
                 sigma = np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2)
                 if quantisation_correlation:
@@ -223,18 +239,19 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
                     q_cov = np.diag([quantisation_variance(step, float(sigma[s]), int(samples[s]))[0]
                                      for s in range(n_seg)])
                 cov += matrix[:, :, c] @ q_cov @ matrix[:, :, c].T
-                fractions.extend(quantisation_variance(step, float(sigma[s]), int(samples[s]))[1]
-                                 for s in range(n_seg))
+                sigmas.append(sigma)
                 u_means.extend(np.sqrt(np.diag(q_cov)))
-            worst = max(fractions)
-            regime = ("no dither: rectangular ±q/2 per segment mean" if worst > 1.0 - 1e-6 else
-                      "dithered: q²/12 per sample, averaged" if worst < 1e-6 else
-                      f"partly dithered: up to {worst:.2g} of q²/12 not averaged by the noise")
+            distribution = f"rectangular, q = {step:.4g}"
+            if describe:  # the undithered fraction depends on σ alone: once per distinct σ
+                worst = max(quantisation_variance(step, float(x), 1)[1] for x in np.unique(sigmas))
+                distribution += "; " + ("no dither: rectangular ±q/2 per segment mean" if worst > 1.0 - 1e-6 else
+                                        "dithered: q²/12 per sample, averaged" if worst < 1e-6 else
+                                        f"partly dithered: up to {worst:.2g} of q²/12 not averaged by the noise")
             correlation = ("segments correlated through the shared quantiser offset" if quantisation_correlation
                            else "segment means independent (Appendix A)")
             lines.append(Line(
                 name=label, category="acquisition", evaluation="B",
-                distribution=f"rectangular, q = {step:.4g}; {regime}",
+                distribution=distribution,
                 u=np.asarray(u_means), input_unit="rad/s" if label.endswith("gyros") else "m/s^2", covariance=cov,
                 note=f"Appendix A eq. (A.3); {correlation}"))
-    return lines
+    return lines, nominal

@@ -94,16 +94,17 @@ from plansim.uncertainty.appendix_a import APPENDIX_A, AppendixABudget, reading_
 from plansim.uncertainty.budget import (
     AppendixAView,
     GumEvaluation,
+    GumUncertainties,
     InputContribution,
     ParameterBudget,
     SystematicEffect,
 )
-from plansim.uncertainty.budget_lines import model_lines
+from plansim.uncertainty.budget_lines import Line, model_lines
 from plansim.uncertainty.metrology.propagation import DEFAULT_COVERAGE_PROBABILITY, coverage_factor, welch_satterthwaite
 from plansim.uncertainty.sensitivities import estimator_matrix
-from plansim.uncertainty.systematic import systematic_effects
+from plansim.uncertainty.systematic import expected_error, systematic_effects
 
-__all__ = ["NEGLIGIBLE", "evaluate_gum"]
+__all__ = ["NEGLIGIBLE", "evaluate_gum", "gum_uncertainties"]
 
 #: Budget lines below this fraction of u_c are left out (10⁻¹² of the variance: numerical noise).
 NEGLIGIBLE = 1e-6
@@ -119,6 +120,106 @@ def _appendix_view(budget: AppendixABudget, name: str, scenario: Scenario, per_c
         printed_uc=budget.printed_combined_standard_uncertainty, printed_U=budget.printed_expanded_uncertainty,
         same_inputs_gum_uc=same, same_inputs_gum_U=budget.coverage_factor * same,
         plansim_u=tuple(x / unit for x in per_category), plansim_uc=uc / unit, plansim_U95=U / unit)
+
+
+def _propagate(scenario: Scenario, coverage_probability: float, quantisation_correlation: bool,
+               relative_uncertainty_of_u: Mapping[str, float] | None, describe: bool
+               ) -> tuple[list[Line], np.ndarray, np.ndarray]:
+    """The budget lines of *scenario* (with the ν the user states), the covariance of the 39 errors
+    (GUM 5.2.2) and the expected segment means (:func:`~plansim.uncertainty.budget_lines.model_lines`)."""
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
+    coverage_factor(math.inf, coverage_probability)  # validates p
+    matrix = estimator_matrix(scenario)
+    if not isinstance(quantisation_correlation, bool):
+        raise TypeError(f"quantisation_correlation = {quantisation_correlation!r}: expected True or False")
+    lines, expected_means = model_lines(scenario, matrix, quantisation_correlation, describe)
+    if relative_uncertainty_of_u:
+        if not isinstance(relative_uncertainty_of_u, Mapping):
+            raise TypeError(f"relative_uncertainty_of_u = {relative_uncertainty_of_u!r}: expected a mapping of "
+                            "budget-line name -> relative uncertainty of its u")
+        by_name = {line.name: line for line in lines}
+        for name, r in relative_uncertainty_of_u.items():
+            if name not in by_name:
+                raise ValueError(f"relative_uncertainty_of_u: no input {name!r} in this scenario's budget; "
+                                 f"inputs: {', '.join(map(repr, by_name))}")
+            if isinstance(r, bool) or not isinstance(r, (int, float)) or not (math.isfinite(r) and r > 0):
+                raise ValueError(f"relative_uncertainty_of_u[{name!r}] = {r!r}: must be a number > 0")
+            line = by_name[name]
+            if line.evaluation != "B":
+                raise ValueError(f"relative_uncertainty_of_u[{name!r}]: a type A input has its degrees of freedom "
+                                 "from its sample count (GUM G.3.3); G.4.2 applies to type B inputs")
+            nu = 0.5 / r**2
+            if line.columns is not None:
+                line.dof = np.full(line.columns.shape[1], nu)
+            else:
+                line.line_dof = nu
+    covariance = np.zeros((N_PARAMETERS, N_PARAMETERS))
+    for line in lines:
+        covariance += line.cov()
+    covariance = 0.5 * (covariance + covariance.T)
+    return lines, covariance, expected_means
+
+
+def _effective_dof(lines: list[Line], variances: list[np.ndarray], uc: np.ndarray) -> np.ndarray:
+    """ν_eff (39,) by the Welch–Satterthwaite formula (JCGM 100 G.4.1, eq. (G.2b)).
+
+    Over every independent component with a finite ν of the lines that count for a parameter (a
+    contribution above :data:`NEGLIGIBLE`·u_c): each column of a line with per-component ν, or the
+    whole line with its ``line_dof``; ``inf`` where no such component is left or u_c is 0.
+    """
+    denominator = np.zeros(N_PARAMETERS)
+    for line, variance in zip(lines, variances):
+        contribution = np.sqrt(variance)
+        if line.columns is not None and line.dof is not None:
+            finite = np.isfinite(line.dof)
+            terms = np.sum(np.abs(line.columns[:, finite]) ** 4 / line.dof[finite], axis=1)
+        elif math.isfinite(line.line_dof):
+            terms = contribution**4 / line.line_dof
+        else:
+            continue
+        counts = (contribution > NEGLIGIBLE * uc) & (contribution != 0.0)  # below: the differences' numerical noise
+        denominator += np.where(counts, terms, 0.0)
+    finite = (denominator > 0) & (uc > 0)
+    return np.divide(uc**4, denominator, out=np.full(N_PARAMETERS, math.inf), where=finite)
+
+
+def _coverage_factors(dof: np.ndarray, coverage_probability: float) -> np.ndarray:
+    """k_p (39,) of every ν_eff (:func:`~plansim.uncertainty.metrology.propagation.coverage_factor`), once per value."""
+    factors = {v: coverage_factor(v, coverage_probability) for v in set(map(float, dof))}
+    return np.array([factors[float(v)] for v in dof])
+
+
+def gum_uncertainties(scenario: Scenario, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY,
+                      quantisation_correlation: bool = True) -> GumUncertainties:
+    """The figures of :func:`evaluate_gum` without the budgets behind them: ``y``, ``u_c``, ``ν_eff``, ``k``, ``U``.
+
+    The same lines, covariance and arithmetic as :func:`evaluate_gum`, so the same numbers, without
+    what only a budget shows (each line per parameter, the systematic effects one by one, the
+    Appendix A view, the second-order terms), which cost more than the figures themselves: for
+    :func:`plansim.planning.predict.predict` and what calls it once per schedule.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario (schedule, table, noise, acquisition, reduction).
+    coverage_probability : float
+        ``p`` of the expanded uncertainties (default 0.95).
+    quantisation_correlation : bool
+        As for :func:`evaluate_gum`.
+
+    Returns
+    -------
+    GumUncertainties
+    """
+    lines, covariance, expected_means = _propagate(scenario, coverage_probability, quantisation_correlation, None,
+                                                   describe=False)
+    uc = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    dof = _effective_dof(lines, [line.variance() for line in lines], uc)
+    k = _coverage_factors(dof, coverage_probability)
+    return GumUncertainties(scenario=scenario.name, estimate=expected_error(scenario, expected_means),
+                            standard_uncertainty=uc, effective_dof=dof, coverage_factor=k, expanded_uncertainty=k * uc,
+                            covariance=covariance, coverage_probability=coverage_probability)
 
 
 def evaluate_gum(scenario: Scenario, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY,
@@ -147,61 +248,31 @@ def evaluate_gum(scenario: Scenario, coverage_probability: float = DEFAULT_COVER
     -------
     GumEvaluation
         Per-parameter budgets (inputs, ``u_c``, ``ν_eff``, ``k``, ``U``, uncorrected systematic
-        effects, the Appendix A figure) and the covariance of the 39 errors.
+        effects, the Appendix A figure) and the covariance of the 39 errors. Only the figures:
+        :func:`gum_uncertainties`.
     """
-    if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
-    coverage_factor(math.inf, coverage_probability)  # validates p
-    matrix = estimator_matrix(scenario)
-    if not isinstance(quantisation_correlation, bool):
-        raise TypeError(f"quantisation_correlation = {quantisation_correlation!r}: expected True or False")
-    lines = model_lines(scenario, matrix, quantisation_correlation)
-    if relative_uncertainty_of_u:
-        if not isinstance(relative_uncertainty_of_u, Mapping):
-            raise TypeError(f"relative_uncertainty_of_u = {relative_uncertainty_of_u!r}: expected a mapping of "
-                            "budget-line name -> relative uncertainty of its u")
-        by_name = {line.name: line for line in lines}
-        for name, r in relative_uncertainty_of_u.items():
-            if name not in by_name:
-                raise ValueError(f"relative_uncertainty_of_u: no input {name!r} in this scenario's budget; "
-                                 f"inputs: {', '.join(map(repr, by_name))}")
-            if isinstance(r, bool) or not isinstance(r, (int, float)) or not (math.isfinite(r) and r > 0):
-                raise ValueError(f"relative_uncertainty_of_u[{name!r}] = {r!r}: must be a number > 0")
-            line = by_name[name]
-            if line.evaluation != "B":
-                raise ValueError(f"relative_uncertainty_of_u[{name!r}]: a type A input has its degrees of freedom "
-                                 "from its sample count (GUM G.3.3); G.4.2 applies to type B inputs")
-            nu = 0.5 / r**2
-            if line.columns is not None:
-                line.dof = np.full(line.columns.shape[1], nu)
-            else:
-                line.line_dof = nu
-    total, effects = systematic_effects(scenario)
-    covariance = np.zeros((N_PARAMETERS, N_PARAMETERS))
-    for line in lines:
-        covariance += line.cov()
-    covariance = 0.5 * (covariance + covariance.T)
+    lines, covariance, expected_means = _propagate(scenario, coverage_probability, quantisation_correlation,
+                                                   relative_uncertainty_of_u, describe=True)
+    total, effects = systematic_effects(scenario, expected_means)
     appendix = {name: b for b in APPENDIX_A for name in b.parameters}
 
     budgets = []
     variances = [line.variance() for line in lines]
+    ucs = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    dofs = _effective_dof(lines, variances, ucs)
+    ks = _coverage_factors(dofs, coverage_probability)
     for p, spec in enumerate(PARAMETERS):
         entries = []
-        ws_terms = []  # (contribution, dof) of every independent component with finite ν
         second = 0.0
-        uc = math.sqrt(max(float(covariance[p, p]), 0.0))
+        uc = float(ucs[p])
         for line, variance in zip(lines, variances):
             contribution = math.sqrt(float(variance[p]))
             if contribution <= NEGLIGIBLE * uc or contribution == 0.0:
                 continue  # below the numerical noise of the finite differences
             if line.columns is not None and line.dof is not None:
-                finite = np.isfinite(line.dof)
-                ws_terms.extend(zip(np.abs(line.columns[p, finite]), line.dof[finite]))
                 group_dof = welch_satterthwaite(line.columns[p], line.dof)
             else:
                 group_dof = line.line_dof
-                if math.isfinite(group_dof):
-                    ws_terms.append((contribution, group_dof))
             if line.second_order is not None:
                 second = max(second, float(line.second_order[p]))
             u_rms = float(np.sqrt(np.mean(line.u**2))) if line.u.size else math.nan
@@ -222,13 +293,8 @@ def evaluate_gum(scenario: Scenario, coverage_probability: float = DEFAULT_COVER
                 input_unit=line.input_unit, sensitivity=sensitivity, contribution=contribution,
                 dof=group_dof, components=int(line.u.size), note=line.note))
         entries.sort(key=lambda e: -e.contribution)
-        if ws_terms and uc > 0:
-            c, nu = np.array(ws_terms).T
-            denominator = float(np.sum(c**4 / nu))
-            dof = uc**4 / denominator if denominator > 0 else math.inf
-        else:
-            dof = math.inf
-        k = coverage_factor(dof, coverage_probability)
+        dof = float(dofs[p])
+        k = float(ks[p])
         U = k * uc
         found = tuple(SystematicEffect(name, float(bias[p]), note) for name, bias, note in effects if bias[p] != 0.0)
         view = None

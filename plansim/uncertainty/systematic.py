@@ -19,22 +19,35 @@ from plansim.model.parameters import N_PARAMETERS
 from plansim.simulate.arguments import noise_free_segment_means
 from plansim.uncertainty.sensitivities import phase_grid_draws
 
-__all__ = ["systematic_effects"]
+__all__ = ["expected_error", "systematic_effects"]
 
 
-def _phase_mean_estimate(scenario: Scenario) -> np.ndarray:
+def _phase_mean_estimate(scenario: Scenario, expected_means: np.ndarray | None = None) -> np.ndarray:
     """The reduction of the start-angle-averaged noise-free means at the nominal draws (39,)."""
-    means = noise_free_segment_means(scenario, phase_grid_draws(scenario)).mean(axis=0)
-    return reduce(means, scenario.schedule, scenario.reduction.reference_gravity,
+    if expected_means is None:
+        expected_means = noise_free_segment_means(scenario, phase_grid_draws(scenario)).mean(axis=0)
+    return reduce(expected_means, scenario.schedule, scenario.reduction.reference_gravity,
                   scenario.reduction.omega_squared_sign)
 
 
-def systematic_effects(scenario: Scenario) -> tuple[np.ndarray, list[tuple[str, np.ndarray, str]]]:
+def expected_error(scenario: Scenario, expected_means: np.ndarray | None = None) -> np.ndarray:
+    """``y`` (39,): estimate − truth of every parameter at the expectation of the inputs, SI (GUM 4.1.4).
+
+    The sum of the systematic effects the estimators do not correct (:func:`systematic_effects`
+    splits it). *expected_means* (S, 6): the noise-free segment means at the nominal draws averaged
+    over the table start angle, if the caller has them
+    (:func:`plansim.uncertainty.budget_lines.model_lines` returns them).
+    """
+    return _phase_mean_estimate(scenario, expected_means) - scenario.truth_nominal
+
+
+def systematic_effects(scenario: Scenario, expected_means: np.ndarray | None = None
+                       ) -> tuple[np.ndarray, list[tuple[str, np.ndarray, str]]]:
     """The expected error of every parameter and its split into uncorrected systematic effects.
 
     Each effect's bias is the estimate with the effect minus the estimate without it (all else as
     in the scenario), both from the noise-free segment means at the nominal draws averaged over the
-    table start angle.
+    table start angle. *expected_means*: as for :func:`expected_error`.
 
     Returns
     -------
@@ -45,7 +58,7 @@ def systematic_effects(scenario: Scenario) -> tuple[np.ndarray, list[tuple[str, 
     """
     if not isinstance(scenario, Scenario):
         raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
-    full = _phase_mean_estimate(scenario)
+    full = _phase_mean_estimate(scenario, expected_means)
     total = full - scenario.truth_nominal
     e = scenario.effects
     zero3 = np.zeros(3)

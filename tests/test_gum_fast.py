@@ -1,4 +1,10 @@
-"""The GUM's finite differences: the sparse kernel gives, bit for bit, what evaluating every perturbed vector gives."""
+"""The GUM's fast paths give the plain computation's numbers.
+
+- the finite differences: the sparse kernel gives, bit for bit, what evaluating every perturbed vector gives
+  (the differences amplify the means' last bits, so nothing less would do);
+- the prediction's figures (:func:`plansim.uncertainty.gum.gum_uncertainties`) are those of the budgets
+  (:func:`plansim.uncertainty.gum.evaluate_gum`).
+"""
 
 from __future__ import annotations
 
@@ -8,6 +14,7 @@ import pytest
 from plansim.io.scenario_file import load_scenario
 from plansim.kernels.layout import HEAD, PER_SEGMENT, SEG_PHASE, draws_length, segment_base
 from plansim.simulate.arguments import noise_free_segment_means
+from plansim.uncertainty.gum import evaluate_gum, gum_uncertainties
 from plansim.uncertainty.sensitivities import PHASE_NODES, phase_grid_draws, segment_mean_derivatives
 
 
@@ -50,3 +57,16 @@ def test_start_angles_are_refused():
         segment_mean_derivatives(scenario, np.array([segment_base(0) + SEG_PHASE]), np.array([1e-3]))
     with pytest.raises(ValueError, match="start angles"):
         segment_mean_derivatives(scenario, np.array([draws_length(len(scenario.schedule))]), np.array([1e-3]))
+
+
+@pytest.mark.parametrize("name, overrides", [("jjf2003", ()), ("linear_gaussian", ("schedule.dwell=10 s",))])
+def test_the_figures_are_those_of_the_budgets(name, overrides):
+    scenario = load_scenario(name, overrides)
+    figures = gum_uncertainties(scenario, coverage_probability=0.9)
+    gum = evaluate_gum(scenario, coverage_probability=0.9)
+    assert np.array_equal(figures.covariance, gum.covariance)
+    assert np.array_equal(figures.standard_uncertainty, gum.standard_uncertainty)
+    assert np.array_equal(figures.estimate, gum.estimate)
+    assert np.array_equal(figures.effective_dof, [b.effective_dof for b in gum.budgets])
+    assert np.array_equal(figures.coverage_factor, [b.coverage_factor for b in gum.budgets])
+    assert np.array_equal(figures.expanded_uncertainty, gum.expanded_uncertainty)
