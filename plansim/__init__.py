@@ -20,10 +20,11 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 _PUBLIC = {"run": "plansim.runner", "Scenario": "plansim.config", "parse_scenario": "plansim.config",
            "builtin_scenarios": "plansim.io.scenario_file", "load_scenario": "plansim.io.scenario_file",
            "save_scenario": "plansim.io.scenario_file", "simulate_and_record": "plansim.runner",
-           "predict": "plansim.planning.predict"}
+           "predict": "plansim.planning.predict", "plan": "plansim.planning.plan",
+           "optimal_design": "plansim.design.schedule_design"}
 
-__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "parse_scenario", "predict", "run", "save_scenario",
-           "simulate_and_record", "__version__"]
+__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "optimal_design", "parse_scenario", "plan", "predict",
+           "run", "save_scenario", "simulate_and_record", "__version__"]
 
 
 def __getattr__(name: str):

@@ -262,7 +262,7 @@ def test_vertical_earth_rate_aliases_into_g_ii_in_a_static_schedule():
     spec = alias_matrix(scenario, estimator="jjf2003")
     names = [p.name for p in plansim.model.parameters.PARAMETERS]
     e = list(EFFECTS).index("earth_rate_up")
-    for i, axis in enumerate("xyz"):
+    for axis in "xyz":
         kg = scenario.truth_nominal[names.index(f"Kg{axis}{axis}")]
         assert spec.alias[e, names.index(f"g{axis}{axis}")] == pytest.approx(
             kg / scenario.reduction.reference_gravity, rel=1e-6)

@@ -76,6 +76,7 @@ COMMANDS = {
     "diagnose": "find the effect a recording's fit lacks",
     "diagnose-check": "check diagnose blind on simulated recordings",
     "sweep": "compare schedules over a grid of scenario fields",
+    "plan": "the shortest schedule that meets your targets",
     "bench": "measure speed and memory on this machine",
 }
 

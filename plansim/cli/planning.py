@@ -1,4 +1,5 @@
-"""``plansim sweep``: one scenario, a grid of schedules, compared (docs/planning.md)."""
+"""``plansim sweep`` (one scenario, a grid of schedules, compared) and ``plansim plan`` (the shortest schedule that
+meets a lab's targets); docs/planning.md."""
 
 from __future__ import annotations
 
@@ -72,6 +73,52 @@ def _cmd_sweep(args) -> int:
     return 0
 
 
+def _cmd_plan(args) -> int:
+    import tomllib
+
+    from plansim.config import parse_scenario
+    from plansim.io.scenario_file import load_scenario, save_scenario
+    from plansim.planning.plan import load_targets, plan
+    from plansim.report.plan import plan_json, plan_report
+    from plansim.report.progress import end_progress_line, stderr_progress
+
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".toml",))
+    if args.trials is not None and args.trials != 0 and args.trials < 2:
+        raise ValueError(f"--trials {args.trials}: must be 0 (no Monte Carlo) or >= 2")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    base = load_scenario(args.scenario, args.set)
+    targets = load_targets(args.targets, base)
+    trials = base.trials if args.trials is None else args.trials
+    with OutputSet() as outputs:
+        out = outputs.stage(args.out, "--out", (".toml",)) if args.out is not None else None
+        progress = None
+        if not (args.quiet or args.json):
+            progress = stderr_progress(f"plansim plan {base.name}", unit="predictions")
+        start = time.perf_counter()
+        result = plan(base, targets, compliant=args.jjf2003_compliant, trials=trials, seed=args.seed,
+                      path=args.path, progress=progress)
+        elapsed = time.perf_counter() - start
+        end_progress_line()
+        if out is not None:
+            save_scenario(result.scenario, out, expand_schedule=True)
+            with open(out, "rb") as f:  # what plansim run will read: parsed back before it is committed
+                parse_scenario(tomllib.load(f), source=str(args.out))
+        outputs.commit()
+    if args.json:
+        print(json.dumps({**plan_json(result), "elapsed_s": elapsed}, indent=2, allow_nan=False))
+    else:
+        print(f"plansim plan {base.name}: {len(targets)} targets from {args.targets}, {elapsed:.1f} s")
+        if base.overrides:
+            print(f"Overrides (--set): {'; '.join(base.overrides)}")
+        print()
+        print(plan_report(result, default_time=base.schedule.duration))
+        if args.out:
+            print(f"\nwrote plan: {args.out} (plansim run {args.out})")
+    return 0
+
+
 def add_commands(sub) -> None:
     p = sub.add_parser(
         "sweep", help=COMMANDS["sweep"],
@@ -101,6 +148,29 @@ def add_commands(sub) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
     p.set_defaults(func=_cmd_sweep)
+
+    p = sub.add_parser(
+        "plan", help=COMMANDS["plan"],
+        description="The shortest JJF 2003-structured schedule (table time, settling included) whose expanded "
+                    "uncertainty meets every target, searched on the prediction and verified by a Monte Carlo "
+                    "(docs/planning.md)")
+    p.add_argument("scenario", nargs="?", default="jjf2003",
+                   help="built-in scenario name or a TOML path (the unit, noise, table, site); default jjf2003")
+    p.add_argument("--targets", required=True,
+                   help="targets file (TOML): [targets] parameter or group = U (k = 2) with its unit, or "
+                        "from_appendix_a = true (docs/planning.md)")
+    add_set_option(p)
+    p.add_argument("--jjf2003-compliant", action="store_true",
+                   help="keep to JJF 2003 §7.2: 12 positions, 7-11 rate points with both maxima, dwell >= 30 s")
+    p.add_argument("--trials", type=int, default=None,
+                   help="Monte Carlo trials of the calibration and verification (default: the scenario's; 0: none)")
+    p.add_argument("--seed", type=int, default=None, help="Monte Carlo seed (default: the scenario's)")
+    p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
+                   help="simulation path, as for plansim run")
+    p.add_argument("--out", default=None, help="write the planned scenario (TOML) that plansim run takes")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the report")
+    p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
+    p.set_defaults(func=_cmd_plan)
 
 
 __all__ = ["add_commands"]

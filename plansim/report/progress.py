@@ -38,15 +38,21 @@ def end_progress_line() -> None:
 
 
 def stderr_progress(label: str = "simulating", unit: str = "trials") -> ProgressCallback:
-    """A progress line on stderr, redrawn in place: *unit* (trials, cells) done / total, rate, time left."""
+    """A progress line on stderr, redrawn in place: *unit* (trials, cells) done / total, rate, time left; with a
+    total of None (a search that does not know its length) done, rate and time so far."""
     start = time.perf_counter()
 
-    def report(done: int, total: int) -> None:
+    def report(done: int, total: int | None) -> None:
         elapsed = time.perf_counter() - start
         rate = done / elapsed if elapsed > 0 else float("nan")
+        shown = f"{rate:,.0f}" if rate >= 10 else f"{rate:.1f}"
+        if total is None:  # a search: how much is done, not how much is left
+            sys.stderr.write(f"\r{label}: {done} {unit} ({shown}/s, {elapsed:4.0f} s)   ")
+            sys.stderr.flush()
+            mark_progress_line(True)
+            return
         left = (total - done) / rate if rate > 0 else float("nan")
         end = "\n" if done >= total else ""
-        shown = f"{rate:,.0f}" if rate >= 10 else f"{rate:.1f}"
         sys.stderr.write(f"\r{label}: {done}/{total} {unit} ({shown}/s, {left:4.0f} s left)   {end}")
         sys.stderr.flush()
         mark_progress_line(done < total)
