@@ -220,6 +220,29 @@ def test_the_pareto_front_is_the_cells_no_other_beats():
     assert not pareto_front([1.0, np.nan], [np.nan, 1.0]).any()
 
 
+def test_the_pareto_front_allows_for_the_monte_carlo_scatter():
+    # with standard errors, a cell is only beaten by one as cheap and better by more than z·√(se_a² + se_b²), or
+    # cheaper and not worse by that much (brute force against the rule, z = 2)
+    rng = np.random.default_rng(5)
+    cost, value = rng.integers(0, 6, 40).astype(float), rng.normal(1.0, 0.05, 40)
+    se = np.full(40, 0.02)
+    front = pareto_front(cost, value, se)
+    for k in range(40):
+        beaten = False
+        for m in range(40):
+            margin = 2.0 * np.hypot(se[m], se[k])
+            if cost[m] <= cost[k] and value[m] <= value[k] + margin and (
+                    cost[m] < cost[k] or value[m] < value[k] - margin):
+                beaten = True
+        assert front[k] == (not beaten)
+    assert front.any()  # the cheapest of the best is always on it
+    # a cell 1 % better but within the scatter does not push a cheaper one off, nor stay on the front itself
+    assert pareto_front([1, 2], [1.00, 0.99], standard_error=[0.01, 0.01]).tolist() == [True, False]
+    assert pareto_front([1, 2], [1.00, 0.90], standard_error=[0.01, 0.01]).tolist() == [True, True]
+    with pytest.raises(ValueError, match="standard_error"):
+        pareto_front([1, 2], [1, 2], standard_error=[-1, 0])
+
+
 # --- the command ---------------------------------------------------------------------------------------------------
 
 def _grid_file(tmp_path):

@@ -208,21 +208,37 @@ def _execute(tasks, executor: str, workers, scheduler, progress, cell_of: dict) 
     return results
 
 
-def pareto_front(cost, value) -> np.ndarray:
-    """Which points are on the Pareto front of (cost, value), both smaller-is-better: no other point is
-    at least as good in both and better in one. NaN points are never on it; equal points both are.
+#: how many combined standard errors a Monte Carlo u must be above another's to count as worse on the Pareto front
+PARETO_Z = 2.0
+
+
+def pareto_front(cost, value, standard_error=None, z: float = PARETO_Z) -> np.ndarray:
+    """Which points are on the Pareto front of (cost, value), both smaller-is-better: no other point is at least as
+    good in both and better in one. NaN points are never on it; equal points both are.
+
+    With the *standard_error* of each value (a Monte Carlo's scatter), "better in value" means better by more than
+    ``z·√(se_a² + se_b²)`` and "at least as good" means not worse by that much: a point is only pushed off the
+    front by one that is as cheap and significantly better, or cheaper and not significantly worse. Without it the
+    values are taken as exact (a prediction).
 
     >>> pareto_front([1, 2, 3, 3], [3, 1, 2, 1]).tolist()
     [True, True, False, False]
+    >>> pareto_front([1, 2], [1.00, 0.99], standard_error=[0.01, 0.01]).tolist()  # 0.01 is not significant
+    [True, False]
     """
     cost = np.asarray(cost, dtype=float)
     value = np.asarray(value, dtype=float)
     if cost.shape != value.shape:
         raise ValueError(f"cost {cost.shape} and value {value.shape}: the shapes must match")
-    c, v = cost.ravel(), value.ravel()
+    se = np.zeros_like(value) if standard_error is None else np.asarray(standard_error, dtype=float)
+    if se.shape != value.shape or np.any(se < 0):
+        raise ValueError(f"standard_error: expected values >= 0 of shape {value.shape}, got {se.shape}")
+    c, v, e = cost.ravel(), value.ravel(), se.ravel()
     ok = np.isfinite(c) & np.isfinite(v)
-    dominated = ((c[None, :] <= c[:, None]) & (v[None, :] <= v[:, None])
-                 & ((c[None, :] < c[:, None]) | (v[None, :] < v[:, None])) & ok[None, :])
+    margin = z * np.sqrt(e[None, :] ** 2 + e[:, None] ** 2)  # [i, j]: point j against point i
+    better = v[None, :] < v[:, None] - margin
+    as_good = v[None, :] <= v[:, None] + margin
+    dominated = ((c[None, :] <= c[:, None]) & as_good & ((c[None, :] < c[:, None]) | better) & ok[None, :])
     return (ok & ~dominated.any(axis=1)).reshape(cost.shape)
 
 
@@ -269,13 +285,17 @@ def _dataset(grid: Grid, results: list[CellResult], base: Scenario, overrides, t
     member = np.array([[p.group == g for p in PARAMETERS] for g in groups])  # (group, parameter)
     u = arrays["u_mc"] if trials > 1 else arrays["u_predicted"]
     u_group = np.stack([np.max(u[..., m], axis=-1) for m in member], axis=-1)
-    front = np.stack([pareto_front(table_time, u_group[..., k]) for k in range(len(groups))], axis=-1)
+    # a Monte Carlo standard deviation of n trials scatters by u/√(2(n − 1)) (normal errors)
+    se_group = u_group / np.sqrt(2.0 * (trials - 1)) if trials > 1 else np.zeros_like(u_group)
+    front = np.stack([pareto_front(table_time, u_group[..., k], se_group[..., k]) for k in range(len(groups))],
+                     axis=-1)
     which = "u_mc" if trials > 1 else "u_predicted"
     data["u_group"] = ((*grid_dims, "group"), u_group, {
         "units": "SI: the group_unit coordinate", "long_name": f"the largest {which} of the group's parameters"})
     data["pareto"] = ((*grid_dims, "group"), front, {
         "units": "1", "long_name": "on the Pareto front of table_time_s against u_group: no other cell is as "
-                                   "short and as good, and better in one"})
+                                   "short and as good, and better in one (with a Monte Carlo: by more than "
+                                   f"{PARETO_Z:g} combined standard errors)"})
     coords: dict = {"parameter": ("parameter", names), "unit": ("parameter", [p.si_unit for p in PARAMETERS]),
                     "parameter_group": ("parameter", [p.group for p in PARAMETERS]),
                     "group": ("group", groups),
