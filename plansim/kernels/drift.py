@@ -147,3 +147,41 @@ def drift_coefficients(n: int, dt: float, hold_interval: float, tau: float | Non
     L21 = cov[0, 1] / L11 if L11 > 0 else 0.0
     L22 = math.sqrt(max(cov[1, 1] - L21**2, 0.0))
     return np.array([a, c, L11, L21, L22])
+
+
+@jit
+def held_process_covariance(coefficients, gaps, sigma, tau, cov_out):
+    """Add the covariance (S, S) of the segment means of one held drift process to ``cov_out``.
+
+    The exact state recursion over the segments: ``coefficients`` (S, 5) are the unit-σ
+    ``a, c, L11, L21, L22`` of :func:`drift_coefficients` (``mean = a·x0 + σL11 z1``,
+    ``end = c·x0 + σ(L21 z1 + L22 z2)``); ``gaps`` (S,) the settling before each segment, over which
+    the state is advanced exactly (φ = exp(−Δ/τ); a random walk when ``tau`` ≤ 0). A Gauss–Markov
+    process is stationary (variance σ²) at the start, a random walk starts at 0.
+    """
+    n_seg = gaps.shape[0]
+    s2 = sigma * sigma
+    variance = s2 if tau > 0.0 else 0.0
+    with_means = np.zeros(n_seg)  # Cov(state, mean_j) for the segments done so far
+    for s in range(n_seg):
+        gap = gaps[s]
+        if gap > 0.0:
+            if tau <= 0.0:
+                variance += s2 * gap
+            else:
+                phi = math.exp(-gap / tau)
+                variance = phi * phi * variance + s2 * (1.0 - phi * phi)
+                for t in range(s):
+                    with_means[t] *= phi
+        a = coefficients[s, 0]
+        c = coefficients[s, 1]
+        l11 = coefficients[s, 2]
+        l21 = coefficients[s, 3]
+        l22 = coefficients[s, 4]
+        for t in range(s):
+            cov_out[s, t] += a * with_means[t]
+            cov_out[t, s] += a * with_means[t]
+            with_means[t] *= c
+        cov_out[s, s] += a * a * variance + s2 * (l11 * l11)
+        with_means[s] = c * a * variance + s2 * l11 * l21
+        variance = c * c * variance + s2 * (l21 * l21 + l22 * l22)

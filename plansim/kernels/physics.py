@@ -155,6 +155,9 @@ def _matmul3(frames, a, b, out):
             frames[out, i, j] = acc
 
 
+#: *channel* of :func:`evaluate_outputs` for all six outputs (an int64, not a literal: one compiled copy)
+ALL_CHANNELS = np.int64(-1)
+
 # slabs of the (6, 3, 3) ``frames`` array of :func:`geometry_buffers`
 _FIXTURE, _TILT, _POSITION_ERROR, _NOMINAL, _PRODUCT, _ACTUAL = 0, 1, 2, 3, 4, 5
 
@@ -241,40 +244,77 @@ def rotated_inputs(ct, st, rate, u, g_b0, om_b0, w, fc):
 
 
 @inline_jit
+def gyro_output(i, w, fc, dT, Kg, Bg, G, sensor, S2):
+    """Noise-free output of gyro *i*: JJF 2003 eq. (1), row i, plus its effects (:func:`sensor_outputs`)."""
+    val = Bg[i] + sensor[EFF_GYRO_BIAS_TEMPERATURE, i] * dT
+    for j in range(3):
+        val += Kg[i, j] * w[j] + G[i, j] * fc[j] + S2[i, j] * fc[j] * fc[j]
+    wi = w[i]
+    val += (Kg[i, i] * sensor[EFF_GYRO_SCALE_TEMPERATURE, i] * dT * wi + sensor[EFF_GYRO_QUADRATIC, i] * wi * wi
+            + sensor[EFF_GYRO_CUBIC, i] * wi * wi * wi)
+    val += 0.5 * sensor[EFF_GYRO_ASYMMETRY, i] * Kg[i, i] * abs(wi)
+    return val
+
+
+@inline_jit
+def accel_output(i, w, fc, perp, dT, Ka, Ba, P, sensor):
+    """Noise-free output of accelerometer *i* at its lever arm: JJF 2003 eq. (2), row i, plus its effects."""
+    f0 = fc[0] + perp[i, 0]
+    f1 = fc[1] + perp[i, 1]
+    f2 = fc[2] + perp[i, 2]
+    fi = f0 if i == 0 else (f1 if i == 1 else f2)
+    val = Ba[i] + sensor[EFF_ACCEL_BIAS_TEMPERATURE, i] * dT
+    val += Ka[i, 0] * f0 + Ka[i, 1] * f1 + Ka[i, 2] * f2
+    val += P[i, 0] * w[0] * w[0] + P[i, 1] * w[1] * w[1] + P[i, 2] * w[2] * w[2]
+    val += Ka[i, i] * sensor[EFF_ACCEL_SCALE_TEMPERATURE, i] * dT * fi + sensor[EFF_ACCEL_SECOND_ORDER, i] * fi * fi
+    return val
+
+
+@inline_jit
 def sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y):
     """Noise-free outputs (6) for gyro input *w* and specific force *fc* at the IMU centre.
 
     JJF 2003 eq. (1)/(2) plus the effects in ``sensor`` (rows :data:`EFFECT_ROWS`) and ``S2``
-    (g² sensitivity, 3×3); ``dT`` = temperature − reference temperature.
+    (g² sensitivity, 3×3); ``dT`` = temperature − reference temperature. Channel i reads row i of
+    the truth's matrices and entry i of its biases alone (:func:`truth_channel`).
     """
     for i in range(3):  # gyros, eq. (1) + effects
-        val = Bg[i] + sensor[EFF_GYRO_BIAS_TEMPERATURE, i] * dT
-        for j in range(3):
-            val += Kg[i, j] * w[j] + G[i, j] * fc[j] + S2[i, j] * fc[j] * fc[j]
-        wi = w[i]
-        val += (Kg[i, i] * sensor[EFF_GYRO_SCALE_TEMPERATURE, i] * dT * wi + sensor[EFF_GYRO_QUADRATIC, i] * wi * wi
-                + sensor[EFF_GYRO_CUBIC, i] * wi * wi * wi)
-        val += 0.5 * sensor[EFF_GYRO_ASYMMETRY, i] * Kg[i, i] * abs(wi)
-        y[i] = val
+        y[i] = gyro_output(i, w, fc, dT, Kg, Bg, G, sensor, S2)
     for i in range(3):  # accelerometers, eq. (2) + effects; accelerometer i sits at its lever arm
-        f0 = fc[0] + perp[i, 0]
-        f1 = fc[1] + perp[i, 1]
-        f2 = fc[2] + perp[i, 2]
-        fi = f0 if i == 0 else (f1 if i == 1 else f2)
-        val = Ba[i] + sensor[EFF_ACCEL_BIAS_TEMPERATURE, i] * dT
-        val += Ka[i, 0] * f0 + Ka[i, 1] * f1 + Ka[i, 2] * f2
-        val += P[i, 0] * w[0] * w[0] + P[i, 1] * w[1] * w[1] + P[i, 2] * w[2] * w[2]
-        val += Ka[i, i] * sensor[EFF_ACCEL_SCALE_TEMPERATURE, i] * dT * fi + sensor[EFF_ACCEL_SECOND_ORDER, i] * fi * fi
-        y[3 + i] = val
+        y[3 + i] = accel_output(i, w, fc, perp, dT, Ka, Ba, P, sensor)
 
 
-@jit
+@inline_jit
+def truth_channel(p):
+    """The one output channel that entry *p* of the truth vector enters (:func:`sensor_outputs`).
+
+    Row i of ``Kg`` and ``G`` and ``Bg[i]`` enter gyro i (eq. (1)); row i of ``Ka`` and ``P`` and
+    ``Ba[i]`` accelerometer i (eq. (2)); the effects' terms use the diagonal of the same rows.
+    """
+    if p < BG_FIRST:
+        return (p - KG_FIRST) // 3
+    if p < G_FIRST:
+        return p - BG_FIRST
+    if p < KA_FIRST:
+        return (p - G_FIRST) // 3
+    if p < BA_FIRST:
+        return 3 + (p - KA_FIRST) // 3
+    if p < P_FIRST:
+        return 3 + p - BA_FIRST
+    return 3 + P_ENTRIES[p - P_FIRST][0]
+
+
+@inline_jit
 def evaluate_outputs(nodes, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
-                     out, scratch):
+                     channel, out, scratch):
     """Noise-free outputs ``out[j]`` (6) at table angles θ_j = phase + 2πj/nodes (j < nodes) and, for
     j ≥ nodes (``extra`` more rows), at θ = phase; table rate ``rates[j]``. Angles by angle addition.
-    ``scratch`` (3, 6) is work space (allocated once per trial by the caller). Pass *nodes* and
-    *extra* as int64 values, not int literals (one compiled copy; see :data:`STREAM_NOISE`)."""
+
+    *channel* :data:`ALL_CHANNELS` writes all six; a channel 0 … 5 writes ``out[j, channel]`` alone
+    (the same number, for a caller that knows the others have not changed: :func:`truth_channel`).
+    ``scratch`` (3, 6) is work space (allocated once per trial by the caller). Pass *nodes*, *extra*
+    and *channel* as int64 values, not int literals (one compiled copy; see :data:`STREAM_NOISE`).
+    """
     w = scratch[0, :3]
     fc = scratch[1, :3]
     y = scratch[2]
@@ -287,7 +327,12 @@ def evaluate_outputs(nodes, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, B
         if j >= nodes:
             ct, st = c0, s0
         rotated_inputs(ct, st, rates[j], u, g_b0, om_b0, w, fc)
-        sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
-        for c in range(6):
-            out[j, c] = y[c]
+        if channel < 0:
+            sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
+            for c in range(6):
+                out[j, c] = y[c]
+        elif channel < 3:
+            out[j, channel] = gyro_output(channel, w, fc, dT, Kg, Bg, G, sensor, S2)
+        else:
+            out[j, channel] = accel_output(channel - 3, w, fc, perp, dT, Ka, Ba, P, sensor)
         ct, st = ct * cd - st * sd, st * cd + ct * sd

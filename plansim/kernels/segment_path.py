@@ -57,17 +57,18 @@ from plansim.kernels.layout import (
     PER_SEGMENT,
     PERPENDICULARITY_FIRST,
     RATE_SYSTEMATIC,
-    SEG_PHASE,
     SEG_RATE_ERROR,
     draws_length,
 )
 from plansim.kernels.options import inline_jit, jit
 from plansim.kernels.physics import (
+    ALL_CHANNELS,
     draw_systematic,
     evaluate_outputs,
     geometry_buffers,
     segment_geometry,
     trial_frames,
+    truth_channel,
     unpack_truth,
 )
 from plansim.kernels.quantiser import channel_moments, fourier_damping, fourier_terms_needed
@@ -192,26 +193,24 @@ def _harmonics_needed(spread, sigma, step, coefficients, row, kmax, tolerance):
 
 
 @inline_jit
-def segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity,
-                    earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp, frames, extra, rates, outputs, scratch):
-    """The noise-free outputs of segment *s* of one trial (*draws*, its truth unpacked in ``Kg … P``).
+def segment_node_outputs(rate, rate_act, phase, dT, extra, channel, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P,
+                         sensor, S2, rates, outputs, scratch):
+    """The noise-free outputs of a segment whose geometry :func:`segment_geometry` has set.
 
+    *rate* is the commanded rate (0: at rest), *rate_act* and *phase* the actual rate and start angle
+    :func:`segment_geometry` returned (any start angle may be given), ``dT`` the temperature offset.
     At rest, ``outputs[0]`` (6): the one output, whatever the table angle. Rotating, ``outputs[j]``
     for j < 7: the outputs at the table angles θ0 + 2πj/7 at the actual rate, then *extra* rows (0 or
-    :data:`_JITTER_NODES`) at θ0 with the rate ± 1e-6 of itself (the rate-jitter response). Returns the
-    actual rate (rad/s; the commanded 0 at rest). ``u … frames`` are :func:`geometry_buffers` (the
-    trial's frames in ``frames``), ``rates`` (7 + *extra*), ``outputs`` (7 + *extra*, 6) and
-    ``scratch`` (3, 6) work space. Inlined: one output model for :func:`noise_free_nodes` and
-    :func:`noise_free_mean_differences`.
+    :data:`_JITTER_NODES`) at θ0 with the rate ± 1e-6 of itself (the rate-jitter response).
+    *channel*: as for :func:`evaluate_outputs`. ``rates`` (7 + *extra*), ``outputs`` (7 + *extra*, 6)
+    and ``scratch`` (3, 6) are work space. Inlined: one output model for :func:`noise_free_nodes`
+    and :func:`noise_free_mean_differences`.
     """
-    rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                       earth_enu, lever, g_b0, om_b0, u, perp, frames)
-    dT = seg_temp[s] - t_ref
-    if seg_rate[s] == 0.0:
+    if rate == 0.0:
         rates[0] = 0.0
         evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
-                         sensor, S2, outputs, scratch)
-        return 0.0
+                         sensor, S2, channel, outputs, scratch)
+        return
     h = 1e-6 * abs(rate_act)
     for j in range(DETERMINISTIC_NODES):
         rates[j] = rate_act
@@ -219,8 +218,7 @@ def segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_te
         rates[DETERMINISTIC_NODES] = rate_act + h
         rates[DETERMINISTIC_NODES + 1] = rate_act - h
     evaluate_outputs(DETERMINISTIC_NODES, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
-                     sensor, S2, outputs, scratch)
-    return rate_act
+                     sensor, S2, channel, outputs, scratch)
 
 
 @jit
@@ -244,17 +242,19 @@ def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp
     outputs = np.empty((DETERMINISTIC_NODES + _JITTER_NODES, 6))
     scratch = np.empty((3, 6))
     for s in range(seg_C0.shape[0]):
+        rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                           earth_enu, lever, g_b0, om_b0, u, perp, frames)
         # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
-        rate_act = segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever,
-                                   t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp, frames,
-                                   _JITTER_NODES, rates, outputs, scratch)
-        rates_out[s] = rate_act
+        segment_node_outputs(seg_rate[s], rate_act, phase, seg_temp[s] - t_ref, _JITTER_NODES, ALL_CHANNELS, u, g_b0,
+                             om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
         if seg_rate[s] == 0.0:
+            rates_out[s] = 0.0
             for c in range(6):
                 for j in range(DETERMINISTIC_NODES):
                     nodes_out[s, j, c] = outputs[0, c]
                 jitter_out[s, c] = 0.0
             continue
+        rates_out[s] = rate_act
         h = 1e-6 * abs(rate_act)
         for c in range(6):
             for j in range(DETERMINISTIC_NODES):
@@ -264,19 +264,9 @@ def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp
                                 * (outputs[DETERMINISTIC_NODES, c] - outputs[DETERMINISTIC_NODES + 1, c]) / (2.0 * h))
 
 
-@jit
-def segment_mean_and_spread(nodes, s, rate, dt, n, weights, mean_out, spread_out):
-    """Exact noise-free mean over the segment's *n* samples (``mean_out``, 6) and the spread
-    max − min of the node values (``spread_out``, 6), from :func:`noise_free_nodes`'s ``nodes``.
-
-    *weights* (7) is work space; at rest (*rate* 0) the mean is the output itself and the spread 0.
-    """
-    if rate == 0.0:
-        for c in range(6):
-            mean_out[c] = nodes[s, 0, c]
-            spread_out[c] = 0.0
-        return
-    arc_weights(DETERMINISTIC_NODES, rate * dt, n, weights)
+@inline_jit
+def weighted_mean_and_spread(nodes, s, weights, mean_out, spread_out):
+    """``mean_out`` (6): ``Σ_j weights[j]·nodes[s, j]`` over the 7 nodes; ``spread_out`` (6): max − min of them."""
     for c in range(6):
         total = 0.0
         low = nodes[s, 0, c]
@@ -288,6 +278,23 @@ def segment_mean_and_spread(nodes, s, rate, dt, n, weights, mean_out, spread_out
             high = max(high, y)
         mean_out[c] = total
         spread_out[c] = high - low
+
+
+@jit
+def segment_mean_and_spread(nodes, s, rate, dt, n, weights, mean_out, spread_out):
+    """Exact noise-free mean over the segment's *n* samples (``mean_out``, 6) and the spread
+    max − min of the node values (``spread_out``, 6), from :func:`noise_free_nodes`'s ``nodes``.
+
+    *weights* (7) is work space (it receives :func:`arc_weights`); at rest (*rate* 0) the mean is
+    the output itself and the spread 0.
+    """
+    if rate == 0.0:
+        for c in range(6):
+            mean_out[c] = nodes[s, 0, c]
+            spread_out[c] = 0.0
+        return
+    arc_weights(DETERMINISTIC_NODES, rate * dt, n, weights)
+    weighted_mean_and_spread(nodes, s, weights, mean_out, spread_out)
 
 
 @jit
@@ -332,42 +339,6 @@ def _segment_reads(index, s, seg_rate, seg_axis_index):
 
 
 @jit
-def _segment_phase_means(draws, s, phases, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
-                         sensor, S2, lever, t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp,
-                         frames, rates, outputs, scratch, weights, spread, means_out):
-    """``means_out[j]`` (6): the noise-free mean of segment *s* with its start angle at ``phases[j]``.
-
-    The mean of :func:`noise_free_means` for *draws* with that start angle, evaluated once at rest
-    (where the angle does not enter). ``outputs`` is (7, 6), work space like ``rates`` (7),
-    ``scratch``, ``weights`` (7) and ``spread`` (6); *draws* is left as it was.
-    """
-    phase_index = HEAD + PER_SEGMENT * s + SEG_PHASE
-    saved = draws[phase_index]
-    nodes = outputs.reshape((1, DETERMINISTIC_NODES, 6))
-    for j in range(phases.shape[0]):
-        if j > 0 and seg_rate[s] == 0.0:
-            for c in range(6):
-                means_out[j, c] = means_out[0, c]
-            continue
-        draws[phase_index] = phases[j]
-        rate_act = segment_outputs(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp, sensor, S2, lever,
-                                   t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0, perp, frames,
-                                   _NO_EXTRA, rates, outputs, scratch)
-        segment_mean_and_spread(nodes, _FIRST, rate_act, seg_dt[s], seg_n[s], weights, means_out[j], spread)
-    draws[phase_index] = saved
-
-
-@inline_jit
-def _phase_average(phase_means, out, k, s):
-    """``out[k, s] = Σ_j phase_means[j] / J``, summed in the order of j (as numpy's mean over a leading axis)."""
-    for c in range(6):
-        total = phase_means[0, c]
-        for j in range(1, phase_means.shape[0]):
-            total += phase_means[j, c]
-        out[k, s, c] = total / phase_means.shape[0]
-
-
-@jit
 def noise_free_mean_differences(base, phases, indices, steps, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
                                 seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu,
                                 phase_means_out, centre_out, plus_out, minus_out):
@@ -381,55 +352,79 @@ def noise_free_mean_differences(base, phases, indices, steps, seg_n, seg_dt, seg
     - ``plus_out``, ``minus_out`` (K, S, 6): the averages with ``base[indices[k]] ± steps[k]``.
 
     Averages are summed in the order of the angles, then divided by J: numpy's mean over the angle
-    axis of the same values. Only the segments that read component ``indices[k]``
-    (:func:`_segment_reads`) are evaluated; the others get ``centre_out``, the value their
-    evaluation would give bit for bit. At rest a segment is evaluated at one angle (it does not
-    depend on it). So every mean equals :func:`noise_free_means` of the corresponding full draws
-    vector, averaged with numpy, exactly, at a fraction of the work: a position error of one
-    segment costs one segment, not S. *indices* must not be start angles (``SEG_PHASE``): those
-    are set from *phases*.
+    axis of the same values. Only what a component enters is evaluated, and everything else is
+    copied from ``centre_out``, the value its evaluation would give bit for bit: only the segments
+    that read the component (:func:`_segment_reads`: a position error of one segment moves that
+    segment alone), and of a truth component only the one channel it enters
+    (:func:`plansim.kernels.physics.truth_channel`); at rest a segment is evaluated at one angle
+    (it does not depend on it), rotating its orientation and arc weights once for all angles. So
+    every mean equals :func:`noise_free_means` of the corresponding full draws vector, averaged
+    with numpy, exactly, at a fraction of the work. *indices* must not be start angles
+    (``SEG_PHASE``): those are set from *phases*.
     """
     n_seg = seg_n.shape[0]
+    n_phases = phases.shape[0]
     draws = base.copy()
     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
     u, g_b0, om_b0, perp, frames = geometry_buffers(draws)
     rates = np.empty(DETERMINISTIC_NODES)
     outputs = np.empty((DETERMINISTIC_NODES, 6))
+    nodes = outputs.reshape((1, DETERMINISTIC_NODES, 6))
     scratch = np.empty((3, 6))
     weights = np.empty(DETERMINISTIC_NODES)
     spread = np.empty(6)
-    phase_means = np.empty((phases.shape[0], 6))
-    for s in range(n_seg):
-        _segment_phase_means(draws, s, phases, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp,
-                             sensor, S2, lever, t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P, u, g_b0, om_b0,
-                             perp, frames, rates, outputs, scratch, weights, spread, phase_means)
-        for j in range(phases.shape[0]):
-            for c in range(6):
-                phase_means_out[j, s, c] = phase_means[j, c]
-        _phase_average(phase_means, centre_out, _FIRST, s)
-    for k in range(indices.shape[0]):
-        index = indices[k]
-        for sign in range(2):
-            out = plus_out if sign == 0 else minus_out
-            draws[index] = base[index] + steps[k] if sign == 0 else base[index] - steps[k]
-            if index < N_TRUTH:
-                Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-            elif index < RATE_SYSTEMATIC:
-                trial_frames(draws, frames)
+    phase_means = np.empty((n_phases, 6))
+    for k in range(-1, indices.shape[0]):  # k = −1: the means at base, into phase_means_out and centre_out
+        index = indices[k] if k >= 0 else -1
+        channel = truth_channel(index) if 0 <= index < N_TRUTH else ALL_CHANNELS
+        for sign in range(2 if k >= 0 else 1):
+            out = centre_out if k < 0 else (plus_out if sign == 0 else minus_out)
+            row = max(k, 0)
+            if k >= 0:
+                draws[index] = base[index] + steps[k] if sign == 0 else base[index] - steps[k]
+                if index < N_TRUTH:
+                    Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
+                elif index < RATE_SYSTEMATIC:
+                    trial_frames(draws, frames)
             for s in range(n_seg):
-                if not _segment_reads(index, s, seg_rate, seg_axis_index):
+                if k >= 0:
                     for c in range(6):
-                        out[k, s, c] = centre_out[0, s, c]
-                    continue
-                _segment_phase_means(draws, s, phases, seg_n, seg_dt, seg_C0, seg_rate, seg_axis, seg_axis_index,
-                                     seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu, Kg, Bg, G, Ka, Ba, P,
-                                     u, g_b0, om_b0, perp, frames, rates, outputs, scratch, weights, spread,
-                                     phase_means)
-                _phase_average(phase_means, out, k, s)
-            draws[index] = base[index]
-        if index < N_TRUTH:
+                        out[row, s, c] = centre_out[0, s, c]
+                    if not _segment_reads(index, s, seg_rate, seg_axis_index):
+                        continue
+                # the segment's mean at every start angle (its orientation and arc weights do not depend on it)
+                rate_act, _ = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                               earth_enu, lever, g_b0, om_b0, u, perp, frames)
+                dT = seg_temp[s] - t_ref
+                if seg_rate[s] == 0.0:  # at rest: one evaluation, whatever the angle
+                    segment_node_outputs(seg_rate[s], rate_act, 0.0, dT, _NO_EXTRA, channel, u, g_b0, om_b0, perp,
+                                         Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
+                    for j in range(n_phases):
+                        for c in range(6):
+                            phase_means[j, c] = outputs[0, c]
+                else:
+                    arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
+                    for j in range(n_phases):
+                        segment_node_outputs(seg_rate[s], rate_act, phases[j], dT, _NO_EXTRA, channel, u, g_b0,
+                                             om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
+                        weighted_mean_and_spread(nodes, _FIRST, weights, phase_means[j], spread)
+                if k < 0:
+                    for j in range(n_phases):
+                        for c in range(6):
+                            phase_means_out[j, s, c] = phase_means[j, c]
+                # the average over the angles, summed in their order (numpy's mean over a leading axis)
+                for c in range(6):
+                    if channel >= 0 and c != channel:
+                        continue  # a truth component moves one channel: the others are the centre's
+                    total = phase_means[0, c]
+                    for j in range(1, n_phases):
+                        total += phase_means[j, c]
+                    out[row, s, c] = total / n_phases
+            if k >= 0:
+                draws[index] = base[index]
+        if 0 <= index < N_TRUTH:
             Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
-        elif index < RATE_SYSTEMATIC:
+        elif 0 <= index < RATE_SYSTEMATIC:
             trial_frames(draws, frames)
 
 

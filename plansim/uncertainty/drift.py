@@ -8,47 +8,14 @@ covariance of every pair of segment means of a channel exactly, settling gaps in
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from plansim.config import Scenario
+from plansim.kernels.drift import held_process_covariance
 from plansim.kernels.layout import NOISE_BIAS_INSTABILITY, NOISE_MARKOV, NOISE_RANDOM_WALK
 from plansim.simulate.arguments import drift_coefficient_table, kernel_arguments
 
 __all__ = ["drift_covariance"]
-
-
-def _process_covariance(coefficients: np.ndarray, gaps: np.ndarray, sigma: float, tau: float | None) -> np.ndarray:
-    """Covariance (S, S) of the segment means of one held drift process (exact state recursion).
-
-    ``coefficients`` (S, 5): unit-σ ``a, c, L11, L21, L22`` of
-    :func:`plansim.kernels.drift.drift_coefficients` (``mean = a·x0 + σL11 z1``,
-    ``end = c·x0 + σ(L21 z1 + L22 z2)``); ``gaps`` (S,): settling before each segment, over which the
-    state is advanced exactly (φ = exp(−Δ/τ), or a random walk when ``tau`` is None).
-    """
-    n_seg = len(gaps)
-    variance = sigma**2 if tau is not None else 0.0  # Gauss–Markov stationary at the start, walks at 0
-    with_means = np.zeros(n_seg)  # Cov(state, mean_j) for the segments done so far
-    cov = np.zeros((n_seg, n_seg))
-    for s in range(n_seg):
-        gap = gaps[s]
-        if gap > 0.0:
-            if tau is None:
-                variance += sigma**2 * gap
-            else:
-                phi = math.exp(-gap / tau)
-                variance = phi**2 * variance + sigma**2 * (1.0 - phi**2)
-                with_means *= phi
-        a, c, l11, l21, l22 = coefficients[s]
-        cov[s, :s] = a * with_means[:s]
-        cov[:s, s] = cov[s, :s]
-        cov[s, s] = a**2 * variance + sigma**2 * l11**2
-        end_with_means = c * with_means
-        end_with_means[s] = c * a * variance + sigma**2 * l11 * l21
-        variance = c**2 * variance + sigma**2 * (l21**2 + l22**2)
-        with_means = end_with_means
-    return cov
 
 
 def drift_covariance(scenario: Scenario, arguments: dict | None = None) -> np.ndarray:
@@ -82,7 +49,7 @@ def drift_covariance(scenario: Scenario, arguments: dict | None = None) -> np.nd
     for c in range(6):
         for p, (sigma, tau) in enumerate(((noise[c, NOISE_BIAS_INSTABILITY], n.bias_instability_correlation_time),
                                           (noise[c, NOISE_MARKOV], n.markov_correlation_time),
-                                          (noise[c, NOISE_RANDOM_WALK], None))):
+                                          (noise[c, NOISE_RANDOM_WALK], 0.0))):  # τ = 0: a random walk
             if sigma > 0.0:
-                out[c] += _process_covariance(table[:, p, :], gaps, float(sigma), tau)
+                held_process_covariance(np.ascontiguousarray(table[:, p, :]), gaps, float(sigma), float(tau), out[c])
     return out
