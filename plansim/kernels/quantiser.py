@@ -183,3 +183,37 @@ def channel_moments(mu, sigma, step, coefficients, row, kmax):
     if kmax > 0:
         return moments_from_damping(mu, sigma, step, coefficients, row, kmax)
     return quantised_gaussian_moments(mu, sigma, step)
+
+
+#: terms of :func:`quantisation_series` between exact evaluations of a harmonic and its damping (the
+#: recurrences in between lose about an ulp per term)
+SERIES_RESEED = 32
+
+
+@jit
+def quantisation_series(turns, damping, terms, out):
+    """``out[i] = Σ_{k=1..terms[i]} cos(2πk·turns[i]) exp(−2π²k²·damping[i]) / k²``.
+
+    The series of the covariance of a noisy quantiser's bias at two input levels
+    (:func:`plansim.uncertainty.quantisation.quantisation_covariance`). The harmonics by rotation
+    (as :func:`moments_from_damping`) and the damping ``e_k`` by its ratio
+    ``e_{k+1}/e_k = exp(−2π²(2k+1)d)``, both evaluated exactly every :data:`SERIES_RESEED` terms:
+    within a few ulp of summing exactly evaluated terms, at a fraction of the cost.
+    """
+    for i in range(turns.shape[0]):
+        t = turns[i]
+        d = damping[i]
+        s1, c1 = sin_cos_turns(t)
+        r2 = math.exp(-4.0 * math.pi * math.pi * d)  # the ratio of successive ratios
+        total = 0.0
+        ck, sk, e, g = 0.0, 0.0, 0.0, 0.0
+        for k in range(1, terms[i] + 1):
+            if (k - 1) % SERIES_RESEED == 0:
+                sk, ck = sin_cos_turns(k * t)
+                e = math.exp(-2.0 * math.pi * math.pi * k * k * d)
+                g = math.exp(-2.0 * math.pi * math.pi * (2 * k + 1) * d)
+            total += ck * e / (k * k)
+            ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
+            e *= g
+            g *= r2
+        out[i] = total

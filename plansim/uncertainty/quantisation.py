@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 
+from plansim.kernels.quantiser import quantisation_series
+
 __all__ = ["quantisation_covariance", "quantisation_variance"]
 
 
@@ -75,9 +77,10 @@ def quantisation_variance(step: float, sigma: float, samples: int) -> tuple[floa
 def _series_sum(fraction: np.ndarray, damping: np.ndarray) -> np.ndarray:
     """``Σ_{k≥1} cos(2πk·f) exp(−2π²k²τ²)/k²`` elementwise for ``f`` = *fraction*, ``τ²`` = *damping*.
 
-    Summed term by term until the damping makes the terms negligible (exp(−46) ≈ 1e-20); where that
-    would need more than :data:`_MAX_TERMS` terms the undamped sum ``π²(x² − x + 1/6)``
-    (x = f mod 1, the Bernoulli polynomial B₂) is used, whose error is O(τ).
+    Summed term by term until the damping makes the terms negligible (exp(−46) ≈ 1e-20;
+    :func:`plansim.kernels.quantiser.quantisation_series`); where that would need more than
+    :data:`_MAX_TERMS` terms the undamped sum ``π²(x² − x + 1/6)`` (x = f mod 1, the Bernoulli
+    polynomial B₂) is used, whose error is O(τ).
     """
     fraction = np.asarray(fraction, dtype=float)
     damping = np.asarray(damping, dtype=float)
@@ -88,12 +91,10 @@ def _series_sum(fraction: np.ndarray, damping: np.ndarray) -> np.ndarray:
     series = needed <= _MAX_TERMS
     out = undamped.copy()
     if np.any(series):
-        terms = int(np.max(needed[series]))
-        xs, ds = x[series], damping[series]
-        acc = np.zeros_like(xs)
-        for k in range(1, terms + 1):
-            acc += np.cos(2.0 * np.pi * k * xs) * np.exp(-2.0 * np.pi**2 * k**2 * ds) / k**2
-        out[series] = acc
+        summed = np.empty(np.count_nonzero(series))
+        quantisation_series(np.ascontiguousarray(x[series]), np.ascontiguousarray(damping[series]),
+                            needed[series].astype(np.int64), summed)
+        out[series] = summed
     return out
 
 
@@ -150,9 +151,12 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
     else:
         g = np.asarray(offset_covariance, dtype=float)
         var_delta = np.maximum(np.diag(g)[:, None] + np.diag(g)[None, :] - 2.0 * g, 0.0)
-    fraction = (means[None, :] - means[:, None]) / step
-    damping = (sigma[:, None] ** 2 + sigma[None, :] ** 2 + var_delta) / step**2
-    cov = step**2 / (2.0 * np.pi**2) * _series_sum(fraction, damping)
+    upper = np.triu_indices(n_seg)  # the covariance is symmetric: each pair once
+    fraction = (means[upper[1]] - means[upper[0]]) / step
+    damping = (sigma[upper[0]] ** 2 + sigma[upper[1]] ** 2 + var_delta[upper]) / step**2
+    cov = np.empty((n_seg, n_seg))
+    cov[upper] = step**2 / (2.0 * np.pi**2) * _series_sum(fraction, damping)
+    cov[upper[1], upper[0]] = cov[upper]
     full = step**2 / 12.0
     bias = np.clip(np.diag(cov).copy(), 0.0, full)
     cov[np.diag_indices(n_seg)] = bias + (full - bias) / samples
