@@ -7,6 +7,7 @@ noise-free segment means of given draws vectors (used by the GUM sensitivities).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -15,7 +16,7 @@ from plansim.config import Scenario
 from plansim.kernels import segment_path
 from plansim.kernels.drift import drift_coefficients
 from plansim.kernels.layout import EFFECT_ROWS, TABLE_ERRORS, TRUTH, draws_length
-from plansim.schedule.segments import Schedule, axis_vector, body_to_level
+from plansim.schedule.segments import Schedule, Segment, axis_vector, body_to_level
 
 #: flicker floor of the Allan deviation per unit bias-instability coefficient B (IEEE Std 952, C.1):
 #: σ_A = B·√(2 ln 2 / π) ≈ 0.664 B
@@ -53,8 +54,13 @@ def bias_instability_sigma(coefficient: np.ndarray) -> np.ndarray:
 
 
 def schedule_arrays(schedule: Schedule) -> dict[str, np.ndarray]:
-    """The nominal schedule as the kernels see it."""
-    segs = schedule.segments
+    """The nominal schedule as the kernels see it (new arrays; built once per distinct schedule)."""
+    return {name: array.copy() for name, array in _schedule_arrays(schedule.segments).items()}
+
+
+@functools.lru_cache(maxsize=64)
+def _schedule_arrays(segs: tuple[Segment, ...]) -> dict[str, np.ndarray]:
+    """:func:`schedule_arrays` of the segments *segs* (a planner asks for the same schedule many times over)."""
     return dict(
         seg_n=np.array([s.samples for s in segs], dtype=np.int64),
         seg_dt=np.array([1.0 / s.sample_rate for s in segs]),
@@ -121,14 +127,15 @@ def drift_coefficient_table(scenario: Scenario) -> np.ndarray:
     n = scenario.noise
     out = np.zeros((len(scenario.schedule), 3, 5))
     taus = (n.bias_instability_correlation_time, n.markov_correlation_time, None)
-    table = {}  # a schedule repeats few (samples, rate) pairs: 135 evaluations -> a handful
     for k, s in enumerate(scenario.schedule.segments):
         for p, tau in enumerate(taus):
-            arguments = (s.samples, 1.0 / s.sample_rate, n.drift_update_interval, tau)
-            if arguments not in table:
-                table[arguments] = drift_coefficients(*arguments)
-            out[k, p] = table[arguments]
+            out[k, p] = _drift_coefficients(s.samples, 1.0 / s.sample_rate, n.drift_update_interval, tau)
     return out
+
+
+#: :func:`plansim.kernels.drift.drift_coefficients`, once per distinct argument: a schedule repeats few
+#: (samples, rate) pairs (135 evaluations -> a handful), and a planner the same schedules many times over
+_drift_coefficients = functools.lru_cache(maxsize=1024)(drift_coefficients)
 
 
 def nominal_draws(scenario: Scenario) -> np.ndarray:

@@ -100,7 +100,12 @@ from plansim.uncertainty.budget import (
     SystematicEffect,
 )
 from plansim.uncertainty.budget_lines import Line, model_lines
-from plansim.uncertainty.metrology.propagation import DEFAULT_COVERAGE_PROBABILITY, coverage_factor, welch_satterthwaite
+from plansim.uncertainty.metrology.propagation import (
+    DEFAULT_COVERAGE_PROBABILITY,
+    coverage_factor,
+    coverage_factors,
+    welch_satterthwaite,
+)
 from plansim.uncertainty.sensitivities import estimator_matrix
 from plansim.uncertainty.systematic import expected_error, systematic_effects
 
@@ -184,12 +189,6 @@ def _effective_dof(lines: list[Line], variances: list[np.ndarray], uc: np.ndarra
     return np.divide(uc**4, denominator, out=np.full(N_PARAMETERS, math.inf), where=finite)
 
 
-def _coverage_factors(dof: np.ndarray, coverage_probability: float) -> np.ndarray:
-    """k_p (39,) of every ν_eff (:func:`~plansim.uncertainty.metrology.propagation.coverage_factor`), once per value."""
-    factors = {v: coverage_factor(v, coverage_probability) for v in set(map(float, dof))}
-    return np.array([factors[float(v)] for v in dof])
-
-
 def gum_uncertainties(scenario: Scenario, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY,
                       quantisation_correlation: bool = True) -> GumUncertainties:
     """The figures of :func:`evaluate_gum` without the budgets behind them: ``y``, ``u_c``, ``ν_eff``, ``k``, ``U``.
@@ -216,7 +215,7 @@ def gum_uncertainties(scenario: Scenario, coverage_probability: float = DEFAULT_
                                                    describe=False)
     uc = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     dof = _effective_dof(lines, [line.variance() for line in lines], uc)
-    k = _coverage_factors(dof, coverage_probability)
+    k = coverage_factors(dof, coverage_probability)
     return GumUncertainties(scenario=scenario.name, estimate=expected_error(scenario, expected_means),
                             standard_uncertainty=uc, effective_dof=dof, coverage_factor=k, expanded_uncertainty=k * uc,
                             covariance=covariance, coverage_probability=coverage_probability)
@@ -260,7 +259,7 @@ def evaluate_gum(scenario: Scenario, coverage_probability: float = DEFAULT_COVER
     variances = [line.variance() for line in lines]
     ucs = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     dofs = _effective_dof(lines, variances, ucs)
-    ks = _coverage_factors(dofs, coverage_probability)
+    ks = coverage_factors(dofs, coverage_probability)
     for p, spec in enumerate(PARAMETERS):
         entries = []
         second = 0.0

@@ -20,6 +20,7 @@ equally spaced angles are exact.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -43,6 +44,7 @@ from plansim.kernels.layout import (
 )
 from plansim.kernels.segment_path import noise_free_mean_differences
 from plansim.model.parameters import N_PARAMETERS
+from plansim.schedule.segments import Schedule, Segment
 from plansim.simulate.arguments import kernel_arguments, noise_free_arguments, nominal_draws
 
 __all__ = ["PHASE_NODES", "estimator_matrix", "finite_differences", "phase_angles", "phase_grid_draws",
@@ -61,7 +63,9 @@ def estimator_matrix(scenario: Scenario) -> np.ndarray:
     """The JJF 2003 reduction as a matrix: ``(39, S, 6)`` with ``estimate = Σ M[:, s, c]·mean[s, c]``.
 
     :func:`plansim.estimate.reduction_matrix` (the reduction applied to the ``6·S`` unit vectors,
-    eq. (5), (7), (10), (12)-(13) being linear least squares and differences), reshaped.
+    eq. (5), (7), (10), (12)-(13) being linear least squares and differences), reshaped. It depends
+    on the schedule, the reference gravity and the ω² sign convention alone, and is built once per
+    distinct three (a planner evaluates one schedule under many tables and noise models).
 
     Parameters
     ----------
@@ -71,6 +75,7 @@ def estimator_matrix(scenario: Scenario) -> np.ndarray:
     Returns
     -------
     (39, S, 6) ndarray
+        Read-only (it is shared between the calls that ask for the same schedule).
 
     Raises
     ------
@@ -82,11 +87,23 @@ def estimator_matrix(scenario: Scenario) -> np.ndarray:
     if not isinstance(scenario, Scenario):
         raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
     r = scenario.reduction
-    matrix = reduction_matrix(scenario.schedule, r.reference_gravity, r.omega_squared_sign)  # (6S, 39)
+    matrix = _estimator_matrix(scenario.schedule.segments, float(r.reference_gravity), r.omega_squared_sign)
     if matrix is None:
         raise ValueError(f"scenario {scenario.name!r}: the JJF 2003 reduction of this schedule is not linear in the "
                          "segment means, so it has no matrix to propagate the GUM budget through")
-    return np.ascontiguousarray(matrix.T.reshape(N_PARAMETERS, len(scenario.schedule), N_CHANNELS))
+    return matrix
+
+
+@functools.lru_cache(maxsize=64)
+def _estimator_matrix(segments: tuple[Segment, ...], reference_gravity: float, omega_squared_sign: str
+                      ) -> np.ndarray | None:
+    """:func:`estimator_matrix` of the schedule of *segments* (read-only), or None where the reduction has no matrix."""
+    matrix = reduction_matrix(Schedule(segments), reference_gravity, omega_squared_sign)  # (6S, 39)
+    if matrix is None:
+        return None
+    matrix = np.ascontiguousarray(matrix.T.reshape(N_PARAMETERS, len(segments), N_CHANNELS))
+    matrix.flags.writeable = False
+    return matrix
 
 
 def phase_angles() -> np.ndarray:

@@ -39,6 +39,7 @@ from plansim.uncertainty.metrology.propagation import (
     DEFAULT_COVERAGE_PROBABILITY,
     combine,
     coverage_factor,
+    coverage_factors,
     welch_satterthwaite,
 )
 from plansim.uncertainty.metrology.several_outputs import JointRegionCheck, correlation_matrix, joint_region
@@ -59,6 +60,7 @@ __all__ = [
     "correlation_matrix",
     "coverage_against_truth",
     "coverage_factor",
+    "coverage_factors",
     "coverage_intervals",
     "coverage_tolerance",
     "coverage_verdict",

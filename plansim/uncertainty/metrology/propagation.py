@@ -3,7 +3,8 @@
 - :func:`combine` — ``u_c = sqrt(Σ u_i²)`` of independent contributions ``u_i = |c_i| u(x_i)``
   (5.1.2, eq. (10)) and their ``ν_eff``;
 - :func:`welch_satterthwaite` — ``ν_eff = u_c⁴ / Σ u_i⁴/ν_i`` (G.4.1, eq. (G.2b));
-- :func:`coverage_factor` — ``k_p = t_p(ν_eff)`` (G.3.4, G.4.1 eq. (G.1e)); ``U_p = k_p·u_c`` (6.2.1).
+- :func:`coverage_factor` — ``k_p = t_p(ν_eff)`` (G.3.4, G.4.1 eq. (G.1e)); ``U_p = k_p·u_c`` (6.2.1);
+  :func:`coverage_factors` for many at once.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import math
 import numpy as np
 from scipy import special  # the quantiles themselves: scipy.stats takes 1.4 s to import
 
-__all__ = ["DEFAULT_COVERAGE_PROBABILITY", "check_dof", "combine", "coverage_factor", "welch_satterthwaite"]
+__all__ = ["DEFAULT_COVERAGE_PROBABILITY", "check_dof", "combine", "coverage_factor", "coverage_factors",
+           "welch_satterthwaite"]
 
 #: Coverage probability of an expanded uncertainty (JCGM 100 6.2.2; the 95 % of a k = 2 statement, 6.3.3).
 DEFAULT_COVERAGE_PROBABILITY = 0.95
@@ -106,10 +108,16 @@ def coverage_factor(dof: float, coverage_probability: float = DEFAULT_COVERAGE_P
     float
         ``k_p``; ``ν = inf`` gives the normal quantile (1.960 for 95 %).
     """
+    return float(coverage_factors([dof], coverage_probability)[0])
+
+
+def coverage_factors(dofs, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY) -> np.ndarray:
+    """:func:`coverage_factor` of every ``ν_eff`` of *dofs* (array_like), in one call of each quantile function."""
     if not (isinstance(coverage_probability, (int, float)) and 0.0 < coverage_probability < 1.0):
         raise ValueError(f"coverage_probability = {coverage_probability!r}: must lie strictly between 0 and 1")
-    (dof,) = check_dof([dof])
+    dofs = check_dof(dofs)
     q = 0.5 * (1.0 + coverage_probability)
-    if math.isinf(dof):
-        return float(special.ndtri(q))  # the normal quantile
-    return float(special.stdtrit(dof, q))  # Student's t quantile
+    out = np.full(dofs.shape, float(special.ndtri(q)))  # ν = ∞: the normal quantile
+    finite = np.isfinite(dofs)
+    out[finite] = special.stdtrit(dofs[finite], q)  # Student's t quantile
+    return out
