@@ -204,7 +204,7 @@ def segment_node_outputs(rate, rate_act, phase, dT, extra, channel, u, g_b0, om_
     :data:`_JITTER_NODES`) at θ0 with the rate ± 1e-6 of itself (the rate-jitter response).
     *channel*: as for :func:`evaluate_outputs`. ``rates`` (7 + *extra*), ``outputs`` (7 + *extra*, 6)
     and ``scratch`` (3, 6) are work space. Inlined: one output model for :func:`noise_free_nodes`
-    and :func:`noise_free_mean_differences`.
+    and :func:`noise_free_mean_derivatives`.
     """
     if rate == 0.0:
         rates[0] = 0.0
@@ -339,28 +339,27 @@ def _segment_reads(index, s, seg_rate, seg_axis_index):
 
 
 @jit
-def noise_free_mean_differences(base, phases, indices, steps, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
+def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
                                 seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu,
-                                phase_means_out, centre_out, plus_out, minus_out):
-    """Noise-free segment means for central differences in components of the draws vector, averaged over start angles.
+                                phase_means_out, first_out, second_out):
+    """Central differences of the noise-free segment means in components of the draws vector, over start angles.
 
     With every segment's start angle at ``phases[j]`` (J angles):
 
     - ``phase_means_out`` (J, S, 6): the means at *base* (D,), as :func:`noise_free_means` gives them
-      for the J draws vectors;
-    - ``centre_out`` (1, S, 6): their average over the J angles;
-    - ``plus_out``, ``minus_out`` (K, S, 6): the averages with ``base[indices[k]] ± steps[k]``.
+      for the J draws vectors; their average over the angles is the centre ``m̄``;
+    - ``first_out``, ``second_out`` (K, S, 6): ``(m̄₊ − m̄₋)/(2h)`` and ``(m̄₊ + m̄₋ − 2m̄)/h²``, where
+      ``m̄±`` are the averages with ``base[indices[k]] ± h``, ``h = steps[k]``.
 
     Averages are summed in the order of the angles, then divided by J: numpy's mean over the angle
-    axis of the same values. Only what a component enters is evaluated, and everything else is
-    copied from ``centre_out``, the value its evaluation would give bit for bit: only the segments
-    that read the component (:func:`_segment_reads`: a position error of one segment moves that
-    segment alone), and of a truth component only the one channel it enters
-    (:func:`plansim.kernels.physics.truth_channel`); at rest a segment is evaluated at one angle
-    (it does not depend on it), rotating its orientation and arc weights once for all angles. So
-    every mean equals :func:`noise_free_means` of the corresponding full draws vector, averaged
-    with numpy, exactly, at a fraction of the work. *indices* must not be start angles
-    (``SEG_PHASE``): those are set from *phases*.
+    axis of the same values, and the differences are numpy's expressions, so the result is that of
+    evaluating every perturbed draws vector with :func:`noise_free_means` and differencing with
+    numpy, bit for bit. Only what a component enters is evaluated: only the segments that read it
+    (:func:`_segment_reads`: a position error of one segment moves that segment alone), and of a
+    truth component only the one channel it enters (:func:`plansim.kernels.physics.truth_channel`);
+    the others' differences are exact zeros (m̄₊ = m̄₋ = m̄). At rest a segment is evaluated at one
+    angle (it does not depend on it); rotating, its orientation and arc weights once for all
+    angles. *indices* must not be start angles (``SEG_PHASE``): those are set from *phases*.
     """
     n_seg = seg_n.shape[0]
     n_phases = phases.shape[0]
@@ -374,24 +373,26 @@ def noise_free_mean_differences(base, phases, indices, steps, seg_n, seg_dt, seg
     weights = np.empty(DETERMINISTIC_NODES)
     spread = np.empty(6)
     phase_means = np.empty((n_phases, 6))
-    for k in range(-1, indices.shape[0]):  # k = −1: the means at base, into phase_means_out and centre_out
+    centre = np.empty((n_seg, 6))
+    plus = np.empty((n_seg, 6))  # m̄₊ of the component at hand
+    for k in range(-1, indices.shape[0]):  # k = −1: the means at base, into phase_means_out and centre
         index = indices[k] if k >= 0 else -1
         channel = truth_channel(index) if 0 <= index < N_TRUTH else ALL_CHANNELS
+        h = steps[k] if k >= 0 else 0.0
         for sign in range(2 if k >= 0 else 1):
-            out = centre_out if k < 0 else (plus_out if sign == 0 else minus_out)
-            row = max(k, 0)
             if k >= 0:
-                draws[index] = base[index] + steps[k] if sign == 0 else base[index] - steps[k]
+                draws[index] = base[index] + h if sign == 0 else base[index] - h
                 if index < N_TRUTH:
                     Kg, Bg, G, Ka, Ba, P = unpack_truth(draws[:N_TRUTH])
                 elif index < RATE_SYSTEMATIC:
                     trial_frames(draws, frames)
             for s in range(n_seg):
-                if k >= 0:
+                if k >= 0 and sign == 1:
                     for c in range(6):
-                        out[row, s, c] = centre_out[0, s, c]
-                    if not _segment_reads(index, s, seg_rate, seg_axis_index):
-                        continue
+                        first_out[k, s, c] = 0.0
+                        second_out[k, s, c] = 0.0
+                if k >= 0 and not _segment_reads(index, s, seg_rate, seg_axis_index):
+                    continue
                 # the segment's mean at every start angle (its orientation and arc weights do not depend on it)
                 rate_act, _ = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                                earth_enu, lever, g_b0, om_b0, u, perp, frames)
@@ -412,14 +413,21 @@ def noise_free_mean_differences(base, phases, indices, steps, seg_n, seg_dt, seg
                     for j in range(n_phases):
                         for c in range(6):
                             phase_means_out[j, s, c] = phase_means[j, c]
-                # the average over the angles, summed in their order (numpy's mean over a leading axis)
                 for c in range(6):
                     if channel >= 0 and c != channel:
-                        continue  # a truth component moves one channel: the others are the centre's
+                        continue  # a truth component moves one channel: the others' differences are zero
+                    # the average over the angles, summed in their order (numpy's mean over a leading axis)
                     total = phase_means[0, c]
                     for j in range(1, n_phases):
                         total += phase_means[j, c]
-                    out[row, s, c] = total / n_phases
+                    mean = total / n_phases
+                    if k < 0:
+                        centre[s, c] = mean
+                    elif sign == 0:
+                        plus[s, c] = mean
+                    else:
+                        first_out[k, s, c] = (plus[s, c] - mean) / (2.0 * h)
+                        second_out[k, s, c] = (plus[s, c] + mean - 2.0 * centre[s, c]) / (h * h)
             if k >= 0:
                 draws[index] = base[index]
         if 0 <= index < N_TRUTH:

@@ -146,7 +146,7 @@ def nominal_draws(scenario: Scenario) -> np.ndarray:
 
 
 #: the arguments of the noise-free kernels (:func:`plansim.kernels.segment_path.noise_free_means`,
-#: :func:`plansim.kernels.segment_path.noise_free_mean_differences`) that describe the scenario
+#: :func:`plansim.kernels.segment_path.noise_free_mean_derivatives`) that describe the scenario
 NOISE_FREE_ARGUMENTS = ("seg_n", "seg_dt", "seg_C0", "seg_rate", "seg_axis", "seg_axis_index", "seg_temp", "sensor",
                         "S2", "lever", "t_ref", "gravity", "earth_enu")
 

@@ -71,6 +71,17 @@ def _distribution_text(error: ErrorDistribution, unit: str) -> str:
     return f"normal, σ = {error.scale:.4g}{shown}"
 
 
+def _through_reduction(matrix: np.ndarray, d_means: np.ndarray) -> np.ndarray:
+    """(39, K): the parameters' response ``R·Δm̄_k`` to each component's change of the means *d_means* (K, S, 6).
+
+    By ``einsum``, group by group: a BLAS product (6 times faster) sums in another order, and where the
+    reduction cancels a component exactly (two halves of a symmetric pair of positions) leaves a
+    rounding residue instead of the zero that makes the budget show that component's own signed
+    sensitivity.
+    """
+    return np.einsum("psc,ksc->pk", matrix, d_means)
+
+
 def _largest_second_order(matrix: np.ndarray, second: np.ndarray, u: np.ndarray) -> np.ndarray:
     """(39,): the largest ``½|∂²E/∂x_k²|·u_k²`` over the components k (*second*: (K, S, 6) ``∂²m̄/∂x_k²``)."""
     return np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second)) * u[None, :] ** 2, axis=1)
@@ -123,23 +134,24 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     steps = np.concatenate([np.full(len(g[2]), g[1].standard_uncertainty) for g in groups] + [spread[idx]])
     nominal, first_all, second_all = segment_mean_derivatives(scenario, indices, steps, arguments)  # (J, S, 6), …
     n_table = len(indices) - idx.size
+    d_means_all = first_all * steps[:, None, None]  # (K, S, 6): what a step u of each component does to the means
 
     # table and fixture errors: finite differences of the noise-free means
-    if groups:
-        first, second = first_all[:n_table], second_all[:n_table]
-        start = 0
-        for name, error, idx_g, unit in groups:
-            stop = start + len(idx_g)
-            u = np.full(len(idx_g), error.standard_uncertainty)
-            d_means = first[start:stop] * u[:, None, None]  # (K, S, 6)
-            for c in range(N_CHANNELS):
-                offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
-            lines.append(Line(
-                name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
-                u=u, input_unit=unit, columns=np.einsum("psc,ksc->pk", matrix, d_means),
-                note="c by central differences of the noise-free segment means, step u(x)",
-                second_order=_largest_second_order(matrix, second[start:stop], u) if describe else None))
-            start = stop
+    start = 0
+    for name, error, idx_g, unit in groups:
+        stop = start + len(idx_g)
+        u = steps[start:stop]
+        d_means = d_means_all[start:stop]
+        # the means' offsets (for the quantiser: its damping is their variance's small difference
+        # Var(Δ) = g_ss + g_tt − 2g_st, so summed group by group, in this order)
+        for c in range(N_CHANNELS):
+            offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
+        lines.append(Line(
+            name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
+            u=u, input_unit=unit, columns=_through_reduction(matrix, d_means),
+            note="c by central differences of the noise-free segment means, step u(x)",
+            second_order=_largest_second_order(matrix, second_all[start:stop], u) if describe else None))
+        start = stop
 
     # table start angle of the rotating segments: exact variance over the angle
     rotating = [s for s, seg in enumerate(segments) if seg.rate != 0.0]
@@ -168,17 +180,16 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
 
     # the unit under calibration: dependence of the error on the true parameters
     if idx.size:
-        first, second = first_all[n_table:], second_all[n_table:]
-        d_means = first * spread[idx][:, None, None]
+        d_means = d_means_all[n_table:]
         for c in range(N_CHANNELS):
             offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
-        columns = np.einsum("psc,ksc->pk", matrix, d_means)
+        columns = _through_reduction(matrix, d_means)
         columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
         lines.append(Line(
             name="unit-to-unit spread", category="unit", evaluation="B", distribution="normal (mimu.truth_spread)",
             u=spread[idx], input_unit="SI of each parameter", columns=columns, mixed_units=True,
             note="∂E/∂Y = R·∂m/∂Y − 1: the error's dependence on the true value",
-            second_order=_largest_second_order(matrix, second, spread[idx]) if describe else None))
+            second_order=_largest_second_order(matrix, second_all[n_table:], spread[idx]) if describe else None))
 
     # white noise of the segment means (type A, ν = n − 1)
     for label, channels in (("white noise, gyros", _GYROS), ("white noise, accelerometers", _ACCELS)):

@@ -13,6 +13,7 @@ the quantiser and its unknown offset, so
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -98,6 +99,14 @@ def _series_sum(fraction: np.ndarray, damping: np.ndarray) -> np.ndarray:
     return out
 
 
+@functools.lru_cache(maxsize=16)
+def _upper_triangle(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(n)``, read-only, once per size (it costs more than the series it indexes)."""
+    rows, cols = np.triu_indices(n)
+    rows.flags.writeable = cols.flags.writeable = False
+    return rows, cols
+
+
 #: Most terms of the quantisation series summed term by term (beyond: the undamped closed form).
 _MAX_TERMS = 2000
 
@@ -151,7 +160,7 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
     else:
         g = np.asarray(offset_covariance, dtype=float)
         var_delta = np.maximum(np.diag(g)[:, None] + np.diag(g)[None, :] - 2.0 * g, 0.0)
-    upper = np.triu_indices(n_seg)  # the covariance is symmetric: each pair once
+    upper = _upper_triangle(n_seg)  # the covariance is symmetric: each pair once
     fraction = (means[upper[1]] - means[upper[0]]) / step
     damping = (sigma[upper[0]] ** 2 + sigma[upper[1]] ** 2 + var_delta[upper]) / step**2
     cov = np.empty((n_seg, n_seg))

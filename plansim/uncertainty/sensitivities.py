@@ -42,7 +42,7 @@ from plansim.kernels.layout import (
     perpendicularity_index,
     segment_base,
 )
-from plansim.kernels.segment_path import noise_free_mean_differences
+from plansim.kernels.segment_path import noise_free_mean_derivatives
 from plansim.model.parameters import N_PARAMETERS
 from plansim.schedule.segments import Schedule, Segment
 from plansim.simulate.arguments import kernel_arguments, noise_free_arguments, nominal_draws
@@ -154,7 +154,7 @@ def segment_mean_derivatives(scenario: Scenario, indices: np.ndarray, steps: np.
 
     Central differences with step ``steps[k]`` around the nominal draws (JCGM 100 5.1.3 note 2),
     averaged over the table start angle (:data:`PHASE_NODES` angles): the derivatives of the
-    expected means. One call of :func:`plansim.kernels.segment_path.noise_free_mean_differences`,
+    expected means. One call of :func:`plansim.kernels.segment_path.noise_free_mean_derivatives`,
     which evaluates a segment only where the component enters it (a position error of one segment
     moves that segment alone), so the result is that of evaluating every perturbed draws vector in
     full, bit for bit, at a fraction of the cost.
@@ -194,14 +194,11 @@ def segment_mean_derivatives(scenario: Scenario, indices: np.ndarray, steps: np.
                          "other than the start angles")
     n_in = len(indices)
     nominal = np.empty((PHASE_NODES, n_seg, N_CHANNELS))
-    centre = np.empty((1, n_seg, N_CHANNELS))
-    mean_plus = np.empty((n_in, n_seg, N_CHANNELS))
-    mean_minus = np.empty((n_in, n_seg, N_CHANNELS))
-    noise_free_mean_differences(nominal_draws(scenario), phase_angles(), indices, steps,
+    first = np.empty((n_in, n_seg, N_CHANNELS))
+    second = np.empty((n_in, n_seg, N_CHANNELS))
+    noise_free_mean_derivatives(nominal_draws(scenario), phase_angles(), indices, steps,
                                 **noise_free_arguments(scenario, arguments), phase_means_out=nominal,
-                                centre_out=centre, plus_out=mean_plus, minus_out=mean_minus)
-    first = (mean_plus - mean_minus) / (2.0 * steps[:, None, None])
-    second = (mean_plus + mean_minus - 2.0 * centre) / steps[:, None, None] ** 2
+                                first_out=first, second_out=second)
     return nominal, first, second
 
 
