@@ -305,10 +305,12 @@ def truth_channel(p):
 
 
 @inline_jit
-def evaluate_outputs(nodes, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2,
-                     channel, out, scratch):
+def evaluate_outputs(nodes, extra, cos_phase, sin_phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor,
+                     S2, channel, out, scratch):
     """Noise-free outputs ``out[j]`` (6) at table angles θ_j = phase + 2πj/nodes (j < nodes) and, for
-    j ≥ nodes (``extra`` more rows), at θ = phase; table rate ``rates[j]``. Angles by angle addition.
+    j ≥ nodes (``extra`` more rows), at θ = phase, given ``cos phase`` and ``sin phase`` (a caller that
+    evaluates many segments at the same angles computes them once); table rate ``rates[j]``. Angles
+    by angle addition.
 
     *channel* :data:`ALL_CHANNELS` writes all six; a channel 0 … 5 writes ``out[j, channel]`` alone
     (the same number, for a caller that knows the others have not changed: :func:`truth_channel`).
@@ -318,8 +320,8 @@ def evaluate_outputs(nodes, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, B
     w = scratch[0, :3]
     fc = scratch[1, :3]
     y = scratch[2]
-    c0 = math.cos(phase)
-    s0 = math.sin(phase)
+    c0 = cos_phase
+    s0 = sin_phase
     cd = math.cos(2.0 * math.pi / nodes)
     sd = math.sin(2.0 * math.pi / nodes)
     ct, st = c0, s0

@@ -188,26 +188,38 @@ def channel_moments(mu, sigma, step, coefficients, row, kmax):
 #: terms of :func:`quantisation_series` between exact evaluations of a harmonic and its damping (the
 #: recurrences in between lose about an ulp per term)
 SERIES_RESEED = 32
+#: the terms :func:`quantisation_series` needs are this over τ: exp(−2π²k²τ²) < exp(−46) ≈ 1e-20 beyond
+_TERMS_PER_INVERSE_TAU = math.sqrt(46.0 / (2.0 * math.pi**2))
+_PI_SQUARED = math.pi**2
 
 
 @jit
-def quantisation_series(turns, damping, terms, out):
-    """``out[i] = Σ_{k=1..terms[i]} cos(2πk·turns[i]) exp(−2π²k²·damping[i]) / k²``.
+def quantisation_series(fraction, damping, max_terms, out):
+    """``out[i] = Σ_{k≥1} cos(2πk·f) exp(−2π²k²·d) / k²`` for ``f = fraction[i]``, ``d = damping[i]`` (τ² ≥ 0).
 
     The series of the covariance of a noisy quantiser's bias at two input levels
-    (:func:`plansim.uncertainty.quantisation.quantisation_covariance`). The harmonics by rotation
-    (as :func:`moments_from_damping`) and the damping ``e_k`` by its ratio
-    ``e_{k+1}/e_k = exp(−2π²(2k+1)d)``, both evaluated exactly every :data:`SERIES_RESEED` terms:
-    within a few ulp of summing exactly evaluated terms, at a fraction of the cost.
+    (:func:`plansim.uncertainty.quantisation.quantisation_covariance`), summed term by term until the
+    damping makes the terms negligible (exp(−46) ≈ 1e-20); where that would need more than
+    *max_terms* terms, the undamped sum ``π²(x² − x + 1/6)`` (x = f mod 1, the Bernoulli polynomial
+    B₂), whose error is O(τ). The harmonics by rotation (as :func:`moments_from_damping`) and the
+    damping ``e_k`` by its ratio ``e_{k+1}/e_k = exp(−2π²(2k+1)d)``, both evaluated exactly every
+    :data:`SERIES_RESEED` terms: within a few ulp of summing exactly evaluated terms, at a fraction
+    of the cost.
     """
-    for i in range(turns.shape[0]):
-        t = turns[i]
+    for i in range(fraction.shape[0]):
+        f = fraction[i]
         d = damping[i]
+        t = f - math.floor(f)
+        tau = math.sqrt(max(d, 0.0))
+        terms = math.ceil(_TERMS_PER_INVERSE_TAU / max(tau, 1e-300)) if tau > 0.0 else math.inf
+        if terms > max_terms:
+            out[i] = _PI_SQUARED * (t * t - t + 1.0 / 6.0)
+            continue
         s1, c1 = sin_cos_turns(t)
         r2 = math.exp(-4.0 * math.pi * math.pi * d)  # the ratio of successive ratios
         total = 0.0
         ck, sk, e, g = 0.0, 0.0, 0.0, 0.0
-        for k in range(1, terms[i] + 1):
+        for k in range(1, int(terms) + 1):
             if (k - 1) % SERIES_RESEED == 0:
                 sk, ck = sin_cos_turns(k * t)
                 e = math.exp(-2.0 * math.pi * math.pi * k * k * d)

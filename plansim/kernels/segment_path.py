@@ -193,12 +193,13 @@ def _harmonics_needed(spread, sigma, step, coefficients, row, kmax, tolerance):
 
 
 @inline_jit
-def segment_node_outputs(rate, rate_act, phase, dT, extra, channel, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P,
-                         sensor, S2, rates, outputs, scratch):
+def segment_node_outputs(rate, rate_act, cos_phase, sin_phase, dT, extra, channel, u, g_b0, om_b0, perp, Kg, Bg, G,
+                         Ka, Ba, P, sensor, S2, rates, outputs, scratch):
     """The noise-free outputs of a segment whose geometry :func:`segment_geometry` has set.
 
-    *rate* is the commanded rate (0: at rest), *rate_act* and *phase* the actual rate and start angle
-    :func:`segment_geometry` returned (any start angle may be given), ``dT`` the temperature offset.
+    *rate* is the commanded rate (0: at rest), *rate_act* the actual rate :func:`segment_geometry`
+    returned, *cos_phase* and *sin_phase* those of the start angle θ0 (the one it returned, or any
+    other), ``dT`` the temperature offset.
     At rest, ``outputs[0]`` (6): the one output, whatever the table angle. Rotating, ``outputs[j]``
     for j < 7: the outputs at the table angles θ0 + 2πj/7 at the actual rate, then *extra* rows (0 or
     :data:`_JITTER_NODES`) at θ0 with the rate ± 1e-6 of itself (the rate-jitter response).
@@ -208,7 +209,7 @@ def segment_node_outputs(rate, rate_act, phase, dT, extra, channel, u, g_b0, om_
     """
     if rate == 0.0:
         rates[0] = 0.0
-        evaluate_outputs(_ONE_NODE, _NO_EXTRA, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
+        evaluate_outputs(_ONE_NODE, _NO_EXTRA, 1.0, 0.0, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
                          sensor, S2, channel, outputs, scratch)
         return
     h = 1e-6 * abs(rate_act)
@@ -217,8 +218,8 @@ def segment_node_outputs(rate, rate_act, phase, dT, extra, channel, u, g_b0, om_
     if extra > 0:
         rates[DETERMINISTIC_NODES] = rate_act + h
         rates[DETERMINISTIC_NODES + 1] = rate_act - h
-    evaluate_outputs(DETERMINISTIC_NODES, extra, phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka, Ba, P,
-                     sensor, S2, channel, outputs, scratch)
+    evaluate_outputs(DETERMINISTIC_NODES, extra, cos_phase, sin_phase, rates, u, g_b0, om_b0, perp, dT, Kg, Bg, G, Ka,
+                     Ba, P, sensor, S2, channel, outputs, scratch)
 
 
 @jit
@@ -245,8 +246,9 @@ def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp
         rate_act, phase = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
                                            earth_enu, lever, g_b0, om_b0, u, perp, frames)
         # the 7 nodes, then two more at θ0 with the rate ± h for the jitter response
-        segment_node_outputs(seg_rate[s], rate_act, phase, seg_temp[s] - t_ref, _JITTER_NODES, ALL_CHANNELS, u, g_b0,
-                             om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
+        segment_node_outputs(seg_rate[s], rate_act, math.cos(phase), math.sin(phase), seg_temp[s] - t_ref,
+                             _JITTER_NODES, ALL_CHANNELS, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates,
+                             outputs, scratch)
         if seg_rate[s] == 0.0:
             rates_out[s] = 0.0
             for c in range(6):
@@ -373,6 +375,11 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
     weights = np.empty(DETERMINISTIC_NODES)
     spread = np.empty(6)
     phase_means = np.empty((n_phases, 6))
+    cos_phases = np.empty(n_phases)  # the start angles are the same for every segment and component
+    sin_phases = np.empty(n_phases)
+    for j in range(n_phases):
+        cos_phases[j] = math.cos(phases[j])
+        sin_phases[j] = math.sin(phases[j])
     centre = np.empty((n_seg, 6))
     plus = np.empty((n_seg, 6))  # m̄₊ of the component at hand
     for k in range(-1, indices.shape[0]):  # k = −1: the means at base, into phase_means_out and centre
@@ -398,7 +405,7 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                                                earth_enu, lever, g_b0, om_b0, u, perp, frames)
                 dT = seg_temp[s] - t_ref
                 if seg_rate[s] == 0.0:  # at rest: one evaluation, whatever the angle
-                    segment_node_outputs(seg_rate[s], rate_act, 0.0, dT, _NO_EXTRA, channel, u, g_b0, om_b0, perp,
+                    segment_node_outputs(seg_rate[s], rate_act, 1.0, 0.0, dT, _NO_EXTRA, channel, u, g_b0, om_b0, perp,
                                          Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
                     for j in range(n_phases):
                         for c in range(6):
@@ -406,8 +413,9 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                 else:
                     arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
                     for j in range(n_phases):
-                        segment_node_outputs(seg_rate[s], rate_act, phases[j], dT, _NO_EXTRA, channel, u, g_b0,
-                                             om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
+                        segment_node_outputs(seg_rate[s], rate_act, cos_phases[j], sin_phases[j], dT, _NO_EXTRA,
+                                             channel, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates,
+                                             outputs, scratch)
                         weighted_mean_and_spread(nodes, _FIRST, weights, phase_means[j], spread)
                 if k < 0:
                     for j in range(n_phases):

@@ -160,10 +160,9 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         deviation = nominal - centre
         # below 64 ulp of the mean the deviation is rounding, not a start-angle effect
         deviation[np.abs(deviation) <= 64 * np.finfo(float).eps * np.abs(centre)[None]] = 0.0
-        cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
-        for s in rotating:
-            d = np.einsum("pc,jc->jp", matrix[:, s, :], deviation[:, s, :])  # (J, 39)
-            cov += d.T @ d / PHASE_NODES
+        d = np.einsum("psc,jsc->sjp", matrix[:, rotating, :], deviation[:, rotating, :])  # (R, J, 39) per angle
+        d = d.reshape(-1, N_PARAMETERS)
+        cov = d.T @ d / PHASE_NODES  # Σ over the rotating segments of the variance over the angle
         # the variance over the angle of each rotating segment's mean, per channel (the angle last: the
         # same pairwise sum as the mean of each segment and channel alone)
         squares = np.mean(np.ascontiguousarray(np.moveaxis(deviation[:, rotating, :] ** 2, 0, -1)), axis=-1)

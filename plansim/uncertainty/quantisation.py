@@ -75,30 +75,6 @@ def quantisation_variance(step: float, sigma: float, samples: int) -> tuple[floa
     return bias + (full - bias) / int(samples), fraction
 
 
-def _series_sum(fraction: np.ndarray, damping: np.ndarray) -> np.ndarray:
-    """``Σ_{k≥1} cos(2πk·f) exp(−2π²k²τ²)/k²`` elementwise for ``f`` = *fraction*, ``τ²`` = *damping*.
-
-    Summed term by term until the damping makes the terms negligible (exp(−46) ≈ 1e-20;
-    :func:`plansim.kernels.quantiser.quantisation_series`); where that would need more than
-    :data:`_MAX_TERMS` terms the undamped sum ``π²(x² − x + 1/6)`` (x = f mod 1, the Bernoulli
-    polynomial B₂) is used, whose error is O(τ).
-    """
-    fraction = np.asarray(fraction, dtype=float)
-    damping = np.asarray(damping, dtype=float)
-    x = fraction - np.floor(fraction)
-    undamped = np.pi**2 * (x**2 - x + 1.0 / 6.0)
-    tau = np.sqrt(np.maximum(damping, 0.0))
-    needed = np.where(tau > 0, np.ceil(np.sqrt(46.0 / (2.0 * np.pi**2)) / np.maximum(tau, 1e-300)), np.inf)
-    series = needed <= _MAX_TERMS
-    out = undamped.copy()
-    if np.any(series):
-        summed = np.empty(np.count_nonzero(series))
-        quantisation_series(np.ascontiguousarray(x[series]), np.ascontiguousarray(damping[series]),
-                            needed[series].astype(np.int64), summed)
-        out[series] = summed
-    return out
-
-
 @functools.lru_cache(maxsize=16)
 def _upper_triangle(n: int) -> tuple[np.ndarray, np.ndarray]:
     """``np.triu_indices(n)``, read-only, once per size (it costs more than the series it indexes)."""
@@ -164,7 +140,9 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
     fraction = (means[upper[1]] - means[upper[0]]) / step
     damping = (sigma[upper[0]] ** 2 + sigma[upper[1]] ** 2 + var_delta[upper]) / step**2
     cov = np.empty((n_seg, n_seg))
-    cov[upper] = step**2 / (2.0 * np.pi**2) * _series_sum(fraction, damping)
+    series = np.empty(fraction.shape)  # Σ_k cos(2πkΔ/q) exp(−2π²k²(…)/q²)/k² (beyond _MAX_TERMS: its closed form)
+    quantisation_series(fraction, damping, _MAX_TERMS, series)
+    cov[upper] = step**2 / (2.0 * np.pi**2) * series
     cov[upper[1], upper[0]] = cov[upper]
     full = step**2 / 12.0
     bias = np.clip(np.diag(cov).copy(), 0.0, full)
