@@ -71,15 +71,17 @@ def _distribution_text(error: ErrorDistribution, unit: str) -> str:
     return f"normal, σ = {error.scale:.4g}{shown}"
 
 
-def _through_reduction(matrix: np.ndarray, d_means: np.ndarray) -> np.ndarray:
+def _through_reduction(matrix: np.ndarray, d_means: np.ndarray, exact_zeros: bool) -> np.ndarray:
     """(39, K): the parameters' response ``R·Δm̄_k`` to each component's change of the means *d_means* (K, S, 6).
 
-    By ``einsum``, group by group: a BLAS product (6 times faster) sums in another order, and where the
-    reduction cancels a component exactly (two halves of a symmetric pair of positions) leaves a
-    rounding residue instead of the zero that makes the budget show that component's own signed
-    sensitivity.
+    *exact_zeros*: by ``einsum``, which leaves an exact zero where the reduction cancels a component
+    (the two halves of a symmetric pair of positions), so that a budget shows that component's own
+    signed sensitivity; otherwise by one BLAS product, six times faster, the same to rounding (a
+    residue of 1e-17 of the line instead of such zeros).
     """
-    return np.einsum("psc,ksc->pk", matrix, d_means)
+    if exact_zeros:
+        return np.einsum("psc,ksc->pk", matrix, d_means)
+    return matrix.reshape(N_PARAMETERS, -1) @ d_means.reshape(len(d_means), matrix[0].size).T
 
 
 def _largest_second_order(matrix: np.ndarray, second: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -102,9 +104,10 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         independent readings.
     describe : bool
         Also what only a budget shows: the largest second-order term of each linearised line
-        (``Line.second_order``) and the quantiser's dither regime in the distribution of its line.
-        ``False`` leaves them out (``None``; the distribution without the regime) and changes no
-        number: the prediction (:func:`plansim.uncertainty.gum.gum_uncertainties`) needs none of them.
+        (``Line.second_order``), the quantiser's dither regime in the distribution of its line, and
+        exact zeros where the reduction cancels a component (:func:`_through_reduction`). ``False``
+        leaves them out (``None``; the distribution without the regime; columns the same to
+        rounding): the prediction (:func:`plansim.uncertainty.gum.gum_uncertainties`) needs none of them.
 
     Returns
     -------
@@ -135,6 +138,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     nominal, first_all, second_all = segment_mean_derivatives(scenario, indices, steps, arguments)  # (J, S, 6), …
     n_table = len(indices) - idx.size
     d_means_all = first_all * steps[:, None, None]  # (K, S, 6): what a step u of each component does to the means
+    columns_all = None if describe else _through_reduction(matrix, d_means_all, exact_zeros=False)
 
     # table and fixture errors: finite differences of the noise-free means
     start = 0
@@ -148,7 +152,8 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
             offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
         lines.append(Line(
             name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
-            u=u, input_unit=unit, columns=_through_reduction(matrix, d_means),
+            u=u, input_unit=unit,
+            columns=_through_reduction(matrix, d_means, True) if describe else columns_all[:, start:stop],
             note="c by central differences of the noise-free segment means, step u(x)",
             second_order=_largest_second_order(matrix, second_all[start:stop], u) if describe else None))
         start = stop
@@ -182,7 +187,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         d_means = d_means_all[n_table:]
         for c in range(N_CHANNELS):
             offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
-        columns = _through_reduction(matrix, d_means)
+        columns = _through_reduction(matrix, d_means, True) if describe else columns_all[:, n_table:].copy()
         columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
         lines.append(Line(
             name="unit-to-unit spread", category="unit", evaluation="B", distribution="normal (mimu.truth_spread)",

@@ -193,9 +193,10 @@ def gum_uncertainties(scenario: Scenario, coverage_probability: float = DEFAULT_
                       quantisation_correlation: bool = True) -> GumUncertainties:
     """The figures of :func:`evaluate_gum` without the budgets behind them: ``y``, ``u_c``, ``ν_eff``, ``k``, ``U``.
 
-    The same lines, covariance and arithmetic as :func:`evaluate_gum`, so the same numbers, without
-    what only a budget shows (each line per parameter, the systematic effects one by one, the
-    Appendix A view, the second-order terms), which cost more than the figures themselves: for
+    The same lines, covariance and arithmetic as :func:`evaluate_gum`, so the same numbers (to
+    rounding, 1e-15: the table lines' columns by one BLAS product, ``model_lines(describe=False)``),
+    without what only a budget shows (each line per parameter, the systematic effects one by one,
+    the Appendix A view, the second-order terms), which cost more than the figures themselves: for
     :func:`plansim.planning.predict.predict` and what calls it once per schedule.
 
     Parameters
