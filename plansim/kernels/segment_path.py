@@ -267,18 +267,25 @@ def noise_free_nodes(draws, seg_C0, seg_rate, seg_axis, seg_axis_index, seg_temp
 
 
 @inline_jit
+def node_mean(nodes, s, c, weights):
+    """``Σ_j weights[j]·nodes[s, j, c]`` over the 7 nodes: channel *c*'s mean over the segment's samples."""
+    total = 0.0
+    for j in range(DETERMINISTIC_NODES):
+        total += weights[j] * nodes[s, j, c]
+    return total
+
+
+@inline_jit
 def weighted_mean_and_spread(nodes, s, weights, mean_out, spread_out):
-    """``mean_out`` (6): ``Σ_j weights[j]·nodes[s, j]`` over the 7 nodes; ``spread_out`` (6): max − min of them."""
+    """``mean_out`` (6): :func:`node_mean` of every channel; ``spread_out`` (6): max − min of the node values."""
     for c in range(6):
-        total = 0.0
+        mean_out[c] = node_mean(nodes, s, c, weights)
         low = nodes[s, 0, c]
         high = low
         for j in range(DETERMINISTIC_NODES):
             y = nodes[s, j, c]
-            total += weights[j] * y
             low = min(low, y)
             high = max(high, y)
-        mean_out[c] = total
         spread_out[c] = high - low
 
 
@@ -340,6 +347,38 @@ def _segment_reads(index, s, seg_rate, seg_axis_index):
     return rotating or (index - HEAD) % PER_SEGMENT < SEG_RATE_ERROR
 
 
+#: what :func:`_save_geometry` keeps of a segment: the actual rate, u, g_b0, Ω_b0 (3 each), perp (3×3), the arc weights
+_SAVED_GEOMETRY = 1 + 9 + 9 + DETERMINISTIC_NODES
+
+
+@inline_jit
+def _save_geometry(rate_act, u, g_b0, om_b0, perp, weights, saved, s):
+    """Keep segment *s*'s orientation (:func:`segment_geometry`) and arc weights in ``saved[s]``."""
+    saved[s, 0] = rate_act
+    for i in range(3):
+        saved[s, 1 + i] = u[i]
+        saved[s, 4 + i] = g_b0[i]
+        saved[s, 7 + i] = om_b0[i]
+        for j in range(3):
+            saved[s, 10 + 3 * i + j] = perp[i, j]
+    for j in range(DETERMINISTIC_NODES):
+        saved[s, 19 + j] = weights[j]
+
+
+@inline_jit
+def _restore_geometry(saved, s, u, g_b0, om_b0, perp, weights):
+    """The inverse of :func:`_save_geometry`: segment *s*'s orientation and arc weights back; returns its rate."""
+    for i in range(3):
+        u[i] = saved[s, 1 + i]
+        g_b0[i] = saved[s, 4 + i]
+        om_b0[i] = saved[s, 7 + i]
+        for j in range(3):
+            perp[i, j] = saved[s, 10 + 3 * i + j]
+    for j in range(DETERMINISTIC_NODES):
+        weights[j] = saved[s, 19 + j]
+    return saved[s, 0]
+
+
 @jit
 def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
                                 seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu,
@@ -358,10 +397,11 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
     evaluating every perturbed draws vector with :func:`noise_free_means` and differencing with
     numpy, bit for bit. Only what a component enters is evaluated: only the segments that read it
     (:func:`_segment_reads`: a position error of one segment moves that segment alone), and of a
-    truth component only the one channel it enters (:func:`plansim.kernels.physics.truth_channel`);
-    the others' differences are exact zeros (m̄₊ = m̄₋ = m̄). At rest a segment is evaluated at one
-    angle (it does not depend on it); rotating, its orientation and arc weights once for all
-    angles. *indices* must not be start angles (``SEG_PHASE``): those are set from *phases*.
+    truth component only the one channel it enters (:func:`plansim.kernels.physics.truth_channel`),
+    with the orientation and arc weights of base (the truth moves neither); the others' differences
+    are exact zeros (m̄₊ = m̄₋ = m̄). At rest a segment is evaluated at one angle (it does not depend
+    on it); rotating, its orientation and arc weights once for all angles. *indices* must not be
+    start angles (``SEG_PHASE``): those are set from *phases*.
     """
     n_seg = seg_n.shape[0]
     n_phases = phases.shape[0]
@@ -373,7 +413,6 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
     nodes = outputs.reshape((1, DETERMINISTIC_NODES, 6))
     scratch = np.empty((3, 6))
     weights = np.empty(DETERMINISTIC_NODES)
-    spread = np.empty(6)
     phase_means = np.empty((n_phases, 6))
     cos_phases = np.empty(n_phases)  # the start angles are the same for every segment and component
     sin_phases = np.empty(n_phases)
@@ -382,6 +421,7 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
         sin_phases[j] = math.sin(phases[j])
     centre = np.empty((n_seg, 6))
     plus = np.empty((n_seg, 6))  # m̄₊ of the component at hand
+    saved = np.empty((n_seg, _SAVED_GEOMETRY))  # each segment's orientation and arc weights at base
     for k in range(-1, indices.shape[0]):  # k = −1: the means at base, into phase_means_out and centre
         index = indices[k] if k >= 0 else -1
         channel = truth_channel(index) if 0 <= index < N_TRUTH else ALL_CHANNELS
@@ -400,9 +440,17 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                         second_out[k, s, c] = 0.0
                 if k >= 0 and not _segment_reads(index, s, seg_rate, seg_axis_index):
                     continue
-                # the segment's mean at every start angle (its orientation and arc weights do not depend on it)
-                rate_act, _ = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
-                                               earth_enu, lever, g_b0, om_b0, u, perp, frames)
+                # the segment's mean at every start angle (its orientation and arc weights do not depend on it;
+                # a truth component leaves them as they are at base, so they are kept from there)
+                if channel >= 0:
+                    rate_act = _restore_geometry(saved, s, u, g_b0, om_b0, perp, weights)
+                else:
+                    rate_act, _ = segment_geometry(draws, s, seg_C0, seg_rate, seg_axis, seg_axis_index, gravity,
+                                                   earth_enu, lever, g_b0, om_b0, u, perp, frames)
+                    if seg_rate[s] != 0.0:
+                        arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
+                    if k < 0:
+                        _save_geometry(rate_act, u, g_b0, om_b0, perp, weights, saved, s)
                 dT = seg_temp[s] - t_ref
                 if seg_rate[s] == 0.0:  # at rest: one evaluation, whatever the angle
                     segment_node_outputs(seg_rate[s], rate_act, 1.0, 0.0, dT, _NO_EXTRA, channel, u, g_b0, om_b0, perp,
@@ -411,12 +459,13 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                         for c in range(6):
                             phase_means[j, c] = outputs[0, c]
                 else:
-                    arc_weights(DETERMINISTIC_NODES, rate_act * seg_dt[s], seg_n[s], weights)
                     for j in range(n_phases):
                         segment_node_outputs(seg_rate[s], rate_act, cos_phases[j], sin_phases[j], dT, _NO_EXTRA,
                                              channel, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates,
                                              outputs, scratch)
-                        weighted_mean_and_spread(nodes, _FIRST, weights, phase_means[j], spread)
+                        for c in range(6):
+                            if channel < 0 or c == channel:
+                                phase_means[j, c] = node_mean(nodes, _FIRST, c, weights)
                 if k < 0:
                     for j in range(n_phases):
                         for c in range(6):
