@@ -49,6 +49,12 @@ def test_complete_calibrations_default(benchmark, default_scenario):
     assert np.isfinite(results["error"].values).all()
 
 
+def test_predict_default(benchmark, default_scenario):
+    """The GUM prediction of the default schedule (plansim bench's predict_seconds)."""
+    prediction = benchmark(plansim.predict, default_scenario)
+    assert np.isfinite(prediction.u_predicted.values).all()
+
+
 def test_bench_command_quick(capsys):
     """`plansim bench --quick --json` runs end to end and reports every documented figure."""
     import json
@@ -59,7 +65,7 @@ def test_bench_command_quick(capsys):
     figures = json.loads(capsys.readouterr().out)
     for key in ("numpy_normal_per_s", "samples_per_s", "calibrations_per_s", "peak_rss_mb", "summary_peak_rss_mb",
                 "summary_seconds", "cold_start_s", "warm_start_s", "seconds_per_trial", "predict_seconds",
-                "sweep_seconds"):
+                "predict_new_schedule_seconds", "sweep_seconds"):
         assert key in figures
     assert figures["sweep_cells"] == 4 and figures["sweep_seconds"] > 0
     assert figures["calibrations_per_s"] > 0 and figures["peak_rss_mb"] > 0 and figures["summary_peak_rss_mb"] > 0
