@@ -61,13 +61,16 @@ def schedule_arrays(schedule: Schedule) -> dict[str, np.ndarray]:
 @functools.lru_cache(maxsize=64)
 def _schedule_arrays(segs: tuple[Segment, ...]) -> dict[str, np.ndarray]:
     """:func:`schedule_arrays` of the segments *segs* (a planner asks for the same schedule many times over)."""
+    poses = {(s.up, s.heading): None for s in segs}  # a schedule repeats few poses and axes
+    poses = {pose: body_to_level(*pose) for pose in poses}
+    axes = {s.rate_axis: axis_vector(s.rate_axis) for s in segs}
     return dict(
         seg_n=np.array([s.samples for s in segs], dtype=np.int64),
         seg_dt=np.array([1.0 / s.sample_rate for s in segs]),
         seg_gap=np.array([s.settle for s in segs]),
-        seg_C0=np.array([body_to_level(s.up, s.heading) for s in segs]),
+        seg_C0=np.array([poses[s.up, s.heading] for s in segs]),
         seg_rate=np.array([s.rate for s in segs]),
-        seg_axis=np.array([axis_vector(s.rate_axis) for s in segs]),
+        seg_axis=np.array([axes[s.rate_axis] for s in segs]),
         seg_axis_index=np.array(["xyz".index(s.rate_axis[1]) for s in segs], dtype=np.int64),
         seg_temp=np.array([s.temperature for s in segs]),
     )
