@@ -128,6 +128,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     arguments = kernel_arguments(scenario)
     noise = arguments["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
     offsets = [np.zeros((n_seg, n_seg)) for _ in range(N_CHANNELS)]  # per channel: covariance of the means' offsets
+    with_offsets = bool(scenario.acquisition.bits) and quantisation_correlation  # what they are for
 
     # every finite difference at once (table and fixture errors, then the unit's spread): one kernel call
     groups = table_groups(scenario)
@@ -148,7 +149,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         d_means = d_means_all[start:stop]
         # the means' offsets (for the quantiser: its damping is their variance's small difference
         # Var(Δ) = g_ss + g_tt − 2g_st, so summed group by group, in this order)
-        for c in range(N_CHANNELS):
+        for c in range(N_CHANNELS if with_offsets else 0):
             offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
         lines.append(Line(
             name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
@@ -185,7 +186,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     # the unit under calibration: dependence of the error on the true parameters
     if idx.size:
         d_means = d_means_all[n_table:]
-        for c in range(N_CHANNELS):
+        for c in range(N_CHANNELS if with_offsets else 0):
             offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
         columns = _through_reduction(matrix, d_means, True) if describe else columns_all[:, n_table:].copy()
         columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
