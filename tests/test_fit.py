@@ -424,6 +424,11 @@ def test_quantisation_step_from_the_data():
     assert quantisation_step(segments) == pytest.approx(q, rel=1e-9)
     assert quantisation_step([level + rng.normal(size=2000) for level in range(5)]) == 0.0
     assert quantisation_step([np.full(100, 1.0), np.full(100, 2.0)]) == 0.0  # no variation: no step to see
+    # quantised segments and one that is not (a signal added after the quantiser): the smallest gap is then a
+    # rounding difference far below the step, which must not be taken for it
+    mixed = [s.copy() for s in segments]
+    mixed[0] = mixed[0] + 0.3 * q * np.sin(np.arange(mixed[0].size))
+    assert quantisation_step(mixed) == 0.0
     assert float(quantisation_error_variance(q, 0.0)) == pytest.approx(q**2 / 12, rel=1e-3)
     assert float(quantisation_error_variance(q, q)) < 1e-12 * q**2  # dithered
 

@@ -48,6 +48,8 @@ RELATIVE_FLOOR = 1e-12
 #: a channel counts as quantised when its static values are multiples of one step to this (relative) and
 #: at most this fraction of them are distinct
 QUANTISATION_MATCH = 1e-6
+#: … and never by more than this fraction of a step
+QUANTISATION_OFF_GRID = 0.01
 QUANTISATION_DISTINCT = 0.5
 #: the drop in χ² for which the Allan fit takes a bias-instability or random-walk term (per term); calibrated by
 #: simulation (tests/test_fit.py): pure white noise in 21 segments of 3000 samples gets one in 0.9 % of 1000 channels
@@ -208,7 +210,11 @@ def quantisation_step(segments: list[np.ndarray]) -> float:
     if q <= 0:
         return 0.0
     ratio = gaps / q
-    if np.all(np.abs(ratio - np.rint(ratio)) <= QUANTISATION_MATCH * np.maximum(ratio, 1.0)):
+    # a gap may miss a whole multiple by rounding (relative QUANTISATION_MATCH), never by a sizeable part of the
+    # step: without that bound, a q far below the data's resolution (two continuous values 1e-19 apart) passes,
+    # because every ratio is then huge and so is its allowance
+    allowance = np.minimum(QUANTISATION_MATCH * np.maximum(ratio, 1.0), QUANTISATION_OFF_GRID)
+    if np.all(np.abs(ratio - np.rint(ratio)) <= allowance):
         return q
     return 0.0
 
