@@ -10,18 +10,22 @@ Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simul
   (:attr:`plansim.diagnose.scores.CandidateScore.noise_equivalent_size`), injected through the scenario's
   ``[mimu.effects]`` field so that the simulator makes it (``bias_drift`` has no field: a ramp in time is added to
   the samples). The component is the first one the schedule identifies;
-- **effects outside the catalogue**, added to the simulated samples (:func:`_add_out_of_catalogue`): a step in
+- **effects outside the catalogue**, added to the simulated samples before the acquisition (the same trial
+  simulated without the quantiser, the effect added, then saturated and quantised as the scenario's acquisition
+  does: :func:`_acquire`; added after the quantiser, they would leave samples off its codes that no sensor
+  makes) (:func:`_add_out_of_catalogue`): a step in
   the x gyro's bias half-way through the recording, of k × the standard uncertainty of a gx segment mean; a
   sample clock that runs fast by k × 100 ppm (the segment table, in nominal time, drifts off the data); a burst
   of extra white noise on gx over a tenth of the run, of k × its noise per sample. And a lever arm of 5 mm on
   the x accelerometer that the fit is not told (aliased with P in JJF 2003: it must never be attributed).
 
-``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, or
-the lack of fit flagged), detection (anything flagged) and correct attribution (the injected effect selected,
-and only it), the confusion of injected against selected, how often an out-of-catalogue effect is flagged as
-an unexplained residual, and the parameters' error against the truth before and after the refit (r.m.s. of
-(estimate − truth)/u, and the 95 % coverage of the after-fit). Each recording's seed is a hash of the root
-seed, the case and the index, so the numbers do not depend on the order of the cases.
+``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, the
+base model's lack of fit, or anything unexplained after the refit, within segments included), detection
+(anything flagged) and correct attribution (the injected effect selected, and only it), the confusion of
+injected against selected, how often an out-of-catalogue effect is flagged as an unexplained residual, and the
+parameters' error against the truth before and after the refit (r.m.s. of (estimate − truth)/u, and the 95 %
+coverage of the after-fit). Each recording's seed is a hash of the root seed, the case and the index, so the
+numbers do not depend on the order of the cases.
 """
 
 from __future__ import annotations
@@ -34,9 +38,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import binom
 
+from plansim.config import parse_scenario
 from plansim.diagnose.procedure import diagnose
 from plansim.fit import resolve_site
+from plansim.io.scenario_file import apply_overrides
+from plansim.kernels.layout import ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP
+from plansim.kernels.quantiser import quantise
 from plansim.runner import simulate_and_record
+from plansim.simulate.arguments import kernel_arguments
 from plansim.simulate.chunks import simulate_recording
 from plansim.uncertainty.metrology.propagation import coverage_factor
 
@@ -91,6 +100,33 @@ class CheckReport:
     out_of_catalogue: list = field(default_factory=list)
 
 
+def _alarm(d) -> bool:
+    """The diagnosis says something is there: an effect selected, the base model's lack of fit, or anything
+    unexplained after the refit (segment level or within segments)."""
+    return bool(d.selected) or bool(d.lack_of_fit.flagged) or bool(d.unexplained["flagged"])
+
+
+def _without_quantiser(scenario):
+    """The scenario with its acquisition's quantiser off (bits = 0): the same trial's samples before it (the
+    quantiser draws no random numbers, so everything else is the same)."""
+    document = apply_overrides(scenario.document, ["acquisition.bits=0"])
+    return parse_scenario(document, source=f"{scenario.source} without its quantiser")
+
+
+def _acquire(scenario, samples: np.ndarray) -> np.ndarray:
+    """Samples (n, 6) through the scenario's acquisition: saturation and quantiser, per channel
+    (:func:`plansim.kernels.quantiser.quantise`, the sample path's own)."""
+    acquisition = np.asarray(kernel_arguments(scenario)["acquisition"], dtype=float)
+    out = np.empty_like(samples)
+    for c in range(samples.shape[1]):
+        kind = c // 3
+        output_range, step = acquisition[ACQ_RANGE + kind], acquisition[ACQ_STEP + kind]
+        full_scale = acquisition[ACQ_FULL_SCALE + kind]
+        inverse = 1.0 / step if step > 0 else 0.0
+        out[:, c] = [quantise(y, output_range, step, inverse, full_scale) for y in samples[:, c]]
+    return out
+
+
 def _run(scenario, recording, truth, lever, alpha, null_draws, seed):
     d = diagnose(recording, resolve_site(scenario=scenario), scenario.turntable, lever_arm=lever, alpha=alpha,
                  null_draws=null_draws, seed=seed)
@@ -138,7 +174,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         reference = reference or d
         sample_rate = recording.schedule.segments[0].sample_rate
         selections += bool(d.selected)
-        alarms += bool(d.selected) or d.lack_of_fit.flagged
+        alarms += _alarm(d)
         z_before.append(z["before"])
         tick()
     report.null = {"recordings": null, "false_alarms": alarms, "rate": alarms / null,
@@ -174,7 +210,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                     samples[:, c] += size * (t - t.mean())
                     recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
                 d, z = _run(injected, recording, truth, lever, alpha, null_draws, s)
-                counts["detected"] += bool(d.selected) or d.lack_of_fit.flagged
+                counts["detected"] += _alarm(d)
                 counts["attributed"] += d.selected == (effect,)
                 key = "+".join(d.selected) or "(none)"
                 counts["selected"][key] = counts["selected"].get(key, 0) + 1
@@ -193,18 +229,21 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     u_mean = float(np.median(np.sqrt(np.diag(reference.before.covariance)).reshape(-1, 6)[:, 0]))
     white = reference.before.noise.channels[0].white
     sigma_sample = float(white * math.sqrt(sample_rate)) if math.isfinite(white) else u_mean
+    unquantised = _without_quantiser(scenario)
     for effect in OUT_OF_CATALOGUE:
         for k in sizes:
             size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample)
             flagged, named = 0, 0
             for i in range(per_effect):
                 s = case_seed(seed, f"{effect}/{k}", i)
-                recording = simulate_and_record(scenario, seed=s, trial=0)
+                # the effect acts on the sensor, before the acquisition: added to the samples of the same trial
+                # without the quantiser, then quantised as the scenario's acquisition does
+                recording = simulate_and_record(unquantised, seed=s, trial=0)
                 _, _, truth = simulate_recording(scenario, s, 0)
                 samples = _add_out_of_catalogue(effect, np.array(recording.samples, dtype=float), size, s)
-                recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
+                recording = type(recording)(_acquire(scenario, samples), recording.schedule, dict(recording.attrs))
                 d, _ = _run(scenario, recording, truth, lever, alpha, null_draws, s)
-                flagged += d.unexplained["flagged"] or d.lack_of_fit.flagged
+                flagged += _alarm(d)
                 named += bool(d.selected)
                 tick()
             report.out_of_catalogue.append({"effect": effect, "times": k, "scale": scale, "size": size,

@@ -2,7 +2,10 @@
 
 1. **Base fit** M0 (:func:`plansim.fit.fit_recording`: the noise from the data, the table's and fixture's
    Type B errors per setting, the between-segment noise the residuals show).
-2. **Lack of fit** of M0 at segment level, against its simulated null (:func:`plansim.diagnose.scores.lack_of_fit`).
+2. **Lack of fit** of M0 at segment level, against its simulated null (:func:`plansim.diagnose.scores.lack_of_fit`),
+   and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, against
+   a null simulated from the recording's own noise (:func:`plansim.diagnose.within.within_segment_tests`); each at
+   α/2, so that "something is unexplained" keeps the level α.
 3. **Candidates** (:mod:`plansim.diagnose.catalogue`): identifiability first, then score tests with the family-wise
    error over the catalogue held at α by the simulated min-p null (:func:`plansim.diagnose.scores.score_candidates`).
 4. **Closed testing** (Marcus, Peritz & Gabriel 1976): of the candidates whose adjusted p-value is below α, the
@@ -12,8 +15,9 @@
    procedure stops when none is significant. Each step tests the intersection hypothesis of the candidates
    still out with a min-p test at level α, so the family-wise error of the selections stays ≤ α (the
    step-down procedure of Westfall & Young 1993 is a shortcut of the closed test).
-5. **What remains**: the lack of fit of the final model; if flagged, where (channels and segments), never named
-   after a candidate.
+5. **What remains**: the lack of fit of the final model and the within-segment findings; if flagged, where
+   (channels and segments) and the pattern (a trend's slope, a step's time and size, a periodic component's
+   frequency and amplitude, a burst's stretch), never named after a candidate.
 6. **Before and after**: residual r.m.s. per channel and χ²/dof, every parameter before and after with u, which
    parameters absorbed the effects, and a leave-one-segment-out prediction error with both models.
 
@@ -29,6 +33,7 @@ import numpy as np
 
 from plansim.diagnose.catalogue import signatures
 from plansim.diagnose.scores import NULL_DRAWS, CandidateScore, LackOfFit, lack_of_fit, null_residuals, score_candidates
+from plansim.diagnose.within import within_segment_tests
 from plansim.fit import fit_recording
 from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
@@ -46,7 +51,7 @@ class Diagnosis:
     after: object  # FitResult
     lack_of_fit: LackOfFit
     lack_of_fit_after: LackOfFit
-    within: object | None  # within-segment tests: not part of this version (None)
+    within: object  # WithinResult: the within-segment tests (plansim.diagnose.within)
     candidates: tuple[CandidateScore, ...]
     selected: tuple[str, ...]
     sizes: dict
@@ -198,9 +203,14 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     # g²-sensitivity when the x-, y- and z-up poses come in blocks), and the tests ran hot.
     before = fit_recording(recording, **options)
     options["between_noise"] = before.between_noise
+    # within segments: the shapes the means cannot show, against the recording's own noise (half the level: the
+    # segment-level lack of fit has the other half, so "something unexplained" keeps the level α)
+    segments = recording.schedule.segments
+    within = within_segment_tests([recording.segment_samples(k) for k in range(len(segments))], segments,
+                                  before.noise, alpha=alpha / 2.0, seed=seed)
     sigs = signatures(before)
     null = null_residuals(before, null_draws, seed)
-    lof = lack_of_fit(before, alpha=alpha, null=null)
+    lof = lack_of_fit(before, alpha=alpha / 2.0, null=null)
     scores = score_candidates(before, sigs, alpha=alpha, null=null)
     first = scores
     steps = [scores]
@@ -253,7 +263,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         scores = score_candidates(current, remaining, alpha=alpha, null=null)
         steps.append(scores)
     after = current
-    lof_after = lack_of_fit(after, alpha=alpha, null=null_residuals(after, null_draws, seed + 1000))
+    lof_after = lack_of_fit(after, alpha=alpha / 2.0, null=null_residuals(after, null_draws, seed + 1000))
     sizes = {}
     if after.extra is not None:
         for effect in selected:
@@ -263,9 +273,11 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
             sizes[effect] = {"components": [n[len(effect) + 1:-1] for n in names],
                              "value": [float(after.extra.estimate[i]) for i in idx],
                              "u": [float(after.extra.u[i]) for i in idx], "unit": unit}
-    unexplained = {"flagged": bool(lof_after.flagged), "where": _where(after, lof_after) if lof_after.flagged else []}
+    unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged),
+                   "where": _where(after, lof_after) if lof_after.flagged else [],
+                   "within_segments": [dict(item) for item in within.flagged]}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
-    return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=None,
+    return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=within,
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,
                      holdout=hold, steps=tuple(steps),
                      information={"before": _information(before), "after": _information(after)}, alpha=alpha)
@@ -314,4 +326,7 @@ def diagnosis_json(d: Diagnosis) -> dict:
             "unexplained": d.unexplained, "before": side(d.before, d.holdout["before"]),
             "after": side(d.after, d.holdout["after"]), "parameters": parameters, "absorbed": absorbed(d),
             "information": d.information, "alpha": d.alpha,
-            "within_segment": "not tested by this version (trends, steps, periodic components within segments)"}
+            "within_segment": {"alpha": d.within.alpha, "draws": d.within.draws,
+                               "segments_tested": len(d.within.segments),
+                               "smallest_adjusted_p_value": d.within.smallest_adjusted_p(),
+                               "flagged": [dict(item) for item in d.within.flagged]}}

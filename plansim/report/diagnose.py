@@ -18,6 +18,35 @@ def _p(value: float) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
 
 
+def _within_lines(d) -> list[str]:
+    """The within-segment findings, each with its pattern in display units."""
+    w = d.within
+    if not w.flagged:
+        return [f"Within the {len(w.segments)} segments at rest (trend, step, periodic, burst, scatter): nothing "
+                f"(smallest adjusted p = {_p(w.smallest_adjusted_p())}, level {w.alpha:g})."]
+    lines = [f"UNEXPLAINED within segments (level {w.alpha:g}, family-wise over {len(w.segments)} segments at rest, "
+             "6 channels and 5 tests): not named after any catalogue effect"]
+    for item in w.flagged[:12]:
+        c = CHANNELS.index(item["channel"])
+        unit, factor = OUTPUT_UNITS[_kind(c)]
+        test = item["test"]
+        if test == "trend":
+            what = f"trend {item['slope'] / factor:+.3g} {unit}/s"
+        elif test == "step":
+            what = f"step of {item['size'] / factor:+.3g} {unit} at {item['at_s']:.1f} s"
+        elif test == "periodic":
+            what = f"periodic at {item['frequency_hz']:.4g} Hz, amplitude {item['amplitude'] / factor:.3g} {unit}"
+        elif test == "burst":
+            what = f"burst from {item['from_s']:.1f} to {item['to_s']:.1f} s, sd {item['std'] / factor:.3g} {unit}"
+        else:
+            what = f"noisier than the other segments: sd {item['std'] / factor:.3g} {unit}"
+        lines.append(f"  {item['channel']} segment {item['segment']} {item['label']}: {what} "
+                     f"(adjusted p = {_p(item['adjusted_p_value'])})")
+    if len(w.flagged) > 12:
+        lines.append(f"  … and {len(w.flagged) - 12} more")
+    return lines
+
+
 def diagnose_report(d) -> str:
     """The whole report of a :class:`plansim.diagnose.procedure.Diagnosis` as text."""
     lines = ["plansim diagnose — closing the loop (docs/closing-the-loop.md)", ""]
@@ -34,7 +63,7 @@ def diagnose_report(d) -> str:
     else:
         lines.append("Found: no catalogue effect is significant.")
     after = d.lack_of_fit_after
-    if d.unexplained["flagged"]:
+    if after.flagged:
         lines.append(f"UNEXPLAINED residual after the refit (p = {_p(after.p_value)}): not named after any "
                      "catalogue effect; where it sits:")
         for where in d.unexplained["where"]:
@@ -45,8 +74,7 @@ def diagnose_report(d) -> str:
             lines.append(f"  {where['channel']} (p = {_p(where['p_value'])}): {segs}")
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
-    lines.append("Within segments (trends, steps, periodic components, samples stuck at a rail): not tested by "
-                 "this version.")
+    lines += _within_lines(d)
     lines += ["", "Candidates (first round; adjusted p: Westfall–Young min-p over the identifiable ones)",
               f"{'effect':25s} {'identifiable':>12s} {'dof':>4s} {'statistic':>10s} {'p':>9s} {'adjusted p':>10s}  "
               "aliased with / would be separated by"]

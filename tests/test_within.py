@@ -1,0 +1,150 @@
+"""Within-segment tests (plansim.diagnose.within): the null noise generator, the statistics, the calibrated
+family-wise false-alarm rate and the power on patterns the segment means cannot show.
+
+Statistical tests use fixed seeds; their tolerances come from the binomial law of the number of trials and say
+their power.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import allantools
+import numpy as np
+import pytest
+from scipy.stats import binom
+
+from plansim.diagnose.within import TESTS, segment_statistics, simulate_noise, within_segment_tests
+from plansim.fit.noise import FLICKER_VARIANCE, ChannelNoise
+from plansim.kernels.layout import CHANNELS
+from plansim.schedule.segments import Segment
+
+FS = 100.0
+N = 5e-4  # white noise, per √Hz
+SIGMA = N * math.sqrt(FS)  # per sample
+
+
+def channel(white=N, B=0.0, K=0.0, q=0.0, name="gx"):
+    empty = np.zeros(0)
+    return ChannelNoise(name, white, B, K, q, 4, 4000, empty, empty, empty)
+
+
+def noise(**kwargs):
+    return SimpleNamespace(channels=tuple(channel(name=c, **kwargs) for c in CHANNELS))
+
+
+def static_segments(count=4, dwell=10.0):
+    return [Segment(label=f"pose {k}", test="static", group=0, up="+x", dwell=dwell, sample_rate=FS)
+            for k in range(count)]
+
+
+def white_samples(segments, rng, sigma=SIGMA):
+    return [sigma * rng.standard_normal((s.samples, 6)) for s in segments]
+
+
+# ------------------------------------------------------------------------------------------- the null noise
+def test_simulated_flicker_has_the_allan_floor_the_fit_assumes():
+    # B only: the Allan deviation of the simulated samples at τ in the flat part equals √(2 ln 2/π)·B (IEEE 952)
+    B = 1e-4
+    x = simulate_noise(channel(white=0.0, B=B), 20000, FS, 8, np.random.default_rng(1))
+    taus = np.array([1.0, 3.0, 10.0])
+    floors = []
+    for row in x:
+        t, adev, *_ = allantools.oadev(row, rate=FS, data_type="freq", taus=taus)
+        floors.append(adev)
+    ratio = np.mean(floors, axis=0) / (math.sqrt(FLICKER_VARIANCE) * B)
+    assert np.all(np.abs(ratio - 1.0) < 0.15), ratio  # 8 records of 200 s: the estimator's own scatter ~5 %
+
+
+def test_simulated_white_noise_and_quantiser():
+    x = simulate_noise(channel(), 4000, FS, 50, np.random.default_rng(2))
+    assert np.std(x) == pytest.approx(SIGMA, rel=0.02)  # 2·10⁵ samples: SE 0.16 %
+    q = 2 * SIGMA
+    y = simulate_noise(channel(q=q), 1000, FS, 5, np.random.default_rng(3), level=0.3 * q)
+    assert np.allclose(y / q, np.round(y / q))
+
+
+# ------------------------------------------------------------------------------------------- statistics
+def test_statistics_of_known_patterns():
+    rng = np.random.default_rng(4)
+    n = 2000
+    t = np.arange(n) / FS
+    white = SIGMA * rng.standard_normal(n)
+    sine, _ = segment_statistics(white + 0.5 * SIGMA * np.sin(2 * math.pi * 7.0 * t), FS)
+    base, _ = segment_statistics(white, FS)
+    _, freq = segment_statistics(white + 0.5 * SIGMA * np.sin(2 * math.pi * 7.0 * t), FS)
+    assert sine[TESTS.index("periodic")] > 10 * base[TESTS.index("periodic")]
+    assert freq == pytest.approx(7.0, abs=FS / n)
+    step, _ = segment_statistics(white + 0.5 * SIGMA * (t > 12.0), FS)
+    assert step[TESTS.index("step")] > 8.0  # 0.5σ over 800 and 1200 samples: about 12 standard errors
+    flat, f = segment_statistics(np.full(n, 3.0), FS)
+    assert np.all(np.isnan(flat)) and np.isnan(f)  # nothing varies: nothing to test
+
+
+# ------------------------------------------------------------------------------------------- the tests
+def test_family_wise_false_alarms_are_at_most_alpha():
+    # 60 recordings of white noise (4 segments at rest × 6 channels × 5 tests each): the fraction flagged must
+    # not exceed α = 0.2 beyond the binomial 99 % bound (power: a true rate of 0.35 fails it 90 % of the time)
+    segments = static_segments()
+    alpha, count = 0.2, 60
+    flagged = 0
+    for i in range(count):
+        rng = np.random.default_rng(100 + i)
+        result = within_segment_tests(white_samples(segments, rng), segments, noise(), alpha=alpha, draws=99,
+                                      seed=i)
+        flagged += result.any_flagged
+    assert flagged <= binom.ppf(0.99, count, alpha)
+
+
+@pytest.mark.parametrize("pattern, test", [
+    ("sine", "periodic"), ("step", "step"), ("burst", "burst"), ("noisier", "scatter"), ("trend", "trend")])
+def test_patterns_inside_one_segment_are_found_and_named(pattern, test):
+    segments = static_segments()
+    rng = np.random.default_rng(7)
+    samples = white_samples(segments, rng)
+    n = segments[2].samples
+    t = np.arange(n) / FS
+    x = samples[2][:, 0]
+    if pattern == "sine":
+        x += 0.5 * SIGMA * np.sin(2 * math.pi * 3.0 * t)
+    elif pattern == "step":
+        x += 0.6 * SIGMA * (t > 4.0)
+    elif pattern == "burst":
+        x += 3.0 * SIGMA * rng.standard_normal(n) * ((t > 2.0) & (t < 3.0))
+    elif pattern == "noisier":
+        x += 1.5 * SIGMA * rng.standard_normal(n)
+    else:
+        x += 0.12 * SIGMA * t
+    result = within_segment_tests(samples, segments, noise(), alpha=0.05, draws=199, seed=1)
+    first = result.flagged[0]
+    assert (first["channel"], first["segment"]) == ("gx", 2)
+    assert test in {f["test"] for f in result.flagged if f["segment"] == 2}
+    if pattern == "sine":
+        periodic = next(f for f in result.flagged if f["test"] == "periodic")
+        assert periodic["frequency_hz"] == pytest.approx(3.0, abs=0.1)
+        assert periodic["amplitude"] == pytest.approx(0.5 * SIGMA, rel=0.2)
+    if pattern == "step":
+        step = next(f for f in result.flagged if f["test"] == "step")
+        assert step["at_s"] == pytest.approx(4.0, abs=0.5)
+
+
+def test_turning_segments_and_undithered_channels_are_not_tested():
+    segments = static_segments(3) + [Segment(label="turning", test="rate", group=0, up="+x", rate=1.0,
+                                             rate_axis="+x", dwell=10.0, sample_rate=FS)]
+    rng = np.random.default_rng(8)
+    samples = white_samples(segments, rng)
+    result = within_segment_tests(samples, segments, noise(), draws=49)
+    assert result.segments == (0, 1, 2)
+    coarse = noise(q=20 * SIGMA)  # the noise far below one step
+    quantised = [20 * SIGMA * np.round(x / (20 * SIGMA) + 0.3) for x in samples]
+    assert np.all(np.isnan(within_segment_tests(quantised, segments, coarse, draws=49).statistic))
+
+
+def test_bad_arguments_are_refused():
+    segments = static_segments(2)
+    samples = white_samples(segments, np.random.default_rng(9))
+    with pytest.raises(ValueError, match="alpha"):
+        within_segment_tests(samples, segments, noise(), alpha=1.5)
+    with pytest.raises(ValueError, match="draws"):
+        within_segment_tests(samples, segments, noise(), draws=5)
