@@ -311,11 +311,6 @@ def _segment_use(schedule: Schedule) -> _Use:
     return _Use(used, unused, model_segments, gyro_only, tuple(sorted(hand_axes)))
 
 
-def _samples_of(recording, k: int) -> np.ndarray:
-    first = int(recording.first_sample[k])
-    return np.asarray(recording.samples[first:first + recording.schedule.segments[k].samples], dtype=float)
-
-
 def _chi2_quantile(dof: int, probability: float) -> float:
     """The *probability* quantile of χ² with *dof* degrees of freedom."""
     from scipy.special import chdtri
@@ -628,7 +623,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
 
     # noise: every segment that is not a move (any pose at rest shows the sensors' noise)
     noise_segments = [k for k, s in enumerate(schedule.segments) if s.test != "move"]
-    all_noise = estimate_noise([_samples_of(recording, k) for k in noise_segments],
+    all_noise = estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in noise_segments],
                                [schedule.segments[k] for k in noise_segments])
     keep = [noise_segments.index(k) for k in used]
     noise = NoiseEstimate(all_noise.channels, all_noise.within_std[keep], all_noise.mean_variance[keep],
