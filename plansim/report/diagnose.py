@@ -52,7 +52,7 @@ def diagnose_report(d) -> str:
     lines = ["plansim diagnose — closing the loop (docs/closing-the-loop.md)", ""]
     lof = d.lack_of_fit
     lines.append(f"Lack of fit of the base model (segment means, simulated null): statistic {_g(lof.statistic, 5)}, "
-                 f"p = {_p(lof.p_value)} -> {'FLAGGED' if lof.flagged else 'not flagged'} at alpha = {d.alpha:g}")
+                 f"p = {_p(lof.p_value)} -> {'FLAGGED' if lof.flagged else 'not flagged'} at alpha/2 = {d.alpha / 2:g}")
     if d.selected:
         lines.append(f"Found (closed testing, family-wise alpha = {d.alpha:g}):")
         for effect in d.selected:
