@@ -126,13 +126,21 @@ def needed_channels(schedule: Schedule) -> np.ndarray:
 
 
 def drift_coefficient_table(scenario: Scenario) -> np.ndarray:
-    """(S, 3, 5) unit-σ drift coefficients per segment for GM bias instability, GM drift, random walk."""
+    """(S, 3, 5) unit-σ drift coefficients per segment for GM bias instability, GM drift, random walk (a new array)."""
     n = scenario.noise
-    out = np.zeros((len(scenario.schedule), 3, 5))
-    taus = (n.bias_instability_correlation_time, n.markov_correlation_time, None)
-    for k, s in enumerate(scenario.schedule.segments):
-        for p, tau in enumerate(taus):
-            out[k, p] = _drift_coefficients(s.samples, 1.0 / s.sample_rate, n.drift_update_interval, tau)
+    return _drift_coefficient_table(scenario.schedule.segments, n.bias_instability_correlation_time,
+                                    n.markov_correlation_time, n.drift_update_interval).copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _drift_coefficient_table(segs: tuple[Segment, ...], bias_instability_time: float, markov_time: float,
+                             update_interval: float) -> np.ndarray:
+    """:func:`drift_coefficient_table` once per distinct schedule and noise times (read-only)."""
+    out = np.zeros((len(segs), 3, 5))
+    for k, s in enumerate(segs):
+        for p, tau in enumerate((bias_instability_time, markov_time, None)):
+            out[k, p] = _drift_coefficients(s.samples, 1.0 / s.sample_rate, update_interval, tau)
+    out.flags.writeable = False
     return out
 
 

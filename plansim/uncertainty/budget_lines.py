@@ -234,7 +234,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         derivative = rate_derivatives(scenario, arguments)
         jitter = smoothness * derivative
         u = np.array([smoothness / math.sqrt(samples[s]) for s in rotating])
-        columns = np.stack([matrix[:, s, :] @ derivative[s] * u[i] for i, s in enumerate(rotating)], axis=1)
+        columns = np.einsum("psc,sc->ps", matrix[:, rotating, :], derivative[rotating]) * u
         lines.append(Line(
             name="rate smoothness", category="table", evaluation="B", distribution="normal, per sample",
             u=u, input_unit="1", columns=columns,
