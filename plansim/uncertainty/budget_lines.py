@@ -246,16 +246,16 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         for label, channels, step in (("quantisation, gyros", _GYROS, a.gyro_step),
                                       ("quantisation, accelerometers", _ACCELS, a.accel_step)):
             cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
-            sigmas, u_means = [], []
-            for c in channels:
-                sigma = np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2)
-                if quantisation_correlation:
-                    q_cov = quantisation_covariance(step, nominal[:, c], sigma, samples, offsets[c])
-                else:
-                    q_cov = np.diag([quantisation_variance(step, float(sigma[s]), int(samples[s]))[0]
-                                     for s in range(n_seg)])
+            sigmas = np.array([np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2) for c in channels])
+            if quantisation_correlation:  # the three channels of the kind at once
+                q_covs = quantisation_covariance(step, nominal[:, channels].T, sigmas, samples,
+                                                 np.array([offsets[c] for c in channels]))
+            else:
+                q_covs = [np.diag([quantisation_variance(step, float(sigma[s]), int(samples[s]))[0]
+                                   for s in range(n_seg)]) for sigma in sigmas]
+            u_means = []
+            for c, q_cov in zip(channels, q_covs):
                 cov += matrix[:, :, c] @ q_cov @ matrix[:, :, c].T
-                sigmas.append(sigma)
                 u_means.extend(np.sqrt(np.diag(q_cov)))
             distribution = f"rectangular, q = {step:.4g}"
             if describe:  # the undithered fraction depends on σ alone: once per distinct σ

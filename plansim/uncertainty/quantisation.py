@@ -89,7 +89,7 @@ _MAX_TERMS = 2000
 
 def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, samples: np.ndarray,
                             offset_covariance: np.ndarray | None = None) -> np.ndarray:
-    """Covariance (S, S) of the quantisation errors of the segment means of one channel.
+    """Covariance (S, S) of the quantisation errors of the segment means of one channel (or of several).
 
     Appendix A's rectangular model per reading, with the correlation GUM 5.2 requires between
     segments of one channel: they share the quantiser and the unknown offset of the channel's
@@ -109,42 +109,47 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
     ----------
     step : float
         Quantisation step q (> 0).
-    means : (S,) array
-        Nominal (noise-free) segment means of the channel.
-    sigma : (S,) array
+    means : (S,) or (C, S) array
+        Nominal (noise-free) segment means of the channel (of each of C channels with the same step).
+    sigma : (S,) or (C, S) array
         White noise σ of one sample at the quantiser input (rate jitter included).
     samples : (S,) array
         Samples per segment.
-    offset_covariance : (S, S) array, optional
+    offset_covariance : (S, S) or (C, S, S) array, optional
         Covariance of the segment means' deviations from nominal other than white noise.
 
     Returns
     -------
-    (S, S) ndarray
+    (S, S) or (C, S, S) ndarray
     """
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: the quantisation step must be finite and > 0")
     means = np.asarray(means, dtype=float)
     sigma = np.asarray(sigma, dtype=float)
     samples = np.asarray(samples, dtype=float)
-    n_seg = means.shape[0]
-    if sigma.shape != (n_seg,) or samples.shape != (n_seg,):
+    n_seg = means.shape[-1]
+    if means.ndim not in (1, 2) or sigma.shape != means.shape or samples.shape != (n_seg,):
         raise ValueError(f"means, sigma, samples: shapes {means.shape}, {sigma.shape}, {samples.shape}; "
-                         "expected one value per segment")
+                         "expected one value per segment (and channel)")
     if offset_covariance is None:
-        var_delta = np.zeros((n_seg, n_seg))
+        var_delta = np.zeros(means.shape + (n_seg,))
     else:
         g = np.asarray(offset_covariance, dtype=float)
-        var_delta = np.maximum(np.diag(g)[:, None] + np.diag(g)[None, :] - 2.0 * g, 0.0)
-    upper = _upper_triangle(n_seg)  # the covariance is symmetric: each pair once
-    fraction = (means[upper[1]] - means[upper[0]]) / step
-    damping = (sigma[upper[0]] ** 2 + sigma[upper[1]] ** 2 + var_delta[upper]) / step**2
-    cov = np.empty((n_seg, n_seg))
+        if g.shape != means.shape + (n_seg,):
+            raise ValueError(f"offset_covariance: shape {g.shape}; expected {means.shape + (n_seg,)}")
+        d = np.diagonal(g, axis1=-2, axis2=-1)
+        var_delta = np.maximum(d[..., :, None] + d[..., None, :] - 2.0 * g, 0.0)
+    rows, cols = _upper_triangle(n_seg)  # the covariance is symmetric: each pair once
+    fraction = np.ascontiguousarray((means[..., cols] - means[..., rows]) / step)
+    damping = np.ascontiguousarray((sigma[..., rows] ** 2 + sigma[..., cols] ** 2 + var_delta[..., rows, cols])
+                                   / step**2)
     series = np.empty(fraction.shape)  # Σ_k cos(2πkΔ/q) exp(−2π²k²(…)/q²)/k² (beyond _MAX_TERMS: its closed form)
-    quantisation_series(fraction, damping, _MAX_TERMS, series)
-    cov[upper] = step**2 / (2.0 * np.pi**2) * series
-    cov[upper[1], upper[0]] = cov[upper]
+    quantisation_series(fraction.reshape(-1), damping.reshape(-1), _MAX_TERMS, series.reshape(-1))
+    cov = np.empty(means.shape + (n_seg,))
+    cov[..., rows, cols] = step**2 / (2.0 * np.pi**2) * series
+    cov[..., cols, rows] = cov[..., rows, cols]
     full = step**2 / 12.0
-    bias = np.clip(np.diag(cov).copy(), 0.0, full)
-    cov[np.diag_indices(n_seg)] = bias + (full - bias) / samples
+    diagonal = np.arange(n_seg)
+    bias = np.minimum(np.maximum(cov[..., diagonal, diagonal], 0.0), full)
+    cov[..., diagonal, diagonal] = bias + (full - bias) / samples
     return cov
