@@ -130,8 +130,9 @@ def table_groups(scenario: Scenario) -> list[tuple[str, ErrorDistribution, list[
     t = scenario.turntable
     segments = scenario.schedule.segments
     n_seg = len(segments)
-    accuracy = [segment_base(s) + SEG_POSITION_ACCURACY + 2 * axis for s in range(n_seg) for axis in range(3)]
-    repeatability = [segment_base(s) + SEG_POSITION_REPEATABILITY + 2 * axis for s in range(n_seg) for axis in range(3)]
+    per_axis = (segment_base(np.arange(n_seg))[:, None] + 2 * np.arange(3)).ravel()  # segment-major, then axis
+    accuracy = (per_axis + SEG_POSITION_ACCURACY).tolist()
+    repeatability = (per_axis + SEG_POSITION_REPEATABILITY).tolist()
     axes = sorted({"xyz".index(s.rate_axis[1]) for s in segments if s.rate != 0.0})
     perpendicularity = [perpendicularity_index(a, k) for a in axes for k in range(2)]
     per_point = [segment_base(s) + SEG_RATE_ERROR for s, seg in enumerate(segments) if seg.rate != 0.0]
