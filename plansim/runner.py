@@ -49,6 +49,7 @@ from plansim.simulate.chunks import (
 )
 from plansim.simulate.paths import PATH_NAMES, choose_path
 from plansim.uncertainty import APPENDIX_A, AppendixABudget
+from plansim.uncertainty.chapter_comparison import CHAPTER_TURN_RATE, MisalignmentComparison, compare_misalignment
 
 if TYPE_CHECKING:
     from plansim.uncertainty.monte_carlo import CalibrationMonteCarlo
@@ -453,3 +454,18 @@ def validate(scenario: Scenario | str = "jjf2003", claims=None, *, path: str = "
     sc = _scenario_of(scenario)
     simulate, path_name = error_simulator(sc, path)
     return validate_scenario(sc, simulate, claims, path=path_name, **options)
+
+
+def compare_chapter_misalignment(scenario: Scenario | str = "jjf2003", trials: int = 1000, seed: int | None = None,
+                                 rate: float = CHAPTER_TURN_RATE, turns: int = 1,
+                                 path: str = "auto") -> MisalignmentComparison:
+    """The gyro misalignments of the same units by JJF 2003 §7.2.3 and by the chapter's ± rate turns, eq. (6-8).
+
+    *scenario* (a built-in name, a TOML path or a :class:`~plansim.config.Scenario`; default ``jjf2003``)
+    is simulated with its JJF 2003 schedule plus the turns (*rate* rad/s, *turns* whole turns each way,
+    about x, y and z); see :func:`plansim.uncertainty.chapter_comparison.compare_misalignment`. *seed*
+    defaults to the scenario's.
+    """
+    sc = _scenario_of(scenario)
+    seed = sc.seed if seed is None else seed
+    return compare_misalignment(sc, trials, seed, rate=rate, turns=turns, path=path)
