@@ -32,6 +32,9 @@ import xarray as xr
 import plansim
 from plansim.config import Scenario
 from plansim.estimate import reduce, reduction_matrix
+from plansim.estimate.jjf1535 import allan_polynomial_fit
+from plansim.estimate.jjf1535_items import reduce_items
+from plansim.fit.noise import allan_deviation
 from plansim.io.recording import UNITS_DESCRIPTION, Recording, plansim_version
 from plansim.io.results import ResultsFile
 from plansim.io.scenario_file import load_scenario
@@ -50,6 +53,7 @@ from plansim.simulate.chunks import (
 from plansim.simulate.paths import PATH_NAMES, choose_path
 from plansim.uncertainty import APPENDIX_A, AppendixABudget
 from plansim.uncertainty.chapter_comparison import CHAPTER_TURN_RATE, MisalignmentComparison, compare_misalignment
+from plansim.uncertainty.jjf1535_monte_carlo import Jjf1535MonteCarlo, jjf1535_monte_carlo, jjf1535_scenario
 
 if TYPE_CHECKING:
     from plansim.uncertainty.monte_carlo import CalibrationMonteCarlo
@@ -469,3 +473,41 @@ def compare_chapter_misalignment(scenario: Scenario | str = "jjf2003", trials: i
     sc = _scenario_of(scenario)
     seed = sc.seed if seed is None else seed
     return compare_misalignment(sc, trials, seed, rate=rate, turns=turns, path=path)
+
+
+def jjf1535_run(scenario: Scenario | str = "jjf2003", trials: int = 1000, seed: int | None = None,
+                procedure=None, path: str = "auto", keep_table: bool = False) -> Jjf1535MonteCarlo:
+    """The x gyro of *scenario*'s units through JJF 1535-2015, its items against the truth and Appendix A.
+
+    *scenario* (a built-in name, a TOML path or a :class:`~plansim.config.Scenario`; default ``jjf2003``) gives the
+    unit, noise, effects and laboratory; see :func:`plansim.uncertainty.jjf1535_monte_carlo.jjf1535_monte_carlo`.
+    *seed* defaults to the scenario's.
+    """
+    sc = _scenario_of(scenario)
+    seed = sc.seed if seed is None else seed
+    return jjf1535_monte_carlo(sc, trials, seed, procedure=procedure, path=path, keep_table=keep_table)
+
+
+def jjf1535_angle_random_walk(scenario: Scenario | str = "jjf2003", seed: int | None = None, trial: int = 0,
+                              procedure=None, keep_table: bool = False) -> tuple[float, float]:
+    """7.2.13 on one simulated session: ``(ARW reported, ARW simulated)``, rad/√s.
+
+    The session's samples (:func:`plansim.simulate.chunks.simulate_recording`) give K (eq. (5), the Q room runs'
+    mean, :func:`plansim.estimate.jjf1535_items.reduce_items`); the long static record divided by K is eq. (21);
+    its overlapping Allan variance at octave-spaced τ (:func:`plansim.fit.noise.allan_deviation`) is eq. (22)–(24);
+    eq. (25)–(26), the five-term polynomial by least squares and ARW = √A₋₁, is
+    :func:`plansim.estimate.jjf1535.allan_polynomial_fit`. The simulated value is the scenario's
+    ``gyro_angle_random_walk`` of the gyro under test.
+    """
+    sc = _scenario_of(scenario)
+    seed = sc.seed if seed is None else seed
+    world, procedure = jjf1535_scenario(sc, procedure, keep_table)
+    samples, means, _truth = simulate_recording(world, seed, trial)
+    K = reduce_items(means, procedure, sc.reduction.reference_gravity)["scale_factor"]
+    schedule = procedure.schedule
+    start = sum(s.samples for s in schedule.segments[: procedure.allan])
+    record = schedule.segments[procedure.allan]
+    rates = samples[start: start + record.samples, procedure.axis] / K
+    tau, adev, _dof = allan_deviation(rates, record.sample_rate)
+    reported = allan_polynomial_fit(tau, adev**2).angle_random_walk
+    return reported, float(sc.noise.gyro_angle_random_walk[procedure.axis])

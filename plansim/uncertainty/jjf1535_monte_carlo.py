@@ -1,0 +1,185 @@
+"""JJF 1535-2015 simulated: a scenario's unit through the JJF 1535 procedure, reduced by its items, against Appendix A.
+
+The scenario file knows the JJF 2003 procedures only (its schedule must pass
+:func:`plansim.estimate.check_design`); a JJF 1535 session is simulated instead by replacing a loaded
+scenario's schedule, turntable and acquisition (:func:`jjf1535_scenario`, ``dataclasses.replace``): the unit, its
+noise, its effects and the laboratory stay the scenario's.
+
+- :func:`jjf1535_scenario` — the JJF 1535 world: the procedure of :func:`plansim.schedule.jjf1535.jjf1535_procedure`,
+  a rate table of Table 2's grade (the Appendix A rate error u = 2.5e-4 as a normal systematic error per session,
+  rate smoothness 0.05 %), a two-axis position table of 3″, a 6½-digit acquisition (21 bits);
+- :func:`jjf1535_monte_carlo` — N trials, each a different unit, reduced by
+  :func:`plansim.estimate.jjf1535_items.reduce_items`, against :func:`~plansim.estimate.jjf1535_items.true_items`;
+  :meth:`Jjf1535MonteCarlo.summary` compares the scale factor and the bias with Appendix A's U.
+
+The angle random walk of 7.2.13 needs the samples of one recording: :func:`plansim.runner.jjf1535_angle_random_walk`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from plansim.config import Scenario
+from plansim.config.saturation import saturation_report
+from plansim.config.scenario import Acquisition, ErrorDistribution
+from plansim.estimate.jjf1535_items import ITEMS, reduce_items, true_items
+from plansim.schedule.jjf1535 import Jjf1535Procedure, jjf1535_procedure
+from plansim.simulate.chunks import check_count, simulate_segment_means
+from plansim.simulate.paths import choose_path
+from plansim.uncertainty.appendix_a_jjf1535 import BIAS, SCALE_FACTOR
+from plansim.units import ARCSEC, DEG
+
+#: the default procedure's largest rate: the R5 point 100 °/s (rad/s), inside the jjf2003 unit's 125 °/s output range
+DEFAULT_MAXIMUM_RATE = 100.0 * DEG
+#: Appendix A.1.2.2 1): the rate table's U_rel = 5e-4 (k = 2), so u = 2.5e-4
+TABLE_RATE_UNCERTAINTY = SCALE_FACTOR.components[0].printed_value
+#: JJF 1535 Table 2: rate smoothness 0.05 %; two-axis position table 3″
+TABLE_RATE_SMOOTHNESS = 5e-4
+POSITION_ACCURACY = 3.0 * ARCSEC
+#: a 6½-digit voltmeter resolves about 2·10⁶ counts over its range: 21 bits
+ACQUISITION_BITS = 21
+#: the items Appendix A budgets, with its budget: Appendix A reads both relative
+BUDGETED = {"scale_factor": SCALE_FACTOR, "bias": BIAS, "bias_up_down": BIAS}
+
+
+def jjf1535_scenario(scenario: Scenario, procedure: Jjf1535Procedure | None = None,
+                     keep_table: bool = False) -> tuple[Scenario, Jjf1535Procedure]:
+    """*scenario*'s unit and laboratory with the JJF 1535 procedure, table and acquisition (module docstring).
+
+    With *keep_table* the scenario's own turntable and acquisition stay (the zero-noise ``ideal`` world keeps its
+    perfect table).
+
+    Raises ``ValueError`` if the procedure drives the gyro past its output range or the acquisition's full scale
+    (a clipped rate point would bend the line of eq. (5)).
+    """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario: expected a plansim Scenario, got {type(scenario).__name__}")
+    if procedure is None:
+        procedure = jjf1535_procedure(DEFAULT_MAXIMUM_RATE)
+    if not isinstance(procedure, Jjf1535Procedure):
+        raise TypeError(f"procedure: expected a Jjf1535Procedure, got {type(procedure).__name__}")
+    if not isinstance(keep_table, bool):
+        raise TypeError(f"keep_table = {keep_table!r}: expected True or False")
+    table = scenario.turntable
+    position = ErrorDistribution("uniform", POSITION_ACCURACY)
+    turntable = dataclasses.replace(
+        table, position_accuracy=position, position_repeatability=position,
+        rate_error_systematic=ErrorDistribution("normal", TABLE_RATE_UNCERTAINTY),
+        rate_error_per_point=ErrorDistribution("uniform", 0.0), rate_smoothness=TABLE_RATE_SMOOTHNESS)
+    acquisition = Acquisition(bits=ACQUISITION_BITS, gyro_full_scale=scenario.acquisition.gyro_full_scale,
+                              accel_full_scale=scenario.acquisition.accel_full_scale)
+    if keep_table:
+        turntable, acquisition = table, scenario.acquisition
+    out = dataclasses.replace(scenario, name=f"{scenario.name} (JJF 1535)", schedule=procedure.schedule,
+                              turntable=turntable, acquisition=acquisition)
+    clipped = saturation_report(out)
+    if clipped:
+        raise ValueError(f"procedure: the JJF 1535 schedule drives the unit of {scenario.name!r} past its limits "
+                         f"(lower maximum_rate): {'; '.join(clipped[:3])}")
+    return out, procedure
+
+
+def truth_of(scenario: Scenario, procedure: Jjf1535Procedure, truth) -> dict[str, float]:
+    """:func:`~plansim.estimate.jjf1535_items.true_items` with the gyro's effects taken from *scenario*."""
+    e, i = scenario.effects, procedure.axis
+    return true_items(truth, procedure,
+                      scale_temperature_coefficient=float(e.gyro_scale_temperature_coefficient[i]),
+                      bias_temperature_coefficient=float(e.gyro_bias_temperature_coefficient[i]),
+                      reference_temperature=e.reference_temperature, asymmetry=float(e.gyro_asymmetry[i]),
+                      nonlinearity_quadratic=float(e.gyro_nonlinearity_quadratic[i]),
+                      nonlinearity_cubic=float(e.gyro_nonlinearity_cubic[i]))
+
+
+@dataclass(frozen=True)
+class Jjf1535MonteCarlo:
+    """Per trial, each item's reported value and the simulated unit's (NaN where the model has none), SI."""
+
+    scenario: str
+    trials: int
+    seed: int
+    path: str
+    items: tuple[str, ...]
+    values: np.ndarray  # (trials, items)
+    truth: np.ndarray  # (trials, items)
+
+    def column(self, item: str, of: str = "values") -> np.ndarray:
+        if item not in self.items:
+            raise ValueError(f"item = {item!r}; allowed: {', '.join(self.items)}")
+        return getattr(self, of)[:, self.items.index(item)]
+
+    def relative_errors(self, item: str) -> np.ndarray:
+        """(reported − true)/true per trial: Appendix A reads the scale factor and the bias relative."""
+        return self.column(item) / self.column(item, "truth") - 1.0
+
+    def summary(self) -> list[dict]:
+        """One row per item, in its JJF 1535 unit (:data:`~plansim.estimate.jjf1535_items.ITEMS`).
+
+        With a true value: the mean, standard deviation (n − 1) and 95 % quantile of |error| of the error, and the
+        mean true value. For the budgeted items also the relative error's statistics, Appendix A's printed U and
+        the fraction of trials whose |relative error| is within it (its coverage). Without: the mean, standard
+        deviation and 2.5 %/97.5 % quantiles of the reported figure.
+        """
+        rows = []
+        for item in self.items:
+            clause, equations, unit, scale = ITEMS[item]
+            x, t = self.column(item), self.column(item, "truth")
+            row = {"item": item, "clause": clause, "equations": equations, "unit": unit, "trials": self.trials}
+            if np.all(np.isnan(t)):
+                q = np.quantile(x, [0.025, 0.975]) / scale
+                row.update(truth=math.nan, mean=float(x.mean() / scale), std=float(np.std(x, ddof=1) / scale),
+                           q025=float(q[0]), q975=float(q[1]))
+            else:
+                err = (x - t) / scale
+                row.update(truth=float(t.mean() / scale), mean_error=float(err.mean()),
+                           std_error=float(np.std(err, ddof=1)), mc_U95=float(np.quantile(np.abs(err), 0.95)))
+            if item in BUDGETED:
+                rel = self.relative_errors(item)
+                budget = BUDGETED[item].printed_expanded_uncertainty
+                row.update(budget=BUDGETED[item].item, budget_U=budget, mean_relative_error=float(rel.mean()),
+                           std_relative_error=float(np.std(rel, ddof=1)),
+                           mc_U95_relative=float(np.quantile(np.abs(rel), 0.95)),
+                           coverage=float(np.mean(np.abs(rel) <= budget)))
+            rows.append(row)
+        return rows
+
+
+def jjf1535_monte_carlo(scenario: Scenario, trials: int, seed: int, procedure: Jjf1535Procedure | None = None,
+                        path: str = "auto", chunk_size: int = 256, keep_table: bool = False) -> Jjf1535MonteCarlo:
+    """Simulate *trials* units of *scenario* through the JJF 1535 procedure and reduce each.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The unit, noise, effects and laboratory (its JJF 2003 schedule, turntable and acquisition are replaced by
+        :func:`jjf1535_scenario`).
+    trials, seed : int
+        Number of trials (>= 2) and root seed (>= 0).
+    procedure : Jjf1535Procedure, optional
+        Default: :func:`~plansim.schedule.jjf1535.jjf1535_procedure` up to :data:`DEFAULT_MAXIMUM_RATE`.
+    path : {"auto", "sample", "segment"}
+        Simulation path (:func:`plansim.simulate.paths.choose_path`).
+    chunk_size : int
+        Trials per chunk.
+    keep_table : bool
+        Keep the scenario's turntable and acquisition (:func:`jjf1535_scenario`).
+    """
+    world, procedure = jjf1535_scenario(scenario, procedure, keep_table)
+    trials = check_count("trials", trials, minimum=2)
+    seed = check_count("seed", seed, minimum=0)
+    chosen, _reasons = choose_path(world, path)
+    means, truth = simulate_segment_means(world, trials, seed, chunk_size=chunk_size, path=chosen)
+    gravity = scenario.reduction.reference_gravity
+    items = tuple(ITEMS)
+    values = np.empty((trials, len(items)))
+    true = np.empty((trials, len(items)))
+    for n in range(trials):
+        v, t = reduce_items(means[n], procedure, gravity), truth_of(world, procedure, truth[n])
+        values[n] = [v[k] for k in items]
+        true[n] = [t[k] for k in items]
+    return Jjf1535MonteCarlo(scenario=world.name, trials=trials, seed=seed, path=chosen, items=items, values=values,
+                             truth=true)
+
