@@ -129,13 +129,27 @@ def test_patterns_inside_one_segment_are_found_and_named(pattern, test):
         assert step["at_s"] == pytest.approx(4.0, abs=0.5)
 
 
-def test_turning_segments_and_undithered_channels_are_not_tested():
-    segments = static_segments(3) + [Segment(label="turning", test="rate", group=0, up="+x", rate=1.0,
-                                             rate_axis="+x", dwell=10.0, sample_rate=FS)]
+def test_turning_segments_are_tested_without_the_tables_harmonics():
+    # a turning segment carries the table's harmonics of its angle (here a tilt's once-per-turn sine 20 times the
+    # noise): removed before the tests, so it is not flagged; a burst inside it is; it takes no part in scatter
+    turning = Segment(label="turning", test="rate", group=0, up="+x", rate=1.0, rate_axis="+x", dwell=10.0,
+                      sample_rate=FS)
+    segments = static_segments(3) + [turning]
     rng = np.random.default_rng(8)
     samples = white_samples(segments, rng)
-    result = within_segment_tests(samples, segments, noise(), draws=49)
-    assert result.segments == (0, 1, 2)
+    angle = np.arange(turning.samples) / FS
+    samples[3][:, 0] += 20 * SIGMA * np.sin(angle + 0.3) + 2 * SIGMA * np.cos(2 * angle)
+    result = within_segment_tests(samples, segments, noise(), draws=99, seed=2)
+    assert result.segments == (0, 1, 2, 3) and not result.any_flagged
+    assert np.all(np.isnan(result.statistic[TESTS.index("scatter"), :, 3]))
+    samples[3][400:500, 0] += 3 * SIGMA * rng.standard_normal(100)
+    burst = within_segment_tests(samples, segments, noise(), draws=99, seed=2)
+    assert {(f["segment"], f["test"]) for f in burst.flagged} >= {(3, "burst")}
+
+
+def test_undithered_channels_are_not_tested():
+    segments = static_segments(3)
+    samples = white_samples(segments, np.random.default_rng(8))
     coarse = noise(q=20 * SIGMA)  # the noise far below one step
     quantised = [20 * SIGMA * np.round(x / (20 * SIGMA) + 0.3) for x in samples]
     assert np.all(np.isnan(within_segment_tests(quantised, segments, coarse, draws=49).statistic))

@@ -3,10 +3,15 @@ noise inside a segment — against a null simulated from the recording's own noi
 
 The segment-level tests (:mod:`plansim.diagnose.scores`) see one mean per segment and channel. An effect that
 changes *within* a segment (a bias that jumps, a vibration, a heater cycling, a loose connector adding noise)
-moves a mean little and the shape a lot. These tests look at the shape, on the segments at rest (a turning
-segment's samples carry the table's own harmonics of its angle: tilt, wobble, rate jitter).
+moves a mean little and the shape a lot. These tests look at the shape. A turning segment's samples carry the
+table's own harmonics of its angle (a tilted axis turns gravity and the Earth rate with it): they are removed
+first, by the fit's degree-2 trigonometric polynomial in the angle
+(:func:`plansim.fit.noise.turning_residuals`), from the data and from every null draw alike; its null is white
+noise at the segment's own scatter (the table's rate jitter adds noise the segments at rest do not have), it is
+tested only where that scatter is at least :data:`TURNING_DITHERED` quantiser steps, and it takes no part in the
+``scatter`` test.
 
-**Statistics**, for each segment at rest and channel, on the samples x minus their mean, with s their standard
+**Statistics**, for each tested segment and channel, on the samples x minus their mean, with s their standard
 deviation and n their number:
 
 - ``trend``: |b|·√(Σ t²)/s, b the least-squares slope over the centred time t (the t-statistic of a slope under
@@ -59,7 +64,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from plansim.fit.noise import RELATIVE_FLOOR, UNITS_SI, channel_kind, quantised_noise_sigma
+from plansim.fit.noise import (
+    RELATIVE_FLOOR,
+    TURNING_HARMONICS,
+    UNITS_SI,
+    channel_kind,
+    quantised_noise_sigma,
+    turning_residuals,
+)
 from plansim.kernels.layout import CHANNELS
 
 __all__ = ["TESTS", "WithinResult", "within_segment_tests", "segment_statistics", "simulate_noise"]
@@ -71,6 +83,10 @@ TESTS = ("trend", "step", "periodic", "burst", "scatter")
 DITHERED = 0.3
 #: the null draws above this quantile make the generalised Pareto tail of :func:`tail_p_values`
 TAIL_QUANTILE = 0.9
+#: a quantised channel is tested in a turning segment where its scatter there is at least this many steps: below
+#: it the quantiser's error follows the turning signal's level along the turn and is not white (measured on
+#: jjf2003's 12-bit channels at 0.5–1 step: the burst test ran at 0.18–0.24 for 0.05)
+TURNING_DITHERED = 2.0
 #: blocks of the burst statistic
 BLOCKS = 10
 #: null draws per segment (p resolves to 1/(B + 1))
@@ -256,7 +272,7 @@ def _median_of_finite(a: np.ndarray) -> np.ndarray:
 
 def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.05, draws: int = NULL_DRAWS,
                          seed: int = 0) -> WithinResult:
-    """The within-segment tests (module docstring) of the segments at rest.
+    """The within-segment tests (module docstring) of the segments at rest and the turning ones of known rate.
 
     Parameters
     ----------
@@ -277,31 +293,47 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
         raise ValueError(f"alpha = {alpha!r}: must be between 0 and 1")
     if isinstance(draws, bool) or not isinstance(draws, (int, np.integer)) or draws < 19:
         raise ValueError(f"draws = {draws!r}: must be a whole number >= 19")
-    tested = [k for k, s in enumerate(segments) if not s.is_rotating and s.test != "move"
-              and np.asarray(segment_samples[k]).shape[0] >= 20]
+    tested = [k for k, s in enumerate(segments) if s.test != "move" and np.asarray(segment_samples[k]).shape[0] >= 20
+              and (not s.is_rotating or math.isfinite(s.rate))]
     S, C, T = len(tested), len(CHANNELS), len(TESTS)
+    at_rest = [k for k in tested if not segments[k].is_rotating]
     # a quantised channel's noise before the quantiser, pooled over the segments at rest (as the fit finds it)
-    before = [quantised_noise_sigma(ch.quantisation_step, [np.asarray(segment_samples[k])[:, c] for k in tested])
-              if ch.quantisation_step and tested else None for c, ch in enumerate(noise.channels)]
+    before = [quantised_noise_sigma(ch.quantisation_step, [np.asarray(segment_samples[k])[:, c] for k in at_rest])
+              if ch.quantisation_step and at_rest else None for c, ch in enumerate(noise.channels)]
     stat = np.full((T, C, S), np.nan)
     freq = np.full((C, S), np.nan)
     null = np.full((draws, T, C, S), np.nan)
     streams = np.random.SeedSequence(seed).spawn(S * C)
     for j, k in enumerate(tested):
+        segment = segments[k]
         x = np.asarray(segment_samples[k], dtype=float)
-        fs = segments[k].sample_rate
+        fs = segment.sample_rate
+        turning = segment.is_rotating
+        if turning:  # the table's own harmonics of its angle out, in the data and in every null draw alike
+            x = turning_residuals(x, segment.rate, fs)
         for c in range(C):
             channel = noise.channels[c]
-            sigma = before[c]
-            if sigma is not None and not sigma >= DITHERED * channel.quantisation_step:
-                continue  # not dithered (or not known): not tested
+            rng = np.random.default_rng(streams[j * C + c])
+            if turning:
+                # the turning signal sweeps the quantiser's codes and carries the table's rate jitter: the null is
+                # white noise at the segment's own scatter, its shape tests free of the scale
+                sd = float(np.std(x[:, c], ddof=1 + 2 * TURNING_HARMONICS))
+                if channel.quantisation_step and not sd >= TURNING_DITHERED * channel.quantisation_step:
+                    continue
+                simulated = turning_residuals((sd * rng.standard_normal((draws, x.shape[0]))).T, segment.rate, fs).T
+            else:
+                sigma = before[c]
+                if sigma is not None and not sigma >= DITHERED * channel.quantisation_step:
+                    continue  # not dithered (or not known): not tested
+                simulated = simulate_noise(channel, x.shape[0], fs, draws, rng, sigma, float(np.mean(x[:, c])))
             observed, f = segment_statistics(x[:, c], fs)
             if not np.any(np.isfinite(observed)):
                 continue
-            rng = np.random.default_rng(streams[j * C + c])
-            simulated = simulate_noise(channel, x.shape[0], fs, draws, rng, sigma, float(np.mean(x[:, c])))
             null[:, :, c, j], _ = segment_statistics(simulated, fs)
             stat[:, c, j], freq[c, j] = observed, f
+            if turning:  # its scatter holds the table's rate jitter: not comparable with the segments at rest
+                stat[TESTS.index("scatter"), c, j] = np.nan
+                null[:, TESTS.index("scatter"), c, j] = np.nan
     scatter = TESTS.index("scatter")  # relative to the channel's other segments, in the data and in each draw
     if S:
         stat[scatter] /= _median_of_finite(stat[scatter])

@@ -406,19 +406,33 @@ class NoiseEstimate:
     notes: tuple[str, ...] = ()
 
 
-def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tuple[np.ndarray, int]:
-    """Scatter (6,) of a turning segment's samples about a degree-2 trigonometric polynomial in the angle."""
-    n = values.shape[0]
+def turning_design(n: int, rate: float, sample_rate: float) -> np.ndarray:
+    """(n, 1 + 2·TURNING_HARMONICS) columns 1, cos hθ, sin hθ (h = 1 … TURNING_HARMONICS) of a turning segment's
+    angle θ = rate·t: the table's own harmonics (a tilt of its axis turns gravity and the Earth rate with it,
+    wobble, the rate's once-per-turn error)."""
     angle = rate * np.arange(n) / sample_rate
     columns = [np.ones(n)]
     for h in range(1, TURNING_HARMONICS + 1):
         columns += [np.cos(h * angle), np.sin(h * angle)]
-    design = np.column_stack(columns)
-    if n <= design.shape[1] + 1:
+    return np.column_stack(columns)
+
+
+def turning_residuals(values: np.ndarray, rate: float, sample_rate: float) -> np.ndarray:
+    """A turning segment's samples (n, …) less their least-squares fit by :func:`turning_design` (n > its columns)."""
+    values = np.asarray(values, dtype=float)
+    design = turning_design(values.shape[0], rate, sample_rate)
+    coefficients, *_ = np.linalg.lstsq(design, values.reshape(values.shape[0], -1), rcond=None)
+    return values - (design @ coefficients).reshape(values.shape)
+
+
+def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tuple[np.ndarray, int]:
+    """Scatter (6,) of a turning segment's samples about a degree-2 trigonometric polynomial in the angle."""
+    n = values.shape[0]
+    columns = 1 + 2 * TURNING_HARMONICS
+    if n <= columns + 1:
         return np.std(values, axis=0, ddof=1) if n > 1 else np.zeros(6), max(n - 1, 1)
-    coefficients, *_ = np.linalg.lstsq(design, values, rcond=None)
-    residual = values - design @ coefficients
-    dof = n - design.shape[1]
+    residual = turning_residuals(values, rate, sample_rate)
+    dof = n - columns
     return np.sqrt(np.sum(residual**2, axis=0) / dof), dof
 
 

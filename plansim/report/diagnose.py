@@ -22,9 +22,9 @@ def _within_lines(d) -> list[str]:
     """The within-segment findings, each with its pattern in display units."""
     w = d.within
     if not w.flagged:
-        return [f"Within the {len(w.segments)} segments at rest (trend, step, periodic, burst, scatter): nothing "
+        return [f"Within the {len(w.segments)} segments tested (trend, step, periodic, burst, scatter): nothing "
                 f"(smallest adjusted p = {_p(w.smallest_adjusted_p())}, level {w.alpha:g})."]
-    lines = [f"UNEXPLAINED within segments (level {w.alpha:g}, family-wise over {len(w.segments)} segments at rest, "
+    lines = [f"UNEXPLAINED within segments (level {w.alpha:g}, family-wise over {len(w.segments)} segments, "
              "6 channels and 5 tests): not named after any catalogue effect"]
     for item in w.flagged[:12]:
         c = CHANNELS.index(item["channel"])
