@@ -99,11 +99,11 @@ STEP_MARGIN = 0.05
 FLICKER_SPAN = 4
 
 
-def segment_statistics(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, np.ndarray]:
+def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[np.ndarray, np.ndarray]:
     """The statistics (..., 5) in the order of :data:`TESTS` of samples *x* (..., n), and the periodic test's
     frequency (..., ) in Hz; ``scatter`` is the variance s² itself here. NaN where the samples do not vary (s at
-    most :data:`plansim.fit.noise.RELATIVE_FLOOR` of their r.m.s.: round-off) or the segment is too short
-    (n < 20)."""
+    most :data:`plansim.fit.noise.RELATIVE_FLOOR` of their r.m.s., or of *level* when given — the r.m.s. of the
+    samples before anything was removed from them: round-off) or the segment is too short (n < 20)."""
     x = np.asarray(x, dtype=float)
     n = x.shape[-1]
     shape = x.shape[:-1]
@@ -111,7 +111,7 @@ def segment_statistics(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, n
     freq = np.full(shape, np.nan)
     if n < 20:
         return out, freq
-    level = np.sqrt(np.mean(x**2, axis=-1))
+    level = np.sqrt(np.mean(x**2, axis=-1)) if level is None else np.asarray(level, dtype=float)
     x = x - x.mean(axis=-1, keepdims=True)
     s2 = np.sum(x**2, axis=-1) / (n - 1)
     varies = s2 > (RELATIVE_FLOOR * level) ** 2  # round-off of noise-free data is not variation
@@ -309,6 +309,7 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
         x = np.asarray(segment_samples[k], dtype=float)
         fs = segment.sample_rate
         turning = segment.is_rotating
+        level = np.sqrt(np.mean(x**2, axis=0))  # (6,): the round-off floor is relative to the samples themselves
         if turning:  # the table's own harmonics of its angle out, in the data and in every null draw alike
             x = turning_residuals(x, segment.rate, fs)
         for c in range(C):
@@ -326,7 +327,7 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
                 if sigma is not None and not sigma >= DITHERED * channel.quantisation_step:
                     continue  # not dithered (or not known): not tested
                 simulated = simulate_noise(channel, x.shape[0], fs, draws, rng, sigma, float(np.mean(x[:, c])))
-            observed, f = segment_statistics(x[:, c], fs)
+            observed, f = segment_statistics(x[:, c], fs, level[c])
             if not np.any(np.isfinite(observed)):
                 continue
             null[:, :, c, j], _ = segment_statistics(simulated, fs)
