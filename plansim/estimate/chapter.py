@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from plansim.estimate.jjf1535 import _array
+from plansim.estimate.jjf1535 import checked_array
 from plansim.model.environment import EARTH_RATE, earth_rate_enu
 from plansim.schedule.chapter import FULL_TURN
 from plansim.schedule.segments import Schedule, Segment, axis_vector, body_to_level
@@ -131,9 +131,9 @@ def rate_misalignment(output_plus, output_minus, scale_factor, angle: float = FU
     array
         E_ab, dimensionless (rad of misalignment), broadcast over the inputs.
     """
-    plus = _array("output_plus", output_plus)
-    minus = _array("output_minus", output_minus)
-    scale = _array("scale_factor", scale_factor)
+    plus = checked_array("output_plus", output_plus)
+    minus = checked_array("output_minus", output_minus)
+    scale = checked_array("scale_factor", scale_factor)
     if isinstance(angle, bool) or not isinstance(angle, (int, float)) or not (math.isfinite(angle) and angle > 0):
         raise ValueError(f"angle = {angle!r} rad; it must be finite and > 0 (one turn is 2π)")
     if np.any(scale == 0):
@@ -167,7 +167,7 @@ def rate_misalignments(means, segments, scale_factors) -> np.ndarray:
     """
     segments = _segments(segments)
     means = _means(means, segments)
-    scale = _array("scale_factors", scale_factors)
+    scale = checked_array("scale_factors", scale_factors)
     if scale.shape[-1:] != (3,):
         raise ValueError(f"scale_factors: expected shape (..., 3), got {scale.shape}")
     turns = [k for k, s in enumerate(segments) if s.test == "rotation"]
@@ -226,8 +226,8 @@ def up_down(output_up, output_down, gravity: float) -> tuple[np.ndarray, np.ndar
     K0, K1 : arrays
         In the output's unit and in output unit per m/s².
     """
-    up = _array("output_up", output_up)
-    down = _array("output_down", output_down)
+    up = checked_array("output_up", output_up)
+    down = checked_array("output_down", output_down)
     if isinstance(gravity, bool) or not isinstance(gravity, (int, float)) or not (math.isfinite(gravity)
                                                                                 and gravity > 0):
         raise ValueError(f"gravity = {gravity!r} m/s^2; it must be finite and > 0")
@@ -324,8 +324,8 @@ def drift_model_fit(drifts, specific_force) -> np.ndarray:
         In plansim's model (JJF 2003 eq. (1)) D0 of gyro i is ``Bg[i]`` and D1, D2, D3 are ``G[i, x]``,
         ``G[i, y]``, ``G[i, z]``.
     """
-    d = _array("drifts", drifts)
-    f = _array("specific_force", specific_force, ndim=2)
+    d = checked_array("drifts", drifts)
+    f = checked_array("specific_force", specific_force, ndim=2)
     if f.shape[1] != 3 or d.ndim < 2 or d.shape[-2:] != (3, f.shape[0]):
         raise ValueError(f"drifts {d.shape} and specific_force {f.shape}: expected (..., 3, n) and (n, 3)")
     design = np.column_stack([np.ones(f.shape[0]), f])  # (n, 4)
@@ -373,7 +373,7 @@ def drift_model(means, segments, gravity: float, latitude: float, gyro_scale, ea
     if isinstance(gravity, bool) or not isinstance(gravity, (int, float)) or not (math.isfinite(gravity)
                                                                                 and gravity > 0):
         raise ValueError(f"gravity = {gravity!r} m/s^2; it must be finite and > 0")
-    K = _array("gyro_scale", gyro_scale)
+    K = checked_array("gyro_scale", gyro_scale)
     if K.shape[-1:] == (3,) and (K.ndim == 1 or K.shape[-2:] != (3, 3)):
         K = K[..., :, None] * np.eye(3)
     if K.shape[-2:] != (3, 3):
@@ -399,7 +399,7 @@ def random_drift(drifts, axis: int = 0) -> np.ndarray:
     axis : int
         The axis of the repeats.
     """
-    d = _array("drifts", drifts)
+    d = checked_array("drifts", drifts)
     if isinstance(axis, bool) or not isinstance(axis, int) or not -d.ndim <= axis < d.ndim:
         raise ValueError(f"axis = {axis!r}; drifts has {d.ndim} dimension(s)")
     if d.shape[axis] < 2:

@@ -43,7 +43,9 @@ THRESHOLD_CRITERION = 0.5
 ALLAN_POWERS = (-2, -1, 0, 1, 2)
 
 
-def _array(name: str, values, ndim: int | None = None, minimum: int = 1) -> np.ndarray:
+def checked_array(name: str, values, ndim: int | None = None, minimum: int = 1) -> np.ndarray:
+    """*values* as a float array, checked: numbers (``TypeError``), *ndim* dimensions when given, at least *minimum*
+    values, every one finite (``ValueError``, naming *name*). Shared by the estimators of this layer."""
     try:
         out = np.asarray(values, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -59,7 +61,7 @@ def _array(name: str, values, ndim: int | None = None, minimum: int = 1) -> np.n
 
 def rate_point_mean(samples) -> np.ndarray:
     """Eq. (4): F̄_j = (1/N) Σ_m F_jm, the mean of the N samples at each rate point (last axis)."""
-    return _array("samples", samples).mean(axis=-1)
+    return checked_array("samples", samples).mean(axis=-1)
 
 
 @dataclass(frozen=True)
@@ -85,8 +87,8 @@ def scale_factor_fit(rates, outputs) -> LineFit:
     outputs : (n,) array
         Mean gyro outputs F̄_j at them (eq. (4)), the at-rest output already subtracted (7.2.1.1 d)).
     """
-    rates = _array("rates", rates, ndim=1, minimum=2)
-    outputs = _array("outputs", outputs, ndim=1, minimum=2)
+    rates = checked_array("rates", rates, ndim=1, minimum=2)
+    outputs = checked_array("outputs", outputs, ndim=1, minimum=2)
     if rates.shape != outputs.shape:
         raise ValueError(f"rates and outputs: expected the same length, got {rates.size} and {outputs.size}")
     K, F0 = line_fit(rates, outputs)
@@ -108,8 +110,8 @@ def scale_factor_nonlinearity(rates, outputs) -> float:
 def scale_factor_asymmetry(rates, outputs) -> float:
     """Eq. (8): K_u = |K+ − K−| / K̄, with K+ and K− fitted by eq. (5) over the positive and the negative rates
     (each with the zero-rate point when there is one) and K̄ = (K+ + K−)/2; eq. (9) is its mean over Q runs."""
-    rates = _array("rates", rates, ndim=1, minimum=2)
-    outputs = _array("outputs", outputs, ndim=1, minimum=2)
+    rates = checked_array("rates", rates, ndim=1, minimum=2)
+    outputs = checked_array("outputs", outputs, ndim=1, minimum=2)
     positive, negative = rates >= 0, rates <= 0
     if np.count_nonzero(rates > 0) < 1 or np.count_nonzero(rates < 0) < 1 or min(positive.sum(), negative.sum()) < 2:
         raise ValueError(f"rates {rates.tolist()}: eq. (8) needs at least two points on each side (zero counts)")
@@ -120,15 +122,15 @@ def scale_factor_asymmetry(rates, outputs) -> float:
 
 def scale_factor_repeatability(scale_factors) -> float:
     """Eq. (10): K_r = (1/K̄)·sqrt(Σ (K_m − K̄)²/(Q − 1)) over Q calibrations, the unit powered off between."""
-    K = _array("scale_factors", scale_factors, ndim=1, minimum=2)
+    K = checked_array("scale_factors", scale_factors, ndim=1, minimum=2)
     return float(np.std(K, ddof=1) / abs(K.mean()))
 
 
 def temperature_sensitivity(values, temperatures, room_index: int = 0, relative: bool = True) -> float:
     """Eq. (11) (relative=True): max_i |(K_i − K_m)/(K_m (T_i − T_m))|, 1/°C; eq. (27) (relative=False):
     max_i |(B_i − B_m)/(T_i − T_m)|, unit of B per °C. Index *room_index* is the room-temperature point m."""
-    x = _array("values", values, ndim=1, minimum=2)
-    T = _array("temperatures", temperatures, ndim=1, minimum=2)
+    x = checked_array("values", values, ndim=1, minimum=2)
+    T = checked_array("temperatures", temperatures, ndim=1, minimum=2)
     if x.shape != T.shape:
         raise ValueError(f"values and temperatures: expected the same length, got {x.size} and {T.size}")
     if not 0 <= room_index < x.size:
@@ -164,9 +166,9 @@ def threshold(scale_factor: float, rates, outputs, zero_outputs) -> float:
     Give each direction's rates in turn and take the larger (7.2.6.1 e)); NaN when even the largest rate
     fails the criterion.
     """
-    rates = _array("rates", rates, ndim=1)
-    outputs = _array("outputs", outputs, ndim=1)
-    zero = np.broadcast_to(_array("zero_outputs", zero_outputs), rates.shape)
+    rates = checked_array("rates", rates, ndim=1)
+    outputs = checked_array("outputs", outputs, ndim=1)
+    zero = np.broadcast_to(checked_array("zero_outputs", zero_outputs), rates.shape)
     return _first_failure(rates, outputs - zero, float(scale_factor) * rates)
 
 
@@ -174,8 +176,8 @@ def resolution(scale_factor: float, increments, output_increments) -> float:
     """Eq. (14): going down the decreasing rate increments ΔΩ_j about a base rate (20–50 × the threshold), the
     smallest |ΔΩ_j| down to which the measured output increment ΔF_j is within 50 % of ΔF̂_j = K·ΔΩ_j (rad/s).
     One direction per call; the resolution is the larger of the two directions (7.2.7.1 f))."""
-    increments = _array("increments", increments, ndim=1)
-    output_increments = _array("output_increments", output_increments, ndim=1)
+    increments = checked_array("increments", increments, ndim=1)
+    output_increments = checked_array("output_increments", output_increments, ndim=1)
     return _first_failure(increments, output_increments, float(scale_factor) * increments)
 
 
@@ -187,7 +189,7 @@ def bias(scale_factor: float, outputs) -> float:
 def bias_stability(scale_factor: float, outputs, samples_per_period: int) -> float:
     """Eq. (18): B_s = (1/K)·sqrt(Σ_j (F̄_j − F̄)²/(N/P − 1)), F̄_j the means over consecutive periods of P
     samples (the averaging time) and F̄ their mean (rad/s); eq. (19) is the mean over Q runs."""
-    F = _array("outputs", outputs, ndim=1)
+    F = checked_array("outputs", outputs, ndim=1)
     P = int(samples_per_period)
     if P < 1 or F.size // P < 2:
         raise ValueError(f"samples_per_period = {samples_per_period}: need 1 <= P and at least two periods in "
@@ -198,7 +200,7 @@ def bias_stability(scale_factor: float, outputs, samples_per_period: int) -> flo
 
 def bias_repeatability(biases) -> float:
     """Eq. (20): B_r = sqrt(Σ (B0m − B̄0)²/(Q − 1)) over Q bias calibrations (unit powered off between)."""
-    return float(np.std(_array("biases", biases, ndim=1, minimum=2), ddof=1))
+    return float(np.std(checked_array("biases", biases, ndim=1, minimum=2), ddof=1))
 
 
 def bias_g_sensitivity(scale_factor: float, up_outputs, down_outputs, gravity: float) -> float:
@@ -218,8 +220,8 @@ def warm_up_time(times, rates, specified_stability: float, samples_per_period: i
     it on. *rates* are outputs already divided by K. NaN when it never is. The specification averages this over
     repeated power-ons.
     """
-    t = _array("times", times, ndim=1)
-    w = _array("rates", rates, ndim=1)
+    t = checked_array("times", times, ndim=1)
+    w = checked_array("rates", rates, ndim=1)
     if t.shape != w.shape:
         raise ValueError(f"times and rates: expected the same length, got {t.size} and {w.size}")
     P = int(samples_per_period)
@@ -257,8 +259,8 @@ def allan_polynomial_fit(tau, allan_variance) -> AllanPolynomial:
     allan_variance : (n,) array
         σ²(τ), (rad/s)².
     """
-    tau = _array("tau", tau, ndim=1, minimum=len(ALLAN_POWERS))
-    avar = _array("allan_variance", allan_variance, ndim=1, minimum=len(ALLAN_POWERS))
+    tau = checked_array("tau", tau, ndim=1, minimum=len(ALLAN_POWERS))
+    avar = checked_array("allan_variance", allan_variance, ndim=1, minimum=len(ALLAN_POWERS))
     if tau.shape != avar.shape or np.any(tau <= 0):
         raise ValueError("tau and allan_variance: expected positive τ and one variance per τ")
     design = np.column_stack([tau**m for m in ALLAN_POWERS])
