@@ -223,9 +223,10 @@ def exchange(blocks, counts, criterion: Criterion | str = "D", costs=None, budge
     current = criterion.value(information(blocks, counts.astype(float)))
     for _ in range(max_passes):
         best, move = current, None
+        M, spent = information(blocks, counts.astype(float)), float(costs @ counts)  # fixed within a pass
         for i in np.flatnonzero(counts > 0):
-            M_out = information(blocks, counts.astype(float)) - blocks[i]
-            spare = budget - (costs @ counts - costs[i])
+            M_out = M - blocks[i]
+            spare = budget - (spent - costs[i])
             for j in np.flatnonzero(costs <= spare + 1e-12 * budget):
                 if j == i:
                     continue
@@ -308,8 +309,7 @@ def refine_support(regressor: Callable[[float], np.ndarray], grid, criterion: Cr
         return x, design
 
     def slopes(x, design):
-        inverse = np.linalg.inv(design.information)
-        G = inverse if criterion.kind == "D" else inverse @ criterion._weight(len(inverse)) @ inverse
+        G, _ = criterion.gradient(design.information)
         return np.array([float(np.sum(G * (regressor(v + h) - regressor(v - h)))) / (2.0 * h) for v in x[interior]])
 
     def value_and_gradient(free):

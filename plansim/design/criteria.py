@@ -143,20 +143,27 @@ class Criterion:
         value = float(np.trace(self._weight(p) @ inverse))
         return value if np.isfinite(value) and value >= 0 else np.inf
 
-    def derivatives(self, blocks: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, float]:
-        """Directional derivatives φ_i (n,) towards each candidate and the bound b, at *M* (nonsingular)."""
+    def gradient(self, M: np.ndarray) -> tuple[np.ndarray, float]:
+        """The symmetric matrix G (p, p) with φ_i = tr(G·M_i) for any candidate, and the bound b, at *M*: D
+        ``M⁻¹`` and p; A ``M⁻¹ W M⁻¹`` and ``tr(W M⁻¹)``; c ``x xᵀ`` and ``cᵀx`` with ``M x = c`` (a generalised
+        inverse: c-optimal information is often singular)."""
         p = M.shape[0]
         self._check(p)
-        if self.kind == "c":  # c-optimal information is often singular: M⁻c from any generalised inverse
+        if self.kind == "c":
             x = self._solve_c(M)
             if x is None:
                 raise ValueError("c-criterion: cᵀθ is not estimable at this design")
-            return np.einsum("j,ijk,k->i", x, blocks, x), float(self.c @ x)
+            return np.outer(x, x), float(self.c @ x)
         inverse = np.linalg.inv(M)
         if self.kind == "D":
-            return np.einsum("jk,ikj->i", inverse, blocks), float(p)
-        G = inverse @ self._weight(p) @ inverse
-        return np.einsum("jk,ikj->i", G, blocks), float(np.trace(self._weight(p) @ inverse))
+            return inverse, float(p)
+        W = self._weight(p)
+        return inverse @ W @ inverse, float(np.trace(W @ inverse))
+
+    def derivatives(self, blocks: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, float]:
+        """Directional derivatives φ_i (n,) towards each candidate and the bound b, at *M* (:meth:`gradient`)."""
+        G, bound = self.gradient(M)
+        return np.einsum("jk,ikj->i", G, blocks), bound
 
     def _solve_c(self, M: np.ndarray) -> np.ndarray | None:
         """x with M·x = c (a generalised-inverse solution; cᵀx does not depend on which), or None when c is not in
