@@ -134,6 +134,13 @@ class Turntable:
     rate_error_per_point: ErrorDistribution  # per rate point
     rate_smoothness: float  # relative standard deviation of the rate, per sample
 
+    @property
+    def position_uncertainty(self) -> float:
+        """Standard uncertainty of one position's angle about each axis, rad: accuracy and repeatability, both
+        drawn per position, combined."""
+        return math.hypot(self.position_accuracy.standard_uncertainty,
+                          self.position_repeatability.standard_uncertainty)
+
 
 @dataclass(frozen=True)
 class Reduction:

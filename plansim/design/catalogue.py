@@ -197,9 +197,7 @@ def candidate_information(scenario: Scenario, candidates=None) -> CandidateInfor
     G = model.n_segments
     J = model.parameter_jacobian(tilts=tilts).reshape(G, 6, -1)
     table = np.zeros((G, 6, 6))
-    u_position = math.hypot(scenario.turntable.position_accuracy.standard_uncertainty,
-                            scenario.turntable.position_repeatability.standard_uncertainty)
-    entries = [(SEG_POSITION_ACCURACY + 2 * axis, u_position) for axis in range(3)]
+    entries = [(SEG_POSITION_ACCURACY + 2 * axis, scenario.turntable.position_uncertainty) for axis in range(3)]
     entries.append((SEG_RATE_ERROR, scenario.turntable.rate_error_per_point.standard_uncertainty))
     for entry, u in entries:
         if u > 0:

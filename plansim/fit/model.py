@@ -339,8 +339,7 @@ class MeanModel:
         """
         S = self.n_segments
         sources: list[InputSource] = []
-        u_position = math.hypot(turntable.position_accuracy.standard_uncertainty,
-                                turntable.position_repeatability.standard_uncertainty)
+        u_position = turntable.position_uncertainty
         if u_position > 0:
             for axis, name in enumerate("ENU"):
                 d = self.segment_sensitivity(theta, SEG_POSITION_ACCURACY + 2 * axis, tilts)
