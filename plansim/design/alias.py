@@ -168,8 +168,9 @@ def alias_matrix(scenario: Scenario, schedule: Schedule | None = None, estimator
     separated_by = [()] * len(EFFECTS)
     if not separable.all():
         extra = candidate_information(scenario, candidates)
-        cand_model = MeanModel(Schedule(tuple(c.segment(100.0, 20.0) for c in _level(candidates)),
-                                        procedure="custom"), gravity, earth)
+        first = schedule.segments[0]  # the candidates recorded as the schedule's segments are
+        cand_model = MeanModel(Schedule(tuple(c.segment(first.sample_rate, first.temperature)
+                                              for c in _level(candidates)), procedure="custom"), gravity, earth)
         Zc = _effect_columns(cand_model, theta)  # (C, 6, E)
         Fw = np.linalg.cholesky(np.linalg.inv(extra.covariance)).transpose(0, 2, 1)  # (C, 6, 6): FwᵀFw = Σ⁻¹
         for e in np.flatnonzero(~separable):
