@@ -224,21 +224,30 @@ class _Search:
         self.calls = 0
         self._cache: dict = {}
 
-    def ratio(self, schedule: Schedule) -> float:
-        """max over the targets of predicted U / target (≤ 1: met); inf when the estimators cannot reduce it."""
+    def predicted(self, schedule: Schedule) -> np.ndarray | None:
+        """The predicted U (39,) of *schedule* (:func:`predicted_U`, once per schedule), or None when the
+        estimators cannot reduce it."""
         key = tuple((s.test, s.up, s.heading, s.rate, s.dwell) for s in schedule.segments)
         if key not in self._cache:
             try:
                 check_design(schedule)
             except ValueError:
-                self._cache[key] = math.inf
-                return math.inf
+                self._cache[key] = None
+                return None
             self.calls += 1
             if self.progress is not None:
                 self.progress(self.calls, None)
-            U = predicted_U(dataclasses.replace(self.base, schedule=schedule))
-            self._cache[key] = float(np.max(U[self.index] / self.limit))
+            self._cache[key] = predicted_U(dataclasses.replace(self.base, schedule=schedule))
         return self._cache[key]
+
+    def ratios(self, schedule: Schedule) -> np.ndarray:
+        """Predicted U / limit per target; inf when the estimators cannot reduce *schedule*."""
+        U = self.predicted(schedule)
+        return np.full(self.limit.shape, math.inf) if U is None else U[self.index] / self.limit
+
+    def ratio(self, schedule: Schedule) -> float:
+        """max over the targets of predicted U / its limit (≤ 1: met); inf when the estimators cannot reduce it."""
+        return float(np.max(self.ratios(schedule)))
 
     def shortest(self, shape: _Shape, test: int, lowest: int) -> _Shape | None:
         """The shape with the shortest dwell of *test* (≥ DWELLS[lowest]) that meets every target, or None. A scan
@@ -383,7 +392,7 @@ def _search(scenario: Scenario, targets: dict[str, Target], limits: np.ndarray, 
     # 3. pruning
     schedule = _prune(search, schedule, compliant)
     planned = dataclasses.replace(scenario, schedule=schedule, name=f"{scenario.name}-plan")
-    U = predicted_U(planned)
+    U = search.predicted(schedule)
     predicted = {n: float(U[PARAMETER_INDEX[n]]) for n in targets}
     return PlanResult(planned, targets, schedule.duration, predicted, compliant, search.calls,
                       _why_needed(search, schedule, compliant), limits=dict(zip(targets, limits.tolist())))
@@ -422,16 +431,16 @@ def _why_needed(search: _Search, schedule: Schedule, compliant: bool) -> tuple[s
     out = []
     for k in range(len(schedule)):
         smaller = _without(schedule, k)
-        if compliant and not jjf2003_compliance(smaller).compliant:
-            out.append("JJF 2003 compliance: " + "; ".join(jjf2003_compliance(smaller).failed()))
+        failed = jjf2003_compliance(smaller).failed() if compliant else []
+        if failed:
+            out.append("JJF 2003 compliance: " + "; ".join(failed))
             continue
-        ratio = search.ratio(smaller)
-        if math.isinf(ratio):
+        ratios = search.ratios(smaller)
+        worst = int(np.argmax(ratios))
+        if math.isinf(ratios[worst]):
             out.append("the JJF 2003 reduction (check_design)")
-        elif ratio > 1.0:
-            U = predicted_U(dataclasses.replace(search.base, schedule=smaller))[search.index] / search.limit
-            worst = int(np.argmax(U))
-            out.append(f"{list(search.targets)[worst]}: predicted U {U[worst]:.3f}× its limit")
+        elif ratios[worst] > 1.0:
+            out.append(f"{list(search.targets)[worst]}: predicted U {ratios[worst]:.3f}× its limit")
         else:
             out.append("nothing (a removable segment: the pruning would have removed it)")
     return tuple(out)
