@@ -99,6 +99,22 @@ STEP_MARGIN = 0.05
 FLICKER_SPAN = 4
 
 
+def _step_profile(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The splits k of the step test, x̄₁ − x̄₂ at each (..., K) and its standard error per unit s, for centred x."""
+    n = x.shape[-1]
+    m = max(2, int(STEP_MARGIN * n))
+    k = np.arange(m, n - m + 1)
+    csum = np.cumsum(x, axis=-1)[..., k - 1]  # Σ of the first k (the whole sums to 0: x is centred)
+    diff = csum / k + csum / (n - k)  # x̄₁ − x̄₂ = S_k/k − (−S_k)/(n − k)
+    return k, diff, np.sqrt(1.0 / k + 1.0 / (n - k))
+
+
+def _block_variances(x: np.ndarray) -> np.ndarray:
+    """Variances (..., BLOCKS) of the burst test's equal blocks of x (the last n mod BLOCKS samples left out)."""
+    width = x.shape[-1] // BLOCKS
+    return np.var(x[..., : width * BLOCKS].reshape(*x.shape[:-1], BLOCKS, width), axis=-1, ddof=1)
+
+
 def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[np.ndarray, np.ndarray]:
     """The statistics (..., 5) in the order of :data:`TESTS` of samples *x* (..., n), and the periodic test's
     frequency (..., ) in Hz; ``scatter`` is the variance s² itself here. NaN where the samples do not vary (s at
@@ -121,11 +137,8 @@ def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[n
     stt = float(t @ t)
     slope = (x @ t) / stt
     out[..., 0] = np.abs(slope) * math.sqrt(stt) / s
-    m = max(2, int(STEP_MARGIN * n))
-    k = np.arange(m, n - m + 1)
-    csum = np.cumsum(x, axis=-1)[..., k - 1]  # Σ of the first k (the whole sums to 0: x is centred)
-    diff = csum / k + csum / (n - k)  # x̄₁ − x̄₂ = S_k/k − (−S_k)/(n − k)
-    out[..., 1] = np.max(np.abs(diff) / np.sqrt(1.0 / k + 1.0 / (n - k)), axis=-1) / s
+    _, diff, se = _step_profile(x)
+    out[..., 1] = np.max(np.abs(diff) / se, axis=-1) / s
     detrended = x - slope[..., None] * t
     power = np.abs(np.fft.rfft(detrended, axis=-1)) ** 2
     band = power[..., MIN_CYCLES:n // 2]
@@ -136,8 +149,7 @@ def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[n
         out[..., 2] = np.where(ok, np.take_along_axis(band, top[..., None], -1)[..., 0] / np.where(ok, median, 1.0),
                                np.nan)
         freq = (top + MIN_CYCLES) * sample_rate / n
-    blocks = x[..., : (n // BLOCKS) * BLOCKS].reshape(*shape, BLOCKS, n // BLOCKS)
-    block_var = np.var(blocks, axis=-1, ddof=1)
+    block_var = _block_variances(x)
     block_median = np.median(block_var, axis=-1)
     out[..., 3] = np.where(block_median > 0, block_var.max(axis=-1) / np.where(block_median > 0, block_median, 1.0),
                            np.nan)
@@ -217,18 +229,15 @@ def _describe(test: str, x: np.ndarray, sample_rate: float, frequency: float, ch
     if test == "trend":
         return {"slope": float((y @ t) / (t @ t)), "unit": f"{unit}/s"}
     if test == "step":
-        m = max(2, int(STEP_MARGIN * n))
-        k = np.arange(m, n - m + 1)
-        csum = np.cumsum(y)[k - 1]
-        diff = csum / k + csum / (n - k)
-        best = int(np.argmax(np.abs(diff) / np.sqrt(1.0 / k + 1.0 / (n - k))))
+        k, diff, se = _step_profile(y)
+        best = int(np.argmax(np.abs(diff) / se))
         return {"at_s": float(k[best] / sample_rate), "size": float(-diff[best]), "unit": unit}
     if test == "periodic":
         amplitude = 2.0 * abs(np.sum(y * np.exp(-2j * math.pi * frequency * np.arange(n) / sample_rate))) / n
         return {"frequency_hz": float(frequency), "amplitude": float(amplitude), "unit": unit}
     if test == "burst":
         width = n // BLOCKS
-        block = int(np.argmax(np.var(y[: width * BLOCKS].reshape(BLOCKS, width), axis=1, ddof=1)))
+        block = int(np.argmax(_block_variances(y)))
         return {"from_s": float(block * width / sample_rate), "to_s": float((block + 1) * width / sample_rate),
                 "std": float(np.std(y[block * width:(block + 1) * width], ddof=1)), "unit": unit}
     return {"std": float(np.std(y, ddof=1)), "unit": unit}
@@ -339,11 +348,9 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
     if S:
         stat[scatter] /= _median_of_finite(stat[scatter])
         null[:, scatter] /= _median_of_finite(null[:, scatter])
-    # each cell's p from its null draws, with a generalised Pareto tail beyond their 90th percentile (so that a
-    # strong pattern gets a p far below 1/B, which the family-wise step needs); each null draw's p the same way
-    # The draws are split: the first half is the reference the p-values are computed against, the second half
-    # plays the data (its p-values computed exactly as the data's), so that the data and the null draws it is
-    # compared with are both out of the reference sample
+    # each cell's p against the first half of its null draws, with a generalised Pareto tail (tail_p_values); the
+    # second half plays the data, its p-values computed exactly as the data's, so that both are out of the
+    # reference sample; then the Westfall–Young min-p over the cells
     half = draws // 2
     p = np.full((T, C, S), np.nan)
     null_p = np.full((draws - half, T, C, S), np.nan)
@@ -354,16 +361,16 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
             continue
         p[t, c, j] = tail_p_values(reference[ok], np.array([stat[t, c, j]]))[0]
         null_p[:, t, c, j] = np.where(np.isfinite(evaluation), tail_p_values(reference[ok], evaluation), np.nan)
-    with np.errstate(invalid="ignore"):
-        flat = null_p.reshape(draws - half, -1)
-        min_null = np.where(np.isfinite(flat).any(axis=1), np.nanmin(np.where(np.isfinite(flat), flat, np.inf),
-                                                                     axis=1), 1.0)
+    flat = null_p.reshape(draws - half, -1)
+    min_null = np.minimum(np.min(np.where(np.isfinite(flat), flat, np.inf), axis=1, initial=np.inf), 1.0)
     adjusted = np.where(np.isfinite(p), (1 + np.count_nonzero(min_null[None, :] <= p.reshape(-1, 1), axis=1)
                                          .reshape(p.shape)) / (draws - half + 1), np.nan)
     flagged = []
     for t, c, j in zip(*np.nonzero(np.nan_to_num(adjusted, nan=1.0) < alpha)):
         k = tested[j]
         x = np.asarray(segment_samples[k], dtype=float)[:, c]
+        if segments[k].is_rotating:  # described as tested: without the table's harmonics
+            x = turning_residuals(x, segments[k].rate, segments[k].sample_rate)
         flagged.append({"test": TESTS[t], "channel": CHANNELS[c], "segment": int(k), "label": segments[k].label,
                         "statistic": float(stat[t, c, j]), "p_value": float(p[t, c, j]),
                         "adjusted_p_value": float(adjusted[t, c, j]),
