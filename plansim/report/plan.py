@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from plansim.model.parameters import parameter
+from plansim.report.sweep import json_number
 
 #: the keys of ``plansim plan --json`` and of each of its targets
 JSON_KEYS = ("scenario", "scenario_source", "overrides", "compliant_jjf2003", "table_time_s", "time_with_rules_s",
@@ -12,10 +13,6 @@ JSON_KEYS = ("scenario", "scenario_source", "overrides", "compliant_jjf2003", "t
              "removal_breaks")
 TARGET_KEYS = ("parameter", "unit", "target_U", "limit_U", "predicted_U", "monte_carlo_U", "monte_carlo_se", "met",
                "source")
-
-
-def _number(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
 
 
 def schedule_summary(schedule) -> dict:
@@ -40,13 +37,13 @@ def plan_json(result) -> dict:
         U_mc, se = mc.get(name, (math.nan, math.nan))
         targets.append({"parameter": name, "unit": parameter(name).si_unit, "target_U": target.U,
                         "limit_U": result.limits[name], "predicted_U": result.predicted[name],
-                        "monte_carlo_U": _number(U_mc), "monte_carlo_se": _number(se), "met": met.get(name),
+                        "monte_carlo_U": json_number(U_mc), "monte_carlo_se": json_number(se), "met": met.get(name),
                         "source": target.source})
     sc = result.scenario
     return {"scenario": sc.name, "scenario_source": sc.source, "overrides": list(sc.overrides),
             "compliant_jjf2003": result.compliant, "table_time_s": result.table_time,
-            "time_with_rules_s": _number(result.time_with_rules),
-            "time_without_rules_s": _number(result.time_without_rules), "segments": len(sc.schedule),
+            "time_with_rules_s": json_number(result.time_with_rules),
+            "time_without_rules_s": json_number(result.time_without_rules), "segments": len(sc.schedule),
             "schedule": schedule_summary(sc.schedule), "trials": result.trials, "rounds": result.rounds,
             "predictions": result.predictions, "all_met": all(met.values()) if met else None, "targets": targets,
             "removal_breaks": [{"segment": s.label, "breaks": why}

@@ -36,7 +36,8 @@ def _cells(ds: xr.Dataset):
         yield coordinates, cell
 
 
-def _number(x) -> float | None:
+def json_number(x) -> float | None:
+    """*x* as a float for JSON, or None when it is not finite (JSON has no NaN or infinity)."""
     x = float(x)
     return x if math.isfinite(x) else None
 
@@ -112,10 +113,10 @@ def sweep_json(ds: xr.Dataset) -> dict:
             "failed_rules": [str(t) for t, ok in zip(ds["rule_text"].values, cell["jjf2003_rule"].values) if not ok],
             "max_rate_rad_s": float(cell["max_rate"]),
             "under_covered": under_covered(ds, cell),
-            "u_group": {g: _number(cell["u_group"].sel(group=g)) for g in groups},
+            "u_group": {g: json_number(cell["u_group"].sel(group=g)) for g in groups},
             "pareto": {g: bool(cell["pareto"].sel(group=g)) for g in groups},
             "parameters": [{"name": str(name), "unit": str(unit),
-                            **{k: _number(cell[k].values[i]) for k in per}}
+                            **{k: json_number(cell[k].values[i]) for k in per}}
                            for i, (name, unit) in enumerate(zip(ds["parameter"].values, ds["unit"].values))],
         })
     dims = _grid_dims(ds)
