@@ -9,7 +9,7 @@ Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simul
   the size taken from the diagnosis of a null recording of the same schedule
   (:attr:`plansim.diagnose.scores.CandidateScore.noise_equivalent_size`), injected through the scenario's
   ``[mimu.effects]`` field so that the simulator makes it (``bias_drift`` has no field: a ramp in time is added to
-  the samples). The component is the first one the schedule identifies;
+  the samples before the acquisition, as below). The component is the first one the schedule identifies;
 - **effects outside the catalogue**, added to the simulated samples before the acquisition (the same trial
   simulated without the quantiser, the effect added, then saturated and quantised as the scenario's acquisition
   does: :func:`_acquire`; added after the quantiser, they would leave samples off its codes that no sensor
@@ -185,6 +185,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     if reference is None or per_effect == 0:
         return report
     nes = {c.effect: c for c in reference.candidates}
+    unquantised = _without_quantiser(scenario)  # effects added to the samples go in before the acquisition
     for effect in ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
                    "bias_drift", "lever_arm"):
         candidate = nes[effect]
@@ -200,15 +201,18 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
             for i in range(per_effect):
                 s = case_seed(seed, f"{effect}/{k}", i)
                 injected = _inject(scenario, effect, component, size) if effect != "bias_drift" else scenario
-                recording = simulate_and_record(injected, seed=s, trial=0)
-                _, _, truth = simulate_recording(injected, s, 0)
-                if effect == "bias_drift":
+                if effect == "bias_drift":  # a ramp on the sensor, before the acquisition, as the others are
+                    recording = simulate_and_record(unquantised, seed=s, trial=0)
                     c = "gx gy gz ax ay az".split().index(component)
                     rate = recording.schedule.segments[0].sample_rate
                     t = np.arange(recording.samples.shape[0]) / rate
                     samples = np.array(recording.samples, dtype=float)
                     samples[:, c] += size * (t - t.mean())
-                    recording = type(recording)(samples, recording.schedule, dict(recording.attrs))
+                    recording = type(recording)(_acquire(scenario, samples), recording.schedule,
+                                                dict(recording.attrs))
+                else:
+                    recording = simulate_and_record(injected, seed=s, trial=0)
+                _, _, truth = simulate_recording(injected, s, 0)
                 d, z = _run(injected, recording, truth, lever, alpha, null_draws, s)
                 counts["detected"] += _alarm(d)
                 counts["attributed"] += d.selected == (effect,)
@@ -229,7 +233,6 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     u_mean = float(np.median(np.sqrt(np.diag(reference.before.covariance)).reshape(-1, 6)[:, 0]))
     white = reference.before.noise.channels[0].white
     sigma_sample = float(white * math.sqrt(sample_rate)) if math.isfinite(white) else u_mean
-    unquantised = _without_quantiser(scenario)
     for effect in OUT_OF_CATALOGUE:
         for k in sizes:
             size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample)
