@@ -50,15 +50,11 @@ from plansim.kernels.layout import (
 )
 from plansim.model.parameters import N_PARAMETERS, pack
 from plansim.schedule.segments import Schedule
-from plansim.simulate.arguments import as_float_arrays, kernel_arguments
+from plansim.simulate.arguments import noise_free_arguments
 
 #: equally spaced start angles (phases) a rotating segment's mean is averaged over: exact for a mean of
 #: degree < 8 in the angle, its variance over the angle exact for degree < 4 (the kernel's is ≤ 3)
 ANGLES = 8
-
-#: the kernel arguments :func:`segment_path.noise_free_means` takes (as noise_free_segment_means passes them)
-_KEEP = ("seg_n", "seg_dt", "seg_C0", "seg_rate", "seg_axis", "seg_axis_index", "seg_temp", "sensor", "S2",
-         "lever", "t_ref", "gravity", "earth_enu")
 
 #: steps of the central differences for the sensitivities to table errors: rad, relative rate, m/s², rad/s.
 #: The outputs are smooth (sines of the angles), so the truncation error is ~h²/6 of the sensitivity
@@ -132,8 +128,7 @@ class MeanModel:
         known = Schedule(tuple(dataclasses.replace(s, heading=0.0, orientation="known") if not s.heading_known
                                else s for s in schedule.segments), procedure=schedule.procedure)
         scenario = dataclasses.replace(_template(), schedule=known)
-        args = as_float_arrays(kernel_arguments(scenario))
-        self._args = {k: args[k] for k in _KEEP}
+        self._args = noise_free_arguments(scenario)
         if lever_arm is not None:
             lever = np.ascontiguousarray(lever_arm, dtype=float)
             if lever.shape != (3, 3) or not np.all(np.isfinite(lever)):
