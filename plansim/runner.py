@@ -35,7 +35,7 @@ from plansim.estimate import reduce, reduction_matrix
 from plansim.estimate.jjf1535 import allan_polynomial_fit
 from plansim.estimate.jjf1535_items import reduce_items
 from plansim.fit.noise import allan_deviation
-from plansim.io.recording import UNITS_DESCRIPTION, Recording, plansim_version
+from plansim.io.recording import UNITS_DESCRIPTION, Recording, plansim_version, segment_first_samples
 from plansim.io.results import ResultsFile
 from plansim.io.scenario_file import load_scenario
 from plansim.kernels.layout import CHANNELS, N_CHANNELS, N_TRUTH
@@ -505,7 +505,7 @@ def jjf1535_angle_random_walk(scenario: Scenario | str = "jjf2003", seed: int | 
     samples, means, _truth = simulate_recording(world, seed, trial)
     K = reduce_items(means, procedure, sc.reduction.reference_gravity)["scale_factor"]
     schedule = procedure.schedule
-    start = sum(s.samples for s in schedule.segments[: procedure.allan])
+    start = int(segment_first_samples(schedule)[procedure.allan])
     record = schedule.segments[procedure.allan]
     rates = samples[start: start + record.samples, procedure.axis] / K
     tau, adev, _dof = allan_deviation(rates, record.sample_rate)
