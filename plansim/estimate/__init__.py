@@ -7,10 +7,11 @@ from plansim.estimate.jjf2003 import (
                                       multi_position_fit,
                                       rate_sensitivity,
                                       reduce,
+                                      reduction_key,
                                       reduction_matrix,
                                       segment_mean,
 )
 
 __all__ = ["DESIGN_MATRIX_A", "check_design", "line_fit", "multi_position_fit", "rate_sensitivity", "reduce",
-           "reduction_matrix",
+           "reduction_key", "reduction_matrix",
            "segment_mean"]

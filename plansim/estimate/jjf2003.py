@@ -8,6 +8,9 @@ accelerometer in m/s²).
 
 from __future__ import annotations
 
+import functools
+from typing import NamedTuple
+
 import numpy as np
 
 from plansim.model.parameters import pack
@@ -69,6 +72,7 @@ def multi_position_fit(group_means: np.ndarray, design: np.ndarray) -> np.ndarra
     """
     design = np.asarray(design, dtype=float)
     right = design.T @ np.linalg.inv(design @ design.T)  # (m, 4)
+    right.flags.writeable = False
     return np.asarray(group_means, dtype=float) @ right
 
 
@@ -164,33 +168,100 @@ def reduce(means: np.ndarray, schedule: Schedule, reference_gravity: float,
     (..., 39) array
         Estimates in SI, ordered as :data:`plansim.model.parameters.PARAMETER_NAMES`.
     """
-    means = np.asarray(means, dtype=float)
+    if omega_squared_sign not in ("model", "as_printed"):
+        raise ValueError(f"reduction.omega_squared_sign = {omega_squared_sign!r}; allowed: 'model', 'as_printed'")
+    return _reduce(np.asarray(means, dtype=float), _reduction_plan(reduction_key(schedule)), reference_gravity,
+                   omega_squared_sign)
+
+
+def _reduce(means: np.ndarray, plan: _ReductionPlan, reference_gravity: float, omega_squared_sign: str) -> np.ndarray:
+    """:func:`reduce` with the schedule's side already worked out (*plan*): the arithmetic on the means alone,
+    operation for operation that of :func:`line_fit`, :func:`multi_position_fit` and :func:`rate_sensitivity`."""
     lead = means.shape[:-2]
     Kg = np.zeros(lead + (3, 3))
-    for axis in range(3):
-        ks = [k for k in schedule.select("rate") if schedule.segments[k].group == axis]
-        rates = np.array([schedule.segments[k].rate for k in ks])
-        slope, _ = line_fit(rates, np.moveaxis(means[..., ks, GYRO], -2, -1))
-        Kg[..., :, axis] = slope  # §7.2.3: column = rate about this table axis
+    for axis, (ks, pseudo_inverse) in enumerate(plan.rate_fits):  # eq. (5)
+        coefficients = np.moveaxis(means[..., ks, GYRO], -2, -1) @ pseudo_inverse.T
+        Kg[..., :, axis] = coefficients[..., 0]  # §7.2.3: column = rate about this table axis
 
-    _, members, design = multi_position_design(schedule)
-    group_means = np.stack([means[..., ks, :].mean(axis=-2) for ks in members], axis=-1)  # (..., 6, m)
-    gyro = multi_position_fit(group_means[..., GYRO, :], design)
-    accel = multi_position_fit(group_means[..., ACCEL, :], design)
+    if plan.group_index is not None:  # groups of one size: their means in one call, laid out as np.stack lays them
+        group_means = np.ascontiguousarray(np.swapaxes(means[..., plan.group_index, :].mean(axis=-2), -1, -2))
+    else:
+        group_means = np.stack([means[..., ks, :].mean(axis=-2) for ks in plan.members], axis=-1)  # (..., 6, m)
+    gyro = group_means[..., GYRO, :] @ plan.right  # eq. (7)/(10)
+    accel = group_means[..., ACCEL, :] @ plan.right
     G, Bg = gyro[..., :3] / reference_gravity, gyro[..., 3]
     Ka, Ba = accel[..., :3] / reference_gravity, accel[..., 3]
 
     P = np.zeros(lead + (3, 3))
-    for axis in range(3):
-        segs = [k for k in schedule.select("omega_squared") if schedule.segments[k].group == axis]
-        rest = [k for k in segs if not schedule.segments[k].is_rotating]
-        turning = [k for k in segs if schedule.segments[k].is_rotating]
-        rate = schedule.segments[turning[0]].rate
+    for axis, (rest, turning, rate) in enumerate(plan.omega_squared):  # eq. (12)-(13)
         u7 = means[..., rest, ACCEL].mean(axis=-2)
         u8 = means[..., turning, ACCEL].mean(axis=-2)
         P[..., :, axis] = rate_sensitivity(u7, u8, rate, omega_squared_sign)
     P[..., [0, 1, 2], [0, 1, 2]] = 0.0
     return pack(Kg, Bg, G, Ka, Ba, P)
+
+
+def reduction_key(schedule: Schedule) -> tuple:
+    """What :func:`reduce` reads of the schedule: each segment's test, group, up-axis and rate.
+
+    Two schedules with the same key have the same reduction (and :func:`reduction_matrix`), whatever
+    their dwells, settling times, sample rates or temperatures; a caller may key a cache on it.
+    """
+    return tuple((s.test, s.group, s.up, s.rate) for s in schedule.segments)
+
+
+class _ReductionPlan(NamedTuple):
+    """The schedule's side of :func:`reduce`: which segments each estimator reads and its fixed matrices."""
+
+    rate_fits: tuple[tuple[list[int], np.ndarray], ...]  # per axis: the rate-test segments, (HᵀH)⁻¹Hᵀ of eq. (5)
+    members: list[list[int]]  # the segments of each multi-position group
+    group_index: np.ndarray | None  # (m, n) the same, where every group has n segments
+    right: np.ndarray  # Aᵀ(AAᵀ)⁻¹ of eq. (7)/(10)
+    omega_squared: tuple[tuple[list[int], list[int], float], ...]  # per axis: U7's and U8's segments, the rate
+
+
+@functools.lru_cache(maxsize=64)
+def _reduction_plan(key: tuple) -> _ReductionPlan:
+    """:func:`reduce`'s index lists and matrices of the schedule whose :func:`reduction_key` is *key*,
+    computed as :func:`line_fit` and :func:`multi_position_fit` compute them (so bit for bit the same),
+    once per distinct schedule (a reduction of a chunk of trials, or of one prediction, then costs only
+    its arithmetic on the means)."""
+    tests = [k[0] for k in key]
+    groups = [k[1] for k in key]
+    ups = [k[2] for k in key]
+    rates = [k[3] for k in key]
+    rate_fits = []
+    for axis in range(3):
+        ks = [k for k, t in enumerate(tests) if t == "rate" and groups[k] == axis]
+        x = np.array([rates[k] for k in ks], dtype=float)
+        H = np.column_stack([x, np.ones_like(x)])
+        if np.linalg.matrix_rank(H) < 2:
+            raise ValueError(f"rate points {x.tolist()}: at least 2 distinct rates are needed for eq. (5)")
+        pseudo_inverse = np.linalg.solve(H.T @ H, H.T)
+        pseudo_inverse.flags.writeable = False  # shared by every reduction of the schedule
+        rate_fits.append((ks, pseudo_inverse))
+    idx = [k for k, t in enumerate(tests) if t == "multi_position"]
+    numbers = sorted({groups[k] for k in idx})
+    members = [[k for k in idx if groups[k] == g] for g in numbers]
+    columns = []
+    for g, ks in zip(numbers, members):
+        up = {ups[k] for k in ks}
+        if len(up) != 1:
+            raise ValueError(f"schedule: multi-position group {g} mixes up-axes {sorted(up)}; "
+                             "the positions averaged into one group must share the axis that points up")
+        columns.append(np.append(axis_vector(up.pop()), 1.0))
+    design = np.array(columns).T if columns else np.zeros((4, 0))
+    right = design.T @ np.linalg.inv(design @ design.T)  # (m, 4)
+    right.flags.writeable = False
+    omega_squared = []
+    for axis in range(3):
+        segs = [k for k, t in enumerate(tests) if t == "omega_squared" and groups[k] == axis]
+        rest = [k for k in segs if not rates[k] != 0.0]
+        turning = [k for k in segs if rates[k] != 0.0]
+        omega_squared.append((rest, turning, rates[turning[0]]))
+    sizes = {len(ks) for ks in members}
+    group_index = np.array(members, dtype=np.intp) if len(sizes) == 1 else None
+    return _ReductionPlan(tuple(rate_fits), members, group_index, right, tuple(omega_squared))
 
 
 def reduction_matrix(schedule: Schedule, reference_gravity: float,
@@ -204,6 +275,8 @@ def reduction_matrix(schedule: Schedule, reference_gravity: float,
     the formulas; it is then checked on random means to within rounding
     (``|probe @ M − reduce(probe)| ≤ 1e-12·(|probe| @ |M|)``). On the default schedule the product
     is about 7× faster than :func:`reduce` on the same chunk.
+
+    It depends on the schedule only through :func:`reduction_key`.
 
     Returns
     -------

@@ -15,6 +15,7 @@ The 39 parameters are held as one flat vector in the order of :data:`PARAMETER_N
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,9 +102,13 @@ def group_spec(group: str) -> ParameterSpec:
     raise ValueError(f"unknown parameter group {group!r}; known: {', '.join(GROUPS)}")
 
 
+@functools.cache
 def _indices(group: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(parameter index, row, column) of each parameter of *group*, built once (read-only)."""
     sel = [(k, p.row, p.col) for k, p in enumerate(PARAMETERS) if p.group == group]
     k, r, c = (np.array(x) for x in zip(*sel))
+    for x in (k, r, c):
+        x.flags.writeable = False
     return k, r, c
 
 

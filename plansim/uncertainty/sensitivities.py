@@ -20,13 +20,13 @@ equally spaced angles are exact.
 
 from __future__ import annotations
 
-import functools
 import math
+import threading
 
 import numpy as np
 
 from plansim.config import ErrorDistribution, Scenario
-from plansim.estimate import reduction_matrix
+from plansim.estimate import reduction_key, reduction_matrix
 from plansim.kernels.layout import (
     FIXTURE,
     HEAD,
@@ -44,7 +44,7 @@ from plansim.kernels.layout import (
 )
 from plansim.kernels.segment_path import noise_free_mean_derivatives
 from plansim.model.parameters import N_PARAMETERS
-from plansim.schedule.segments import Schedule, Segment
+from plansim.schedule.segments import Schedule
 from plansim.simulate.arguments import kernel_arguments, noise_free_arguments, nominal_draws
 
 __all__ = ["PHASE_NODES", "estimator_matrix", "finite_differences", "phase_angles", "phase_grid_draws",
@@ -64,8 +64,10 @@ def estimator_matrix(scenario: Scenario) -> np.ndarray:
 
     :func:`plansim.estimate.reduction_matrix` (the reduction applied to the ``6·S`` unit vectors,
     eq. (5), (7), (10), (12)-(13) being linear least squares and differences), reshaped. It depends
-    on the schedule, the reference gravity and the ω² sign convention alone, and is built once per
-    distinct three (a planner evaluates one schedule under many tables and noise models).
+    on the schedule's :func:`~plansim.estimate.reduction_key` (its segments' tests, groups, up-axes and
+    rates: not their dwells), the reference gravity and the ω² sign convention alone, and is built
+    once per distinct three (a planner evaluates one schedule under many tables and noise models, and
+    many dwells of one schedule).
 
     Parameters
     ----------
@@ -87,21 +89,37 @@ def estimator_matrix(scenario: Scenario) -> np.ndarray:
     if not isinstance(scenario, Scenario):
         raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
     r = scenario.reduction
-    matrix = _estimator_matrix(scenario.schedule.segments, float(r.reference_gravity), r.omega_squared_sign)
+    key = (reduction_key(scenario.schedule), float(r.reference_gravity), r.omega_squared_sign)
+    with _MATRICES_LOCK:  # a sweep predicts on threads
+        found = key in _MATRICES
+        if found:
+            _MATRICES[key] = matrix = _MATRICES.pop(key)  # the most recently used last
+    if not found:
+        matrix = _estimator_matrix(scenario.schedule, *key[1:])
+        with _MATRICES_LOCK:
+            _MATRICES[key] = matrix
+            if len(_MATRICES) > _MATRICES_KEPT:
+                del _MATRICES[next(iter(_MATRICES))]
     if matrix is None:
         raise ValueError(f"scenario {scenario.name!r}: the JJF 2003 reduction of this schedule is not linear in the "
                          "segment means, so it has no matrix to propagate the GUM budget through")
     return matrix
 
 
-@functools.lru_cache(maxsize=64)
-def _estimator_matrix(segments: tuple[Segment, ...], reference_gravity: float, omega_squared_sign: str
-                      ) -> np.ndarray | None:
-    """:func:`estimator_matrix` of the schedule of *segments* (read-only), or None where the reduction has no matrix."""
-    matrix = reduction_matrix(Schedule(segments), reference_gravity, omega_squared_sign)  # (6S, 39)
+#: :func:`estimator_matrix` per :func:`plansim.estimate.reduction_key`, reference gravity and sign convention
+#: (the reduction reads the schedule's tests, groups, up-axes and rates alone: schedules that differ only in
+#: their dwells share it), the least recently used dropped beyond :data:`_MATRICES_KEPT`
+_MATRICES: dict[tuple, np.ndarray | None] = {}
+_MATRICES_KEPT = 64
+_MATRICES_LOCK = threading.Lock()
+
+
+def _estimator_matrix(schedule: Schedule, reference_gravity: float, omega_squared_sign: str) -> np.ndarray | None:
+    """:func:`estimator_matrix` of *schedule* (read-only), or None where the reduction has no matrix."""
+    matrix = reduction_matrix(schedule, reference_gravity, omega_squared_sign)  # (6S, 39)
     if matrix is None:
         return None
-    matrix = np.ascontiguousarray(matrix.T.reshape(N_PARAMETERS, len(segments), N_CHANNELS))
+    matrix = np.ascontiguousarray(matrix.T.reshape(N_PARAMETERS, len(schedule), N_CHANNELS))
     matrix.flags.writeable = False
     return matrix
 
