@@ -112,6 +112,15 @@ def segment_drift(drift, drift_coeffs, s, noise, stream, mean_out):
     return stream
 
 
+@jit
+def _later_block_sums(weight, phi, T, E):
+    """The backward recursions of :func:`drift_coefficients`, from the last block (``T[B−1] = 0``, ``E[B−1] = 1``):
+    ``T[i] = w[i+1] + φ[i+1]·T[i+1]`` and ``E[i] = φ[i+1]·E[i+1]`` (a loop over the segment's blocks)."""
+    for i in range(T.shape[0] - 2, -1, -1):
+        T[i] = weight[i + 1] + phi[i + 1] * T[i + 1]
+        E[i] = phi[i + 1] * E[i + 1]
+
+
 def drift_coefficients(n: int, dt: float, hold_interval: float, tau: float | None) -> np.ndarray:
     """Unit-σ coefficients (a, c, L11, L21, L22) of a held drift process over one recorded segment.
 
@@ -137,9 +146,7 @@ def drift_coefficients(n: int, dt: float, hold_interval: float, tau: float | Non
     c = float(A[-1])
     T = np.zeros(blocks)  # T_i = Σ_{j>i} w_j Π_{i<l<j} φ_l
     E = np.ones(blocks)  # E_i = Π_{i<l<B} φ_l
-    for i in range(blocks - 2, -1, -1):
-        T[i] = weight[i + 1] + phi[i + 1] * T[i + 1]
-        E[i] = phi[i + 1] * E[i + 1]
+    _later_block_sums(weight, phi, T, E)
     b = q * T
     d = q * E
     cov = np.array([[b @ b, b @ d], [b @ d, d @ d]])
