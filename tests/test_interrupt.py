@@ -30,10 +30,18 @@ MESSAGES = {signal.SIGINT: ("plansim: interrupted", 130), signal.SIGTERM: ("plan
 START_TIMEOUT = 180
 
 
+def _as_at_a_terminal() -> None:
+    """In the child, before plansim starts: SIGINT at its default, as at a terminal where Ctrl-C reaches it. A
+    shell without job control starts a background job (``pytest … &``, ``nohup``) with SIGINT ignored, the child
+    inherits that, and Python then installs no KeyboardInterrupt handler: the test would measure how it was
+    launched, not plansim."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start(argv, cwd, logs, env=None) -> tuple[subprocess.Popen, object]:
     out, err = open(logs / "stdout", "wb"), open(logs / "stderr", "wb")
     process = subprocess.Popen([sys.executable, "-m", "plansim.cli", *argv], cwd=cwd, stdout=out, stderr=err,
-                               stdin=subprocess.DEVNULL, env=env)
+                               stdin=subprocess.DEVNULL, env=env, preexec_fn=_as_at_a_terminal)
     out.close()
     err.close()
     return process, logs / "stderr"
