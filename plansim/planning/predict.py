@@ -26,10 +26,11 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import xarray as xr
 
 from plansim.config import Scenario
-from plansim.model.parameters import PARAMETERS
+from plansim.model.parameters import N_PARAMETERS, PARAMETERS
 from plansim.uncertainty.gum import gum_uncertainties
 
 
@@ -71,38 +72,49 @@ def predict(scenario: Scenario, coverage_probability: float = 0.95) -> xr.Datase
     if not 0 < coverage_probability < 1:
         raise ValueError(f"coverage_probability = {coverage_probability!r}: must be between 0 and 1")
     gum = gum_uncertainties(scenario, coverage_probability=coverage_probability)
+    values = {"u_predicted": gum.standard_uncertainty, "bias_predicted": gum.estimate,
+              "U_predicted": gum.expanded_uncertainty, "coverage_factor": gum.coverage_factor,
+              "effective_dof": gum.effective_dof, "covariance": gum.covariance}
+    prediction = _template(float(coverage_probability)).copy(deep=False, data=values)
+    prediction.attrs = {
+        "title": f"plansim prediction for scenario {scenario.name!r}",
+        "scenario": scenario.name, "scenario_source": scenario.source or "a Scenario object built in Python",
+        "scenario_overrides": "; ".join(scenario.overrides),
+        "method": "GUM (JCGM 100) of the JJF 2003 reduction on the scenario's schedule "
+                  "(plansim.uncertainty.gum.evaluate_gum; docs/uncertainty.md)",
+        "coverage_probability": float(coverage_probability)}
+    return prediction
+
+
+@functools.lru_cache(maxsize=8)
+def _template(coverage_probability: float) -> xr.Dataset:
+    """The Dataset :func:`predict` returns, with placeholder figures: built once per *coverage_probability*
+    and copied with each prediction's figures (its variables' attributes copied, the coordinates shared,
+    read-only), at a quarter of the cost of building it."""
     per = "SI: the unit coordinate of each parameter"
+    vector, matrix = np.zeros(N_PARAMETERS), np.zeros((N_PARAMETERS, N_PARAMETERS))
     data = {
-        "u_predicted": ("parameter", gum.standard_uncertainty,
+        "u_predicted": ("parameter", vector,
                         {"units": per, "long_name": "predicted standard uncertainty u_c of the calibrated value"}),
-        "bias_predicted": ("parameter", gum.estimate,
+        "bias_predicted": ("parameter", vector,
                            {"units": per, "long_name": "predicted bias: the error at the inputs' expectation "
                                                        "(systematic effects the estimators do not correct)"}),
-        "U_predicted": ("parameter", gum.expanded_uncertainty,
+        "U_predicted": ("parameter", vector,
                         {"units": per, "long_name": f"predicted expanded uncertainty, p = {coverage_probability:g}"}),
-        "coverage_factor": ("parameter", gum.coverage_factor,
+        "coverage_factor": ("parameter", vector,
                             {"units": "1", "long_name": "coverage factor k (t-distribution at nu_eff)"}),
-        "effective_dof": ("parameter", gum.effective_dof,
+        "effective_dof": ("parameter", vector,
                           {"units": "1", "long_name": "Welch-Satterthwaite effective degrees of freedom"}),
-        "covariance": (("parameter", "parameter_"), gum.covariance,
+        "covariance": (("parameter", "parameter_"), matrix,
                        {"units": "product of the two parameters' SI units",
                         "long_name": "covariance of the parameter errors (GUM 5.2.2)"}),
     }
-    attrs = {"title": f"plansim prediction for scenario {scenario.name!r}",
-             "scenario": scenario.name, "scenario_source": scenario.source or "a Scenario object built in Python",
-             "scenario_overrides": "; ".join(scenario.overrides),
-             "method": "GUM (JCGM 100) of the JJF 2003 reduction on the scenario's schedule "
-                       "(plansim.uncertainty.gum.evaluate_gum; docs/uncertainty.md)",
-             "coverage_probability": float(coverage_probability)}
-    return xr.Dataset(data, coords=_coordinates().copy(deep=True), attrs=attrs)
-
-
-@functools.cache
-def _coordinates() -> xr.Coordinates:
-    """The parameter coordinates of a prediction (names, SI units, long names), built once: a copy per
-    prediction costs half of building them (their indexes are half the time of the Dataset)."""
     names = [p.name for p in PARAMETERS]
-    return xr.Coordinates({"parameter": ("parameter", names),
-                           "unit": ("parameter", [p.si_unit for p in PARAMETERS]),
-                           "long_name": ("parameter", [p.long_name for p in PARAMETERS]),
-                           "parameter_": ("parameter_", names)})
+    coordinates = {"parameter": ("parameter", names),
+                   "unit": ("parameter", [p.si_unit for p in PARAMETERS]),
+                   "long_name": ("parameter", [p.long_name for p in PARAMETERS]),
+                   "parameter_": ("parameter_", names)}
+    template = xr.Dataset(data, coords=coordinates)
+    for name in ("unit", "long_name"):  # shared by every prediction: not to be written in place
+        template[name].values.flags.writeable = False
+    return template
