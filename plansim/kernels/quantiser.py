@@ -207,25 +207,70 @@ def quantisation_series(fraction, damping, max_terms, out):
     of the cost.
     """
     for i in range(fraction.shape[0]):
-        f = fraction[i]
-        d = damping[i]
-        t = f - math.floor(f)
-        tau = math.sqrt(max(d, 0.0))
-        terms = math.ceil(_TERMS_PER_INVERSE_TAU / max(tau, 1e-300)) if tau > 0.0 else math.inf
-        if terms > max_terms:
-            out[i] = _PI_SQUARED * (t * t - t + 1.0 / 6.0)
-            continue
-        s1, c1 = sin_cos_turns(t)
-        r2 = math.exp(-4.0 * math.pi * math.pi * d)  # the ratio of successive ratios
-        total = 0.0
-        ck, sk, e, g = 0.0, 0.0, 0.0, 0.0
-        for k in range(1, int(terms) + 1):
-            if (k - 1) % SERIES_RESEED == 0:
-                sk, ck = sin_cos_turns(k * t)
-                e = math.exp(-2.0 * math.pi * math.pi * k * k * d)
-                g = math.exp(-2.0 * math.pi * math.pi * (2 * k + 1) * d)
-            total += ck * e / (k * k)
-            ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
-            e *= g
-            g *= r2
-        out[i] = total
+        out[i] = _series_value(fraction[i], damping[i], max_terms)
+
+
+@inline_jit
+def _series_value(f, d, max_terms):
+    """One value of :func:`quantisation_series`: ``Σ_{k≥1} cos(2πk·f) exp(−2π²k²·d) / k²``."""
+    t = f - math.floor(f)
+    tau = math.sqrt(max(d, 0.0))
+    terms = math.ceil(_TERMS_PER_INVERSE_TAU / max(tau, 1e-300)) if tau > 0.0 else math.inf
+    if terms > max_terms:
+        return _PI_SQUARED * (t * t - t + 1.0 / 6.0)
+    s1, c1 = sin_cos_turns(t)
+    r2 = math.exp(-4.0 * math.pi * math.pi * d)  # the ratio of successive ratios
+    total = 0.0
+    ck, sk, e, g = 0.0, 0.0, 0.0, 0.0
+    for k in range(1, int(terms) + 1):
+        if (k - 1) % SERIES_RESEED == 0:
+            sk, ck = sin_cos_turns(k * t)
+            e = math.exp(-2.0 * math.pi * math.pi * k * k * d)
+            g = math.exp(-2.0 * math.pi * math.pi * (2 * k + 1) * d)
+        total += ck * e / (k * k)
+        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
+        e *= g
+        g *= r2
+    return total
+
+
+@inline_jit
+def _at_least(x, low):
+    """``np.maximum(x, low)`` (NaN kept)."""
+    return x if (x >= low or x != x) else low
+
+
+@inline_jit
+def _at_most(x, high):
+    """``np.minimum(x, high)`` (NaN kept)."""
+    return x if (x <= high or x != x) else high
+
+
+@jit
+def quantisation_covariances(means, sigma, samples, offsets, with_offsets, step, step_squared, scale, full, max_terms,
+                             out):
+    """``out[c]`` (S, S): the covariance of the quantisation errors of the segment means of channel *c*.
+
+    The arithmetic of :func:`plansim.uncertainty.quantisation.quantisation_covariance`, operation for
+    operation, for each pair s ≤ t: ``Var Δ = max((g_ss + g_tt) − 2g_st, 0)`` of ``g = offsets[c]``
+    (0 unless *with_offsets*), the series (:func:`quantisation_series`) at ``(m_t − m_s)/q`` and
+    ``(σ_s² + σ_t² + Var Δ)/q²`` times *scale* (``q²/2π²``); then the diagonal's averaged part,
+    ``B + (full − B)/n_s`` with ``B = min(max(c_ss, 0), full)``. *step_squared*, *scale* and *full*
+    are computed by the caller (``q**2``, ``q**2 / (2π**2)``, ``q**2 / 12``). ``means``, ``sigma``:
+    (C, S); ``samples``: (S,); ``offsets``: (C, S, S).
+    """
+    n_seg = means.shape[1]
+    for c in range(means.shape[0]):
+        for s in range(n_seg):
+            for t in range(s, n_seg):
+                var_delta = 0.0
+                if with_offsets:
+                    var_delta = _at_least((offsets[c, s, s] + offsets[c, t, t]) - 2.0 * offsets[c, s, t], 0.0)
+                fraction = (means[c, t] - means[c, s]) / step
+                damping = (sigma[c, s] * sigma[c, s] + sigma[c, t] * sigma[c, t] + var_delta) / step_squared
+                value = scale * _series_value(fraction, damping, max_terms)
+                out[c, s, t] = value
+                out[c, t, s] = value
+        for s in range(n_seg):
+            bias = _at_most(_at_least(out[c, s, s], 0.0), full)
+            out[c, s, s] = bias + (full - bias) / samples[s]

@@ -13,12 +13,11 @@ the quantiser and its unknown offset, so
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
-from plansim.kernels.quantiser import quantisation_series
+from plansim.kernels.quantiser import quantisation_covariances
 
 __all__ = ["quantisation_covariance", "quantisation_variance"]
 
@@ -75,14 +74,6 @@ def quantisation_variance(step: float, sigma: float, samples: int) -> tuple[floa
     return bias + (full - bias) / int(samples), fraction
 
 
-@functools.lru_cache(maxsize=16)
-def _upper_triangle(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``np.triu_indices(n)``, read-only, once per size (it costs more than the series it indexes)."""
-    rows, cols = np.triu_indices(n)
-    rows.flags.writeable = cols.flags.writeable = False
-    return rows, cols
-
-
 #: Most terms of the quantisation series summed term by term (beyond: the undamped closed form).
 _MAX_TERMS = 2000
 
@@ -132,24 +123,18 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
         raise ValueError(f"means, sigma, samples: shapes {means.shape}, {sigma.shape}, {samples.shape}; "
                          "expected one value per segment (and channel)")
     if offset_covariance is None:
-        var_delta = np.zeros(means.shape + (n_seg,))
+        g = np.zeros((1, 1, 1))
     else:
         g = np.asarray(offset_covariance, dtype=float)
         if g.shape != means.shape + (n_seg,):
             raise ValueError(f"offset_covariance: shape {g.shape}; expected {means.shape + (n_seg,)}")
-        d = np.diagonal(g, axis1=-2, axis2=-1)
-        var_delta = np.maximum(d[..., :, None] + d[..., None, :] - 2.0 * g, 0.0)
-    rows, cols = _upper_triangle(n_seg)  # the covariance is symmetric: each pair once
-    fraction = np.ascontiguousarray((means[..., cols] - means[..., rows]) / step)
-    damping = np.ascontiguousarray((sigma[..., rows] ** 2 + sigma[..., cols] ** 2 + var_delta[..., rows, cols])
-                                   / step**2)
-    series = np.empty(fraction.shape)  # Σ_k cos(2πkΔ/q) exp(−2π²k²(…)/q²)/k² (beyond _MAX_TERMS: its closed form)
-    quantisation_series(fraction.reshape(-1), damping.reshape(-1), _MAX_TERMS, series.reshape(-1))
+    # every pair s ≤ t and the diagonal's averaged part in one kernel call (the arithmetic of the numpy
+    # expressions it replaced, operation for operation)
     cov = np.empty(means.shape + (n_seg,))
-    cov[..., rows, cols] = step**2 / (2.0 * np.pi**2) * series
-    cov[..., cols, rows] = cov[..., rows, cols]
-    full = step**2 / 12.0
-    diagonal = np.arange(n_seg)
-    bias = np.minimum(np.maximum(cov[..., diagonal, diagonal], 0.0), full)
-    cov[..., diagonal, diagonal] = bias + (full - bias) / samples
+    channels = (1, n_seg) if means.ndim == 1 else means.shape
+    quantisation_covariances(np.ascontiguousarray(means.reshape(channels)),
+                             np.ascontiguousarray(sigma.reshape(channels)), samples,
+                             np.ascontiguousarray(g).reshape((-1,) + g.shape[-2:]), offset_covariance is not None,
+                             step, step**2, step**2 / (2.0 * np.pi**2), step**2 / 12.0, _MAX_TERMS,
+                             cov.reshape(channels + (n_seg,)))
     return cov
