@@ -157,6 +157,9 @@ def _matmul3(frames, a, b, out):
 
 #: *channel* of :func:`evaluate_outputs` for all six outputs (an int64, not a literal: one compiled copy)
 ALL_CHANNELS = np.int64(-1)
+#: *channel* of :func:`evaluate_outputs` for the three gyros' outputs, and for the three accelerometers'
+GYRO_OUTPUTS = np.int64(-2)
+ACCEL_OUTPUTS = np.int64(-3)
 
 # slabs of the (6, 3, 3) ``frames`` array of :func:`geometry_buffers`
 _FIXTURE, _TILT, _POSITION_ERROR, _NOMINAL, _PRODUCT, _ACTUAL = 0, 1, 2, 3, 4, 5
@@ -313,7 +316,9 @@ def evaluate_outputs(nodes, extra, cos_phase, sin_phase, rates, u, g_b0, om_b0, 
     by angle addition.
 
     *channel* :data:`ALL_CHANNELS` writes all six; a channel 0 … 5 writes ``out[j, channel]`` alone
-    (the same number, for a caller that knows the others have not changed: :func:`truth_channel`).
+    (the same number, for a caller that knows the others have not changed: :func:`truth_channel`);
+    :data:`GYRO_OUTPUTS` or :data:`ACCEL_OUTPUTS` the three of that kind alone (the same numbers; each
+    channel is computed on its own).
     ``scratch`` (3, 6) is work space (allocated once per trial by the caller). Pass *nodes*, *extra*
     and *channel* as int64 values, not int literals (one compiled copy; see :data:`STREAM_NOISE`).
     """
@@ -329,10 +334,16 @@ def evaluate_outputs(nodes, extra, cos_phase, sin_phase, rates, u, g_b0, om_b0, 
         if j >= nodes:
             ct, st = c0, s0
         rotated_inputs(ct, st, rates[j], u, g_b0, om_b0, w, fc)
-        if channel < 0:
+        if channel == ALL_CHANNELS:
             sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
             for c in range(6):
                 out[j, c] = y[c]
+        elif channel == GYRO_OUTPUTS:
+            for i in range(3):
+                out[j, i] = gyro_output(i, w, fc, dT, Kg, Bg, G, sensor, S2)
+        elif channel == ACCEL_OUTPUTS:
+            for i in range(3):
+                out[j, 3 + i] = accel_output(i, w, fc, perp, dT, Ka, Ba, P, sensor)
         elif channel < 3:
             out[j, channel] = gyro_output(channel, w, fc, dT, Kg, Bg, G, sensor, S2)
         else:

@@ -62,7 +62,9 @@ from plansim.kernels.layout import (
 )
 from plansim.kernels.options import inline_jit, jit
 from plansim.kernels.physics import (
+    ACCEL_OUTPUTS,
     ALL_CHANNELS,
+    GYRO_OUTPUTS,
     draw_systematic,
     evaluate_outputs,
     geometry_buffers,
@@ -379,8 +381,38 @@ def _restore_geometry(saved, s, u, g_b0, om_b0, perp, weights):
     return saved[s, 0]
 
 
+@inline_jit
+def _evaluated(code, c):
+    """Whether :func:`plansim.kernels.physics.evaluate_outputs` with *channel* = *code* writes channel *c*."""
+    if code == ALL_CHANNELS:
+        return True
+    if code == GYRO_OUTPUTS:
+        return c < 3
+    if code == ACCEL_OUTPUTS:
+        return c >= 3
+    return c == code
+
+
+@inline_jit
+def _outputs_needed(channel, needed, s):
+    """The *channel* argument of :func:`plansim.kernels.physics.evaluate_outputs` for the outputs of segment *s*
+    that a component moving *channel* (:data:`ALL_CHANNELS` or one channel) changes and ``needed[s]`` asks for;
+    −9 if none."""
+    if channel >= 0:
+        return channel if needed[s, channel] != 0 else -9
+    gyros = needed[s, 0] != 0 or needed[s, 1] != 0 or needed[s, 2] != 0
+    accels = needed[s, 3] != 0 or needed[s, 4] != 0 or needed[s, 5] != 0
+    if gyros and accels:
+        return ALL_CHANNELS
+    if gyros:
+        return GYRO_OUTPUTS
+    if accels:
+        return ACCEL_OUTPUTS
+    return -9
+
+
 @jit
-def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
+def noise_free_mean_derivatives(base, phases, indices, steps, needed, seg_n, seg_dt, seg_C0, seg_rate, seg_axis,
                                 seg_axis_index, seg_temp, sensor, S2, lever, t_ref, gravity, earth_enu,
                                 phase_means_out, first_out, second_out):
     """Central differences of the noise-free segment means in components of the draws vector, over start angles.
@@ -402,6 +434,11 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
     are exact zeros (m̄₊ = m̄₋ = m̄). At rest a segment is evaluated at one angle (it does not depend
     on it); rotating, its orientation and arc weights once for all angles. *indices* must not be
     start angles (``SEG_PHASE``): those are set from *phases*.
+
+    ``needed`` (S, 6) is nonzero where the caller uses the derivatives of segment s's channel c (where the
+    reduction reads that mean); elsewhere they are left exact zeros and, if no channel of that kind (gyros,
+    accelerometers) of the segment is needed, not evaluated. Those needed are the same numbers whatever
+    ``needed`` is (each channel's output is computed on its own). ``phase_means_out`` is always complete.
     """
     n_seg = seg_n.shape[0]
     n_phases = phases.shape[0]
@@ -440,6 +477,9 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                         second_out[k, s, c] = 0.0
                 if k >= 0 and not _segment_reads(index, s, seg_rate, seg_axis_index):
                     continue
+                code = channel if k < 0 else _outputs_needed(channel, needed, s)  # the outputs to evaluate
+                if code == -9:
+                    continue
                 # the segment's mean at every start angle (its orientation and arc weights do not depend on it;
                 # a truth component leaves them as they are at base, so they are kept from there)
                 if channel >= 0:
@@ -453,7 +493,7 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                         _save_geometry(rate_act, u, g_b0, om_b0, perp, weights, saved, s)
                 dT = seg_temp[s] - t_ref
                 if seg_rate[s] == 0.0:  # at rest: one evaluation, whatever the angle
-                    segment_node_outputs(seg_rate[s], rate_act, 1.0, 0.0, dT, _NO_EXTRA, channel, u, g_b0, om_b0, perp,
+                    segment_node_outputs(seg_rate[s], rate_act, 1.0, 0.0, dT, _NO_EXTRA, code, u, g_b0, om_b0, perp,
                                          Kg, Bg, G, Ka, Ba, P, sensor, S2, rates, outputs, scratch)
                     for j in range(n_phases):
                         for c in range(6):
@@ -461,17 +501,17 @@ def noise_free_mean_derivatives(base, phases, indices, steps, seg_n, seg_dt, seg
                 else:
                     for j in range(n_phases):
                         segment_node_outputs(seg_rate[s], rate_act, cos_phases[j], sin_phases[j], dT, _NO_EXTRA,
-                                             channel, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates,
+                                             code, u, g_b0, om_b0, perp, Kg, Bg, G, Ka, Ba, P, sensor, S2, rates,
                                              outputs, scratch)
                         for c in range(6):
-                            if channel < 0 or c == channel:
+                            if _evaluated(code, c):
                                 phase_means[j, c] = node_mean(nodes, _FIRST, c, weights)
                 if k < 0:
                     for j in range(n_phases):
                         for c in range(6):
                             phase_means_out[j, s, c] = phase_means[j, c]
                 for c in range(6):
-                    if channel >= 0 and c != channel:
+                    if not _evaluated(code, c) or (k >= 0 and needed[s, c] == 0):
                         continue  # a truth component moves one channel: the others' differences are zero
                     # the average over the angles, summed in their order (numpy's mean over a leading axis)
                     total = phase_means[0, c]

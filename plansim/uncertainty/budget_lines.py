@@ -84,6 +84,15 @@ def _through_reduction(matrix: np.ndarray, d_means: np.ndarray, exact_zeros: boo
     return matrix.reshape(N_PARAMETERS, -1) @ d_means.reshape(len(d_means), matrix[0].size).T
 
 
+def _gram(d_means: np.ndarray) -> np.ndarray:
+    """(6, S, S): ``Dᵀ·D`` per channel of the means' changes *d_means* (K, S, 6), ``D = d_means[:, :, c]``.
+
+    One stacked product of the channels' contiguous copies: each channel's the same BLAS product, so the
+    same numbers, as the six 2-D products ``d_means[:, :, c].T @ d_means[:, :, c]``.
+    """
+    return np.ascontiguousarray(d_means.transpose(2, 1, 0)) @ np.ascontiguousarray(d_means.transpose(2, 0, 1))
+
+
 def _largest_second_order(matrix: np.ndarray, second: np.ndarray, u: np.ndarray) -> np.ndarray:
     """(39,): the largest ``½|∂²E/∂x_k²|·u_k²`` over the components k (*second*: (K, S, 6) ``∂²m̄/∂x_k²``)."""
     return np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second)) * u[None, :] ** 2, axis=1)
@@ -127,7 +136,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     dts = np.array([1.0 / s.sample_rate for s in segments])
     arguments = kernel_arguments(scenario)
     noise = arguments["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
-    offsets = [np.zeros((n_seg, n_seg)) for _ in range(N_CHANNELS)]  # per channel: covariance of the means' offsets
+    offsets = np.zeros((N_CHANNELS, n_seg, n_seg))  # per channel: covariance of the means' offsets
     with_offsets = bool(scenario.acquisition.bits) and quantisation_correlation  # what they are for
 
     # every finite difference at once (table and fixture errors, then the unit's spread): one kernel call
@@ -136,7 +145,11 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     idx = np.flatnonzero(spread > 0)
     indices = np.concatenate([np.array(g[2], dtype=np.int64) for g in groups] + [idx])
     steps = np.concatenate([np.full(len(g[2]), g[1].standard_uncertainty) for g in groups] + [spread[idx]])
-    nominal, first_all, second_all = segment_mean_derivatives(scenario, indices, steps, arguments)  # (J, S, 6), …
+    # only where the reduction reads a mean (the matrix is not zero): the derivatives elsewhere only ever meet
+    # the matrix's zeros (the columns, the start-angle line) or pairs of quantisation errors no estimate reads
+    needed = np.any(matrix != 0.0, axis=0)
+    nominal, first_all, second_all = segment_mean_derivatives(scenario, indices, steps, arguments,
+                                                              needed)  # (J, S, 6), (K, S, 6), (K, S, 6)
     n_table = len(indices) - idx.size
     d_means_all = first_all * steps[:, None, None]  # (K, S, 6): what a step u of each component does to the means
     columns_all = None if describe else _through_reduction(matrix, d_means_all, exact_zeros=False)
@@ -149,8 +162,8 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         d_means = d_means_all[start:stop]
         # the means' offsets (for the quantiser: its damping is their variance's small difference
         # Var(Δ) = g_ss + g_tt − 2g_st, so summed group by group, in this order)
-        for c in range(N_CHANNELS if with_offsets else 0):
-            offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
+        if with_offsets:
+            offsets += _gram(d_means)
         lines.append(Line(
             name=name, category="table", evaluation="B", distribution=_distribution_text(error, unit),
             u=u, input_unit=unit,
@@ -186,8 +199,8 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     # the unit under calibration: dependence of the error on the true parameters
     if idx.size:
         d_means = d_means_all[n_table:]
-        for c in range(N_CHANNELS if with_offsets else 0):
-            offsets[c] += d_means[:, :, c].T @ d_means[:, :, c]
+        if with_offsets:
+            offsets += _gram(d_means)
         columns = _through_reduction(matrix, d_means, True) if describe else columns_all[:, n_table:].copy()
         columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
         lines.append(Line(
@@ -212,8 +225,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
 
     # drift: exact covariance of the segment means
     drift = drift_covariance(scenario, arguments)
-    for c in range(N_CHANNELS):
-        offsets[c] += drift[c]
+    offsets += drift
     for label, channels in (("drift, gyros", _GYROS), ("drift, accelerometers", _ACCELS)):
         cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
         for c in channels:
@@ -249,7 +261,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
             sigmas = np.array([np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2) for c in channels])
             if quantisation_correlation:  # the three channels of the kind at once
                 q_covs = quantisation_covariance(step, nominal[:, channels].T, sigmas, samples,
-                                                 np.array([offsets[c] for c in channels]))
+                                                 offsets[channels.start:channels.stop])
             else:
                 q_covs = [np.diag([quantisation_variance(step, float(sigma[s]), int(samples[s]))[0]
                                    for s in range(n_seg)]) for sigma in sigmas]

@@ -168,7 +168,8 @@ def table_groups(scenario: Scenario) -> list[tuple[str, ErrorDistribution, list[
 
 
 def segment_mean_derivatives(scenario: Scenario, indices: np.ndarray, steps: np.ndarray,
-                             arguments: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                             arguments: dict | None = None, needed: np.ndarray | None = None
+                             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The noise-free segment means at the nominal draws, and their first and second derivatives.
 
     Central differences with step ``steps[k]`` around the nominal draws (JCGM 100 5.1.3 note 2),
@@ -187,6 +188,10 @@ def segment_mean_derivatives(scenario: Scenario, indices: np.ndarray, steps: np.
         Step of each component (its standard uncertainty).
     arguments : dict, optional
         :func:`plansim.simulate.arguments.kernel_arguments` of *scenario*, if the caller has them.
+    needed : (S, 6) array of bool, optional
+        Where the caller uses the derivatives (e.g. where the estimator matrix is not zero): elsewhere
+        they are left zero, and a segment none of whose gyros (accelerometers) is needed does not
+        evaluate them. Default: everywhere. The derivatives needed are the same numbers either way.
 
     Returns
     -------
@@ -211,11 +216,15 @@ def segment_mean_derivatives(scenario: Scenario, indices: np.ndarray, steps: np.
             (indices >= HEAD) & ((indices - HEAD) % PER_SEGMENT == SEG_PHASE)):
         raise ValueError(f"indices = {indices.tolist()}: expected components of the draws vector (0 … {size - 1}) "
                          "other than the start angles")
+    needed = (np.ones((n_seg, N_CHANNELS), dtype=np.int64) if needed is None
+              else np.ascontiguousarray(needed, dtype=np.int64))
+    if needed.shape != (n_seg, N_CHANNELS):
+        raise ValueError(f"needed: shape {needed.shape}; expected ({n_seg}, {N_CHANNELS})")
     n_in = len(indices)
     nominal = np.empty((PHASE_NODES, n_seg, N_CHANNELS))
     first = np.empty((n_in, n_seg, N_CHANNELS))
     second = np.empty((n_in, n_seg, N_CHANNELS))
-    noise_free_mean_derivatives(nominal_draws(scenario), phase_angles(), indices, steps,
+    noise_free_mean_derivatives(nominal_draws(scenario), phase_angles(), indices, steps, needed,
                                 **noise_free_arguments(scenario, arguments), phase_means_out=nominal,
                                 first_out=first, second_out=second)
     return nominal, first, second
