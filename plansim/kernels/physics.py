@@ -329,11 +329,29 @@ def evaluate_outputs(nodes, extra, cos_phase, sin_phase, rates, u, g_b0, om_b0, 
     s0 = sin_phase
     cd = math.cos(2.0 * math.pi / nodes)
     sd = math.sin(2.0 * math.pi / nodes)
+    # what rotated_inputs computes of u, g_b0 and Ω_b0 alone, once for every angle (the same expressions)
+    u0, u1, u2 = u[0], u[1], u[2]
+    g0, g1, g2 = g_b0[0], g_b0[1], g_b0[2]
+    o0, o1, o2 = om_b0[0], om_b0[1], om_b0[2]
+    ug = u0 * g0 + u1 * g1 + u2 * g2
+    uo = u0 * o0 + u1 * o1 + u2 * o2
+    xg0, xg1, xg2 = u1 * g2 - u2 * g1, u2 * g0 - u0 * g2, u0 * g1 - u1 * g0
+    xo0, xo1, xo2 = u1 * o2 - u2 * o1, u2 * o0 - u0 * o2, u0 * o1 - u1 * o0
+    yg0, yg1, yg2 = u0 * ug, u1 * ug, u2 * ug
+    yo0, yo1, yo2 = u0 * uo, u1 * uo, u2 * uo
     ct, st = c0, s0
     for j in range(nodes + extra):
         if j >= nodes:
             ct, st = c0, s0
-        rotated_inputs(ct, st, rates[j], u, g_b0, om_b0, w, fc)
+        # rotated_inputs(ct, st, rates[j], u, g_b0, om_b0, w, fc), its invariant parts taken from above
+        rate = rates[j]
+        versine = 1.0 - ct
+        fc[0] = g0 * ct - xg0 * st + yg0 * versine
+        fc[1] = g1 * ct - xg1 * st + yg1 * versine
+        fc[2] = g2 * ct - xg2 * st + yg2 * versine
+        w[0] = rate * u0 + o0 * ct - xo0 * st + yo0 * versine
+        w[1] = rate * u1 + o1 * ct - xo1 * st + yo1 * versine
+        w[2] = rate * u2 + o2 * ct - xo2 * st + yo2 * versine
         if channel == ALL_CHANNELS:
             sensor_outputs(w, fc, perp, dT, Kg, Bg, G, Ka, Ba, P, sensor, S2, y)
             for c in range(6):

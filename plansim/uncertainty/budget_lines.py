@@ -131,10 +131,10 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     lines: list[Line] = []
     segments = scenario.schedule.segments
     n_seg = len(segments)
-    samples = np.array([s.samples for s in segments], dtype=float)
-    durations = np.array([s.samples / s.sample_rate for s in segments])
-    dts = np.array([1.0 / s.sample_rate for s in segments])
     arguments = kernel_arguments(scenario)
+    samples = arguments["seg_n"].astype(float)
+    durations = samples / np.array([s.sample_rate for s in segments])  # s.samples / s.sample_rate
+    dts = arguments["seg_dt"]  # 1 / s.sample_rate
     noise = arguments["noise"]  # (6, 4), columns plansim.kernels.layout.NOISE_COLUMNS
     offsets = np.zeros((N_CHANNELS, n_seg, n_seg))  # per channel: covariance of the means' offsets
     with_offsets = bool(scenario.acquisition.bits) and quantisation_correlation  # what they are for
@@ -185,8 +185,8 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         # the variance over the angle of each rotating segment's mean, per channel (the angle last: the
         # same pairwise sum as the mean of each segment and channel alone)
         squares = np.mean(np.ascontiguousarray(np.moveaxis(deviation[:, rotating, :] ** 2, 0, -1)), axis=-1)
-        for c in range(N_CHANNELS):
-            offsets[c][rotating, rotating] += squares[:, c]
+        diagonal = np.array(rotating)
+        offsets[:, diagonal, diagonal] += squares.T
         if np.any(np.diag(cov) > 0):
             lines.append(Line(
                 name="table start angle", category="table", evaluation="B",
@@ -243,7 +243,9 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     smoothness = scenario.turntable.rate_smoothness
     jitter = np.zeros((n_seg, N_CHANNELS))
     if smoothness > 0 and rotating:
-        derivative = rate_derivatives(scenario, arguments)
+        # (without describe, only where the reduction reads a mean: elsewhere the jitter only reaches the
+        # quantisation errors of means no estimate reads, and the lines' u, which describe alone shows)
+        derivative = rate_derivatives(scenario, arguments, None if describe else needed)
         jitter = smoothness * derivative
         u = np.array([smoothness / math.sqrt(samples[s]) for s in rotating])
         columns = np.einsum("psc,sc->ps", matrix[:, rotating, :], derivative[rotating]) * u

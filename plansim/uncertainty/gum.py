@@ -102,7 +102,7 @@ from plansim.uncertainty.budget import (
 from plansim.uncertainty.budget_lines import Line, model_lines
 from plansim.uncertainty.metrology.propagation import (
     DEFAULT_COVERAGE_PROBABILITY,
-    coverage_factor,
+    check_coverage_probability,
     coverage_factors,
     welch_satterthwaite,
 )
@@ -134,7 +134,7 @@ def _propagate(scenario: Scenario, coverage_probability: float, quantisation_cor
     (GUM 5.2.2) and the expected segment means (:func:`~plansim.uncertainty.budget_lines.model_lines`)."""
     if not isinstance(scenario, Scenario):
         raise TypeError(f"scenario = {scenario!r}: expected a plansim.config.Scenario")
-    coverage_factor(math.inf, coverage_probability)  # validates p
+    check_coverage_probability(coverage_probability)
     matrix = estimator_matrix(scenario)
     if not isinstance(quantisation_correlation, bool):
         raise TypeError(f"quantisation_correlation = {quantisation_correlation!r}: expected True or False")

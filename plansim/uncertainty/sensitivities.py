@@ -250,14 +250,16 @@ def finite_differences(scenario: Scenario, indices: np.ndarray, steps: np.ndarra
     return first, second
 
 
-def rate_derivatives(scenario: Scenario, arguments: dict | None = None) -> np.ndarray:
+def rate_derivatives(scenario: Scenario, arguments: dict | None = None, needed: np.ndarray | None = None
+                     ) -> np.ndarray:
     """(S, 6): ``rate · ∂(segment mean)/∂(rate)`` of each rotating segment, averaged over the start angle.
 
     The response of the outputs to the per-sample rate jitter of the table: the gyro input ω·u
     (and with it P·ω²) follows the rate, the centripetal term of the lever arm does not (the
     simulator jitters the gyro input only), so the derivative is taken with the lever arm removed,
     by central differences of the noise-free means in the relative rate error of each point.
-    *arguments*: :func:`plansim.simulate.arguments.kernel_arguments` of *scenario*, if the caller has them.
+    *arguments*: :func:`plansim.simulate.arguments.kernel_arguments` of *scenario*, if the caller has them;
+    *needed*: as for :func:`segment_mean_derivatives` (zero elsewhere).
     """
     without_lever = dict(kernel_arguments(scenario) if arguments is None else arguments, lever=np.zeros((3, 3)))
     segments = scenario.schedule.segments
@@ -266,7 +268,7 @@ def rate_derivatives(scenario: Scenario, arguments: dict | None = None) -> np.nd
     if not rotating:
         return out
     indices = np.array([segment_base(s) + SEG_RATE_ERROR for s in rotating], dtype=np.int64)
-    _, first, _ = segment_mean_derivatives(scenario, indices, np.full(len(rotating), RATE_STEP), without_lever)
+    _, first, _ = segment_mean_derivatives(scenario, indices, np.full(len(rotating), RATE_STEP), without_lever, needed)
     for k, s in enumerate(rotating):
         out[s] = first[k, s]
     return out

@@ -14,8 +14,8 @@ import math
 import numpy as np
 from scipy import special  # the quantiles themselves: scipy.stats takes 1.4 s to import
 
-__all__ = ["DEFAULT_COVERAGE_PROBABILITY", "check_dof", "combine", "coverage_factor", "coverage_factors",
-           "welch_satterthwaite"]
+__all__ = ["DEFAULT_COVERAGE_PROBABILITY", "check_coverage_probability", "check_dof", "combine", "coverage_factor",
+           "coverage_factors", "welch_satterthwaite"]
 
 #: Coverage probability of an expanded uncertainty (JCGM 100 6.2.2; the 95 % of a k = 2 statement, 6.3.3).
 DEFAULT_COVERAGE_PROBABILITY = 0.95
@@ -111,10 +111,15 @@ def coverage_factor(dof: float, coverage_probability: float = DEFAULT_COVERAGE_P
     return float(coverage_factors([dof], coverage_probability)[0])
 
 
-def coverage_factors(dofs, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY) -> np.ndarray:
-    """:func:`coverage_factor` of every ``ν_eff`` of *dofs* (array_like), in one call of each quantile function."""
+def check_coverage_probability(coverage_probability) -> None:
+    """Raise ``ValueError`` unless *coverage_probability* is a number strictly between 0 and 1."""
     if not (isinstance(coverage_probability, (int, float)) and 0.0 < coverage_probability < 1.0):
         raise ValueError(f"coverage_probability = {coverage_probability!r}: must lie strictly between 0 and 1")
+
+
+def coverage_factors(dofs, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY) -> np.ndarray:
+    """:func:`coverage_factor` of every ``ν_eff`` of *dofs* (array_like), in one call of each quantile function."""
+    check_coverage_probability(coverage_probability)
     dofs = check_dof(dofs)
     q = 0.5 * (1.0 + coverage_probability)
     out = np.full(dofs.shape, float(special.ndtri(q)))  # ν = ∞: the normal quantile
