@@ -62,8 +62,8 @@ def schedule_arrays(schedule: Schedule) -> dict[str, np.ndarray]:
 def _schedule_arrays(segs: tuple[Segment, ...]) -> dict[str, np.ndarray]:
     """:func:`schedule_arrays` of the segments *segs* (a planner asks for the same schedule many times over)."""
     poses = {(s.up, s.heading): None for s in segs}  # a schedule repeats few poses and axes
-    poses = {pose: body_to_level(*pose) for pose in poses}
-    axes = {s.rate_axis: axis_vector(s.rate_axis) for s in segs}
+    poses = {pose: _body_to_level(*pose) for pose in poses}
+    axes = {s.rate_axis: _axis_vector(s.rate_axis) for s in segs}
     return dict(
         seg_n=np.array([s.samples for s in segs], dtype=np.int64),
         seg_dt=np.array([1.0 / s.sample_rate for s in segs]),
@@ -74,6 +74,22 @@ def _schedule_arrays(segs: tuple[Segment, ...]) -> dict[str, np.ndarray]:
         seg_axis_index=np.array(["xyz".index(s.rate_axis[1]) for s in segs], dtype=np.int64),
         seg_temp=np.array([s.temperature for s in segs]),
     )
+
+
+@functools.lru_cache(maxsize=256)
+def _body_to_level(up: str, heading: float) -> np.ndarray:
+    """:func:`plansim.schedule.segments.body_to_level` once per pose (read-only): schedules repeat a few poses."""
+    matrix = body_to_level(up, heading)
+    matrix.flags.writeable = False
+    return matrix
+
+
+@functools.lru_cache(maxsize=64)
+def _axis_vector(name: str) -> np.ndarray:
+    """:func:`plansim.schedule.segments.axis_vector` once per axis (read-only)."""
+    vector = axis_vector(name)
+    vector.flags.writeable = False
+    return vector
 
 
 def kernel_arguments(scenario: Scenario) -> dict[str, object]:
@@ -137,9 +153,11 @@ def _drift_coefficient_table(segs: tuple[Segment, ...], bias_instability_time: f
                              update_interval: float) -> np.ndarray:
     """:func:`drift_coefficient_table` once per distinct schedule and noise times (read-only)."""
     out = np.zeros((len(segs), 3, 5))
-    for k, s in enumerate(segs):
+    recorded = [(s.samples, s.sample_rate) for s in segs]
+    for samples, rate in set(recorded):  # a schedule records few distinct (samples, rate) pairs
+        at = [k for k, pair in enumerate(recorded) if pair == (samples, rate)]
         for p, tau in enumerate((bias_instability_time, markov_time, None)):
-            out[k, p] = _drift_coefficients(s.samples, 1.0 / s.sample_rate, update_interval, tau)
+            out[at, p] = _drift_coefficients(samples, 1.0 / rate, update_interval, tau)
     out.flags.writeable = False
     return out
 
