@@ -247,8 +247,8 @@ def _at_most(x, high):
 
 
 @jit
-def quantisation_covariances(means, sigma, samples, offsets, with_offsets, step, step_squared, scale, full, max_terms,
-                             out):
+def quantisation_covariances(means, sigma, samples, offsets, with_offsets, needed, step, step_squared, scale, full,
+                             max_terms, out):
     """``out[c]`` (S, S): the covariance of the quantisation errors of the segment means of channel *c*.
 
     The arithmetic of :func:`plansim.uncertainty.quantisation.quantisation_covariance`, operation for
@@ -256,13 +256,18 @@ def quantisation_covariances(means, sigma, samples, offsets, with_offsets, step,
     (0 unless *with_offsets*), the series (:func:`quantisation_series`) at ``(m_t − m_s)/q`` and
     ``(σ_s² + σ_t² + Var Δ)/q²`` times *scale* (``q²/2π²``); then the diagonal's averaged part,
     ``B + (full − B)/n_s`` with ``B = min(max(c_ss, 0), full)``. *step_squared*, *scale* and *full*
-    are computed by the caller (``q**2``, ``q**2 / (2π**2)``, ``q**2 / 12``). ``means``, ``sigma``:
-    (C, S); ``samples``: (S,); ``offsets``: (C, S, S).
+    are computed by the caller (``q**2``, ``q**2 / (2π**2)``, ``q**2 / 12``). ``means``, ``sigma``, ``needed``:
+    (C, S); ``samples``: (S,); ``offsets``: (C, S, S). A pair s ≠ t of which one segment is not ``needed``
+    is left 0.
     """
     n_seg = means.shape[1]
     for c in range(means.shape[0]):
         for s in range(n_seg):
             for t in range(s, n_seg):
+                if t != s and (needed[c, s] == 0 or needed[c, t] == 0):
+                    out[c, s, t] = 0.0
+                    out[c, t, s] = 0.0
+                    continue
                 var_delta = 0.0
                 if with_offsets:
                     var_delta = _at_least((offsets[c, s, s] + offsets[c, t, t]) - 2.0 * offsets[c, s, t], 0.0)

@@ -262,8 +262,9 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
             cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
             sigmas = np.array([np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2) for c in channels])
             if quantisation_correlation:  # the three channels of the kind at once
+                # the pairs no estimate reads (a segment the matrix does not read) only meet its zeros
                 q_covs = quantisation_covariance(step, nominal[:, channels].T, sigmas, samples,
-                                                 offsets[channels.start:channels.stop])
+                                                 offsets[channels.start:channels.stop], needed[:, channels].T)
             else:
                 q_covs = [np.diag([quantisation_variance(step, float(sigma[s]), int(samples[s]))[0]
                                    for s in range(n_seg)]) for sigma in sigmas]

@@ -175,14 +175,15 @@ def _effective_dof(lines: list[Line], variances: list[np.ndarray], uc: np.ndarra
     """
     denominator = np.zeros(N_PARAMETERS)
     for line, variance in zip(lines, variances):
-        contribution = np.sqrt(variance)
         if line.columns is not None and line.dof is not None:
+            contribution = np.sqrt(variance)
             finite = np.isfinite(line.dof)
             terms = np.sum(np.abs(line.columns[:, finite]) ** 4 / line.dof[finite], axis=1)
         elif math.isfinite(line.line_dof):
+            contribution = np.sqrt(variance)
             terms = contribution**4 / line.line_dof
         else:
-            continue
+            continue  # ν = ∞: no term
         counts = (contribution > NEGLIGIBLE * uc) & (contribution != 0.0)  # below: the differences' numerical noise
         denominator += np.where(counts, terms, 0.0)
     finite = (denominator > 0) & (uc > 0)

@@ -79,7 +79,8 @@ _MAX_TERMS = 2000
 
 
 def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, samples: np.ndarray,
-                            offset_covariance: np.ndarray | None = None) -> np.ndarray:
+                            offset_covariance: np.ndarray | None = None, needed: np.ndarray | None = None
+                            ) -> np.ndarray:
     """Covariance (S, S) of the quantisation errors of the segment means of one channel (or of several).
 
     Appendix A's rectangular model per reading, with the correlation GUM 5.2 requires between
@@ -108,6 +109,9 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
         Samples per segment.
     offset_covariance : (S, S) or (C, S, S) array, optional
         Covariance of the segment means' deviations from nominal other than white noise.
+    needed : (S,) or (C, S) array of bool, optional
+        The segments whose covariances the caller uses (e.g. where the estimator matrix is not zero):
+        a pair with another segment is left 0 (the diagonal is always given). Default: all.
 
     Returns
     -------
@@ -130,11 +134,16 @@ def quantisation_covariance(step: float, means: np.ndarray, sigma: np.ndarray, s
             raise ValueError(f"offset_covariance: shape {g.shape}; expected {means.shape + (n_seg,)}")
     # every pair s ≤ t and the diagonal's averaged part in one kernel call (the arithmetic of the numpy
     # expressions it replaced, operation for operation)
+    needed = (np.ones(means.shape, dtype=np.int64) if needed is None
+              else np.asarray(needed, dtype=np.int64))
+    if needed.shape != means.shape:
+        raise ValueError(f"needed: shape {needed.shape}; expected {means.shape}")
     cov = np.empty(means.shape + (n_seg,))
     channels = (1, n_seg) if means.ndim == 1 else means.shape
     quantisation_covariances(np.ascontiguousarray(means.reshape(channels)),
                              np.ascontiguousarray(sigma.reshape(channels)), samples,
                              np.ascontiguousarray(g).reshape((-1,) + g.shape[-2:]), offset_covariance is not None,
+                             np.ascontiguousarray(needed.reshape(channels)),
                              step, step**2, step**2 / (2.0 * np.pi**2), step**2 / 12.0, _MAX_TERMS,
                              cov.reshape(channels + (n_seg,)))
     return cov
