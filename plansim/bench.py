@@ -18,7 +18,8 @@ Figures (all per second of wall time, thread count reported):
 - ``predict_seconds`` — one :func:`plansim.planning.predict.predict` of the default scenario (the GUM of
   its schedule), the planner's inner step, asked again (what depends on the schedule alone is kept
   from the first call); ``predict_new_schedule_seconds`` — the same for a schedule not predicted
-  before (a dwell of its own each round), which builds that too;
+  before (a dwell of its own each round), which builds what depends on its segments (the kernels'
+  schedule arrays, the drift coefficients) but shares the estimator matrix, which a dwell does not change;
 - ``sweep_seconds`` — :func:`plansim.planning.sweep.sweep` of the default scenario over 100 cells (25 dwell
   times × 6/12 positions × 2 ω² rates) at 10⁴ trials per cell on the thread executor, one round (the
   planner issue's target: ≤ 60 s on a 2-core machine).
@@ -161,9 +162,11 @@ def predict_seconds() -> float:
 def predict_new_schedule_seconds(rounds: int = ROUNDS) -> float:
     """Best-of-rounds time of one prediction of a schedule not predicted before, s.
 
-    Each round predicts the default with a dwell of its own (61 s, 62 s, …), so the estimator
-    matrix and the other schedule-only inputs are built within the timed call
-    (:func:`plansim.uncertainty.sensitivities.estimator_matrix`).
+    Each round predicts the default with a dwell of its own (61 s, 62 s, …), so what depends on the
+    segments (the kernels' schedule arrays, the drift coefficients) is built within the timed call. The
+    estimator matrix is not: it depends on the segments' tests, groups, up-axes and rates alone
+    (:func:`plansim.estimate.reduction_key`), which a dwell does not change, and is shared
+    (:func:`plansim.uncertainty.sensitivities.estimator_matrix`; a new one costs about 1 ms).
     """
     from plansim.io.scenario_file import load_scenario
     from plansim.planning.predict import predict
