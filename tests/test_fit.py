@@ -33,6 +33,7 @@ from plansim.fit.noise import (
     quantisation_error_given_levels,
     quantisation_error_variance,
     quantisation_step,
+    quantised_noise_posterior,
     quantised_noise_sigma,
 )
 from plansim.fit.result import JSON_KEYS, fit_json
@@ -448,6 +449,70 @@ def test_the_noise_before_the_quantiser_by_maximum_likelihood(ratio):
     if ratio == 0.25:
         sheppard = [math.sqrt(max(np.var(x, ddof=1) - q**2 / 12, 0.0)) for x in segments]
         assert max(sheppard) - min(sheppard) > 0.5 * ratio * q
+
+
+@pytest.mark.parametrize("ratio", [0.25, 1.0])
+def test_the_noise_posterior_concentrates_where_the_counts_fix_sigma(ratio):
+    """Where many segments toggle (σ ≥ q/4), the posterior of σ (levels integrated out, log-uniform prior) is
+    narrow about the true σ: its mean within 10 % (the grid's spacing is 6 %), and it agrees with the maximum
+    likelihood value."""
+    rng = np.random.default_rng(11)
+    q = 0.0383
+    levels = rng.uniform(-5 * q, 5 * q, 12)
+    segments = [q * np.round((level + ratio * q * rng.normal(size=3000)) / q) for level in levels]
+    sigma, weights = quantised_noise_posterior(q, segments)
+    assert weights.sum() == pytest.approx(1.0)
+    assert np.sum(weights * sigma) == pytest.approx(ratio * q, rel=0.10)
+    assert np.sum(weights * sigma) == pytest.approx(quantised_noise_sigma(q, segments), rel=0.10)
+
+
+def test_a_stated_noise_is_the_prior_where_the_counts_say_little():
+    """Four segments that never leave their level say only that σ is below about q/8 (3000 samples each): the
+    posterior stays within the grid's low end and the data's bound, and within that a stated σ (a data sheet's
+    noise density times √f_s, log-normal with STATED_NOISE_LOG_SD = ln 2) moves it: the larger the stated σ, the
+    larger the posterior's centre. Where many segments toggle the counts outweigh the prior (σ = q/4: within 10 %
+    of the truth with a stated σ half of it)."""
+    q = 0.0383
+    still = [np.full(3000, k * q) for k in range(4)]
+    centres = []
+    for stated in (0.02 * q, None, 0.05 * q, 0.1 * q):
+        sigma, weights = quantised_noise_posterior(q, still, stated_sigma=stated)
+        assert weights.sum() == pytest.approx(1.0)
+        assert sigma.min() >= 0.02 * q * (1 - 1e-12) and sigma.max() < 0.15 * q
+        centres.append(math.exp(np.sum(weights * np.log(sigma))))
+    assert centres[0] < centres[1] < centres[2] < centres[3]
+    rng = np.random.default_rng(11)
+    levels = rng.uniform(-5 * q, 5 * q, 12)
+    segments = [q * np.round((level + 0.25 * q * rng.normal(size=3000)) / q) for level in levels]
+    sigma, weights = quantised_noise_posterior(q, segments, stated_sigma=0.125 * q)
+    assert np.sum(weights * sigma) == pytest.approx(0.25 * q, rel=0.10)
+
+
+def test_the_error_given_the_levels_is_calibrated_with_sigma_from_the_same_data():
+    """The σ before the quantiser is not known: 10 channels of 24 static segments (3000 samples, levels uniform,
+    σ = 0.052q: the 12-bit accelerometers of the default scenario, which few segments toggle). With σ from the
+    segments' own counts, averaged over its posterior, the mean stated conditional error matches the mean actual
+    (x̄ − μ)² within ±20 % (240 segments: the ratio's relative sd is about 5 %, a 4σ band). The maximum-likelihood
+    σ plugged in instead is biased high here (mean over the channels above the true σ), so it states smaller errors
+    than the posterior does."""
+    rng = np.random.default_rng(1)
+    q, ratio = 1.0, 0.052
+    actual, posterior, plugged, sigmas = [], [], [], []
+    for _ in range(10):
+        mus = rng.uniform(-3.0, 3.0, 24)
+        segments = [q * np.round((mu + ratio * q * rng.standard_normal(3000)) / q) for mu in mus]
+        point = quantised_noise_sigma(q, segments)
+        sigma, weights = quantised_noise_posterior(q, segments)
+        sigmas.append(point)
+        for mu, x in zip(mus, segments):
+            actual.append((x.mean() - mu) ** 2)
+            posterior.append(quantisation_error_given_levels(q, x, sigma, weights))
+            plugged.append(quantisation_error_given_levels(q, x, point))
+    assert 0.8 < np.mean(actual) / np.mean(posterior) < 1.25
+    assert np.mean(sigmas) > ratio * q
+    assert np.mean(plugged) < np.mean(posterior)
+    with pytest.raises(ValueError, match="weights"):
+        quantisation_error_given_levels(q, segments[0], [0.1, 0.2], [1.0])
 
 
 @pytest.mark.parametrize("ratio", [0.02, 0.05, 0.15])
