@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 
 from plansim.cli.common import COMMANDS
@@ -89,9 +90,10 @@ def _cmd_fit(args) -> int:
 
 def recording_and_fit_options(args):
     """The recording, the site and the fit's options from a command's RECORDING, --latitude/--height and
-    --scenario (its turntable grade, reduction and known lever arms), as ``plansim fit`` and ``plansim diagnose``
-    take them."""
+    --scenario (its turntable grade, reduction, known lever arms and stated noise), as ``plansim fit`` and
+    ``plansim diagnose`` take them."""
     from plansim.fit import resolve_site
+    from plansim.fit.noise import stated_white_noise
     from plansim.io.recording import read_recording
     from plansim.io.scenario_file import load_scenario
 
@@ -105,6 +107,9 @@ def recording_and_fit_options(args):
                        omega_squared_sign=scenario.reduction.omega_squared_sign)
         if scenario.effects.accel_lever_arm.any():  # the fixture's known lever arms: a model input, not absorbed by P
             options["lever_arm"] = scenario.effects.accel_lever_arm
+        stated = stated_white_noise(scenario)
+        if any(math.isfinite(x) for x in stated):  # the sensor's stated noise: what an undithered quantiser hides
+            options["stated_white"] = stated
     return recording, site, options
 
 
@@ -114,8 +119,8 @@ def add_site_and_scenario_options(p) -> None:
                    help="site latitude (default: the recording's site_latitude_deg, else the scenario's)")
     p.add_argument("--height", type=float, default=None, metavar="M", help="site height, with --latitude")
     p.add_argument("--scenario", default=None,
-                   help="the lab's scenario (name or TOML path): its site, turntable/fixture grade, reduction and "
-                        "known lever arms (default: JJF 2003 Table 1 and the recording's attributes)")
+                   help="the lab's scenario (name or TOML path): its site, turntable/fixture grade, reduction, stated "
+                        "noise and known lever arms (default: JJF 2003 Table 1 and the recording's attributes)")
 
 
 def _add_fit_command(sub) -> None:

@@ -169,13 +169,13 @@ def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
 
 def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed: int = 0,
              null_draws: int = NULL_DRAWS, lever_arm=None, reference_gravity=None, omega_squared_sign: str = "model",
-             turntable_source: str = "") -> Diagnosis:
+             turntable_source: str = "", stated_white=None) -> Diagnosis:
     """Diagnose a recording (module docstring).
 
     Parameters
     ----------
     recording : plansim.io.recording.Recording
-    site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source
+    site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source, stated_white
         As :func:`plansim.fit.fit_recording`.
     alpha : float
         Family-wise false-alarm rate of the selections and level of the lack-of-fit test (0 < alpha < 1).
@@ -195,7 +195,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     if isinstance(null_draws, bool) or not isinstance(null_draws, (int, np.integer)) or null_draws < 19:
         raise ValueError(f"null_draws = {null_draws!r}: must be a whole number >= 19 (p resolves to 1/(B + 1))")
     options = dict(site=site, turntable=turntable, turntable_source=turntable_source,
-                   reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm)
+                   reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm,
+                   stated_white=stated_white)
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the
     # null hypothesis — the base model — as a score test estimates its nuisance parameters; every fit below then
     # takes it as given. Estimated with the candidates in the model instead, it came out too small wherever a

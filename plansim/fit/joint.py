@@ -530,7 +530,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
-                  between_noise: BetweenSegmentNoise | None = None) -> FitResult:
+                  between_noise: BetweenSegmentNoise | None = None, stated_white=None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -559,6 +559,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         The noise between segments beyond the prediction, given rather than estimated from this fit's residuals
         (``plansim diagnose`` estimates it once from the largest model, so that it does not absorb the effects
         it tests for).
+    stated_white : (6,) array_like, optional
+        The sensor's stated white-noise densities (rad/s/√Hz for gx gy gz, m/s²/√Hz for ax ay az; NaN where not
+        stated), as a scenario's ``[mimu.noise]`` gives them: the prior of the noise before a quantiser the noise
+        does not dither, which the data show only weakly (:func:`plansim.fit.noise.quantised_noise_posterior`).
 
     Returns
     -------
@@ -624,7 +628,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     # noise: every segment that is not a move (any pose at rest shows the sensors' noise)
     noise_segments = [k for k, s in enumerate(schedule.segments) if s.test != "move"]
     all_noise = estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in noise_segments],
-                               [schedule.segments[k] for k in noise_segments])
+                               [schedule.segments[k] for k in noise_segments], stated_white)
     keep = [noise_segments.index(k) for k in used]
     noise = NoiseEstimate(all_noise.channels, all_noise.within_std[keep], all_noise.mean_variance[keep],
                           all_noise.mean_variance_dof[keep], all_noise.quantisation_variance[keep],
