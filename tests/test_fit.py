@@ -29,6 +29,7 @@ from plansim.fit.noise import (
     allan_deviation,
     dither_for_error,
     fit_allan,
+    level_clusters,
     pooled_allan_variance,
     quantisation_error_given_levels,
     quantisation_error_variance,
@@ -486,6 +487,37 @@ def test_a_stated_noise_is_the_prior_where_the_counts_say_little():
     segments = [q * np.round((level + 0.25 * q * rng.normal(size=3000)) / q) for level in levels]
     sigma, weights = quantised_noise_posterior(q, segments, stated_sigma=0.125 * q)
     assert np.sum(weights * sigma) == pytest.approx(0.25 * q, rel=0.10)
+
+
+def test_segments_at_one_setting_read_one_level():
+    """The 12 positions: an accelerometer reads one level at the two headings of each up-axis (gravity is along the
+    up-axis whatever the heading), a gyro two (the Earth rate turns with the heading); a pose placed by hand is a
+    level of its own; two segments of one setting more than a step apart (a drift) are two levels. Pooled, the
+    counts of a segment that never leaves its level and of its twin that toggles rarely place the level as the
+    twin's do, 3σ inside the edge: the first's error is then that distance from its code (0.35q), where alone it
+    would be stated as that of a level anywhere in the middle of the step (about 0.19q r.m.s.)."""
+    segments = multi_position(12)
+    q, n = 1.0, 3000
+    samples = [np.zeros((n, 6)) for _ in segments]
+    for k in range(len(segments)):
+        samples[k][:, 3] = float(k // 2)  # one level per up-axis on ax
+    static = list(range(len(segments)))
+    clusters = level_clusters(samples, segments, static, 3, q)
+    assert sorted(map(sorted, clusters)) == [[2 * i, 2 * i + 1] for i in range(6)]
+    assert all(len(c) == 1 for c in level_clusters(samples, segments, static, 0, q))
+    placed = [dataclasses.replace(segments[0], orientation="approximate"), segments[1]]
+    assert len(level_clusters(samples[:2], placed, [0, 1], 3, q)) == 2
+    drifted = [samples[0].copy(), samples[1].copy()]
+    drifted[1][:, 3] += 3 * q
+    assert len(level_clusters(drifted, segments[:2], [0, 1], 3, q)) == 2
+    rng = np.random.default_rng(3)
+    level, sigma = 0.5 - 0.15, 0.05  # 3σ inside the edge at 0.5: toggles rarely
+    still = np.zeros(n)
+    twin = q * np.round((level + sigma * rng.standard_normal(n)) / q)
+    alone = quantisation_error_given_levels(q, still, sigma)
+    pooled = quantisation_error_given_levels(q, still, sigma, pooled=np.concatenate([still, twin]))
+    assert alone < 0.5 * level**2
+    assert pooled == pytest.approx(level**2, rel=0.15)
 
 
 def test_the_error_given_the_levels_is_calibrated_with_sigma_from_the_same_data():

@@ -408,7 +408,7 @@ def _log_likelihood(levels: np.ndarray, counts: np.ndarray, m: np.ndarray, r: fl
 POSTERIOR_GRID = np.linspace(-1.0, 1.0, 801)
 
 
-def quantisation_error_given_levels(step: float, values, sigma, weights=None) -> float:
+def quantisation_error_given_levels(step: float, values, sigma, weights=None, pooled=None) -> float:
     """Mean square error of a static segment's sample mean as its true level, given how its samples fall on the
     quantiser's levels: E[(x̄ − μ)² | the level counts], μ uniform a priori, noise σ before the quantiser.
 
@@ -428,27 +428,67 @@ def quantisation_error_given_levels(step: float, values, sigma, weights=None) ->
         The noise σ before the quantiser, or the values of its posterior (:func:`quantised_noise_posterior`).
     weights : (G,) array, optional
         The posterior weights of *sigma*: the error is then averaged over them.
+    pooled : (N,) array, optional
+        The samples of every segment at the same level as this one (this one's included: the same setting,
+        :func:`level_clusters`): the level's posterior is then taken from all their counts, and the error is
+        that of this segment's own mean.
     """
     if weights is not None:
         sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
         weights = np.atleast_1d(np.asarray(weights, dtype=float))
         if sigma.shape != weights.shape:
             raise ValueError(f"sigma {sigma.shape} and weights {weights.shape}: expected the same shape")
-        return float(sum(w * quantisation_error_given_levels(step, values, float(r))
+        return float(sum(w * quantisation_error_given_levels(step, values, float(r), pooled=pooled)
                          for r, w in zip(sigma, weights)) / np.sum(weights))
     sigma = float(sigma)
     if not step > 0:  # also NaN
         return 0.0
-    table = _level_table(values, step)
+    evidence = values if pooled is None else pooled
+    table = _level_table(evidence, step)
     if table is None or table[0].size > MAX_LEVELS:  # spread over many levels: dithered by its own scatter (Sheppard)
         own = math.sqrt(max(float(np.var(np.asarray(values, dtype=float), ddof=1)) - step**2 / 12.0, 0.0))
         return float(quantisation_error_variance(step, max(own, sigma)))
-    levels, counts, mean = table
+    levels, counts, centre = table
+    # this segment's mean, in steps from the evidence's first sample (the table's own mean without pooling)
+    mean = centre if pooled is None else float((np.mean(np.asarray(values, dtype=float)) - evidence[0]) / step)
     r = max(sigma / step, float(SIGMA_GRID[0]))
-    m = mean + POSTERIOR_GRID[None, :]
+    m = centre + POSTERIOR_GRID[None, :]
     log_l = _log_likelihood(levels[None, :], counts[None, :], m, r)[0]
     weights = np.exp(log_l - log_l.max())
     return float(np.sum(weights * (mean - m[0]) ** 2) / np.sum(weights) * step**2)
+
+
+def level_clusters(segment_samples: list[np.ndarray], segments, indices, channel: int, step: float) -> list[list[int]]:
+    """The static segments (*indices*) of one channel that read one level: the same nominal input to the channel
+    and sample means within a step of each other.
+
+    The same nominal input: the same up-axis and temperature, a known orientation, and for a gyro also the same
+    heading (the Earth rate turns with it); for an accelerometer the heading does not matter (gravity is along
+    the up-axis whatever it is: the two headings of the 12 positions of JJF 2003 Appendix C read one level).
+    Within such a setting, segments whose means lie more than a step apart are split (a drift, a table that did
+    not return to the same place): each cluster is sorted by mean and cut where neighbours differ by more than q.
+    A segment on its own is a cluster of one.
+    """
+    gyro = channel < 3
+    settings: dict[tuple, list[int]] = {}
+    for k in indices:
+        s = segments[k]
+        if s.orientation != "known" or (gyro and not math.isfinite(s.heading)):
+            key = ("alone", k)
+        else:
+            key = (s.up, float(s.temperature)) + ((round(float(s.heading), 9),) if gyro else ())
+        settings.setdefault(key, []).append(k)
+    clusters = []
+    for members in settings.values():
+        means = sorted((float(np.mean(segment_samples[k][:, channel])), k) for k in members)
+        current = [means[0][1]]
+        for (previous, _), (mean, k) in zip(means, means[1:]):
+            if not (step > 0 and abs(mean - previous) <= step):
+                clusters.append(current)
+                current = []
+            current.append(k)
+        clusters.append(current)
+    return clusters
 
 
 def dither_for_error(step: float, mean_square: float) -> float:
@@ -606,7 +646,13 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
     if stated.shape != (6,):
         raise ValueError(f"stated_white: expected 6 values (gx gy gz ax ay az), got shape {stated.shape}")
     rate = float(np.median([segments[k].sample_rate for k in static])) if static else math.nan
-    sigma_before = [quantised_noise_posterior(ch.quantisation_step, [segment_samples[k][:, c] for k in static],
+    # segments at one setting read one level: they are one draw of where a level sits in a step, not several (the
+    # σ likelihood counts how many levels toggle), and their pooled counts place that level
+    clusters = [level_clusters(segment_samples, segments, static, c, ch.quantisation_step) if static else []
+                for c, ch in enumerate(channels)]
+    pooled = [{k: np.concatenate([segment_samples[r][:, c] for r in cluster]) for cluster in clusters[c]
+               for k in cluster} for c in range(6)]
+    sigma_before = [quantised_noise_posterior(ch.quantisation_step, [pooled[c][cluster[0]] for cluster in clusters[c]],
                                               stated[c] * math.sqrt(rate) if np.isfinite(stated[c]) else None)
                     if ch.quantisation_step > 0 and static else None for c, ch in enumerate(channels)]
     variance = np.zeros((S, 6))
@@ -639,7 +685,8 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                     # The quantiser's harmonics stand for up to q²/12 of it (shared by segments at one level);
                     # beyond that (a segment that toggles rarely: its mean off by most of a step) the excess is
                     # the segment's own error
-                    given = quantisation_error_given_levels(ch.quantisation_step, x[:, c], *sigma_before[c])
+                    given = quantisation_error_given_levels(ch.quantisation_step, x[:, c], *sigma_before[c],
+                                                            pooled=pooled[c].get(k))
                     quantisation[k, c] = min(given, ch.quantisation_step**2 / 12.0)
                     own_quantisation = given - quantisation[k, c]
                     dither[k, c] = dither_for_error(ch.quantisation_step, quantisation[k, c])
