@@ -116,7 +116,7 @@ def test_sine_fit_rejects_bad_inputs_naming_the_argument():
         ((np.where(np.arange(8) == 5, np.inf, t), y, 3.0), ValueError, "t: every value must be finite"),
         ((t[::-1], y, 3.0), ValueError, "t: expected strictly increasing"),
         ((np.r_[t[:4], t[3:7]], y, 3.0), ValueError, r"t\[3\] = 0.03 then t\[4\] = 0.03"),
-        ((t, y, 0.0), ValueError, "frequency: expected a finite frequency > 0 Hz, got 0.0"),
+        ((t, y, 0.0), ValueError, "frequency: expected a finite number > 0 Hz, got 0.0"),
         ((t, y, -1.0), ValueError, "frequency: .* got -1.0"),
         ((t, y, math.nan), ValueError, "frequency"),
         ((t, y, "3 Hz"), TypeError, "frequency: expected one number"),

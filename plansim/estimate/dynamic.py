@@ -41,6 +41,7 @@ import numpy as np
 import scipy.linalg
 
 from plansim.estimate.jjf1535 import checked_array
+from plansim.model.dynamics import one_number, positive_number
 
 #: |H| = 1/√2 = −3.0103 dB, the half-power point: the default level of :func:`bandwidth_3db`
 HALF_POWER = 1.0 / math.sqrt(2.0)
@@ -57,16 +58,6 @@ def wrap_phase(phase):
     return float(out) if out.ndim == 0 else out
 
 
-def _frequency(value) -> float:
-    if isinstance(value, (str, bytes, bool)):
-        raise TypeError(f"frequency: expected one number (Hz), got {value!r}")
-    try:
-        out = float(value)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"frequency: expected one number (Hz), got {value!r}") from exc
-    if not (math.isfinite(out) and out > 0):
-        raise ValueError(f"frequency: expected a finite frequency > 0 Hz, got {value!r}")
-    return out
 
 
 @dataclass(frozen=True)
@@ -149,7 +140,7 @@ def sine_fit(t, y, frequency: float) -> SineFit:
         k = int(np.argmin(steps > 0))
         raise ValueError(f"t: expected strictly increasing times, got t[{k}] = {float(t[k])!r} then "
                          f"t[{k + 1}] = {float(t[k + 1])!r}")
-    f = _frequency(frequency)
+    f = positive_number("frequency", frequency, "Hz")
     omega_t = 2.0 * math.pi * f * t
     design = np.column_stack((np.cos(omega_t), np.sin(omega_t), np.ones_like(t)))
     solution, _, rank, _ = scipy.linalg.lstsq(design, y, cond=RANK_TOLERANCE)
@@ -274,12 +265,7 @@ def frequency_response(frequencies, amplitudes, phases, input_amplitude, static_
     if np.any(A <= 0):
         raise ValueError(f"input_amplitude: expected values > 0 rad/s, got {np.asarray(input_amplitude).tolist()}")
     phi_in = _per_repeat("input_phases", input_phases, E.shape)
-    if isinstance(static_sensitivity, (str, bytes, bool)):
-        raise TypeError(f"static_sensitivity: expected one number, got {static_sensitivity!r}")
-    try:
-        S0 = float(static_sensitivity)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"static_sensitivity: expected one number, got {static_sensitivity!r}") from exc
+    S0 = one_number("static_sensitivity", static_sensitivity)
     if not (math.isfinite(S0) and S0 != 0):
         raise ValueError(f"static_sensitivity: expected a finite nonzero S_0, got {static_sensitivity!r}")
 
@@ -346,12 +332,7 @@ def bandwidth_3db(frequencies, ratios, level: float = HALF_POWER) -> float:
         raise ValueError(f"frequencies: expected values > 0 Hz, strictly increasing, got {f.tolist()}")
     if np.any(K < 0):
         raise ValueError(f"ratios: expected values ≥ 0, got {K.tolist()}")
-    if isinstance(level, (str, bytes, bool)):
-        raise TypeError(f"level: expected one number, got {level!r}")
-    try:
-        lev = float(level)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"level: expected one number, got {level!r}") from exc
+    lev = one_number("level", level)
     if not 0 < lev < 1:
         raise ValueError(f"level: expected 0 < level < 1 (1/√2 for −3 dB), got {level!r}")
     if K[0] < lev:

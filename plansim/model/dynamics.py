@@ -30,16 +30,23 @@ import math
 import numpy as np
 
 
-def _positive(name: str, value) -> float:
-    """*value* as a float, finite and > 0 (``TypeError`` for a non-number, ``ValueError`` otherwise)."""
+def one_number(name: str, value, unit: str = "") -> float:
+    """*value* as a float, or a ``TypeError`` naming *name*, the value and (where given) the *unit* it is read in
+    for anything that is not one number (a string, a bool, a list)."""
+    read_in = f" ({unit})" if unit else ""
     if isinstance(value, (str, bytes, bool)):
-        raise TypeError(f"{name}: expected one number, got {value!r}")
+        raise TypeError(f"{name}: expected one number{read_in}, got {value!r}")
     try:
-        out = float(value)
+        return float(value)
     except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name}: expected one number, got {value!r}") from exc
+        raise TypeError(f"{name}: expected one number{read_in}, got {value!r}") from exc
+
+
+def positive_number(name: str, value, unit: str = "") -> float:
+    """:func:`one_number`, and a ``ValueError`` naming the same unless it is finite and > 0."""
+    out = one_number(name, value, unit)
     if not (math.isfinite(out) and out > 0):
-        raise ValueError(f"{name}: expected a finite number > 0, got {value!r}")
+        raise ValueError(f"{name}: expected a finite number > 0{' ' + unit if unit else ''}, got {value!r}")
     return out
 
 
@@ -71,16 +78,16 @@ def second_order_response(frequencies, natural_frequency: float, damping: float)
         1/(1 − x² + 2jζx) with x = f/f_n, the shape of *frequencies*.
     """
     f = _frequencies(frequencies)
-    x = f / _positive("natural_frequency", natural_frequency)
-    return 1.0 / (1.0 - x * x + 2j * _positive("damping", damping) * x)
+    x = f / positive_number("natural_frequency", natural_frequency)
+    return 1.0 / (1.0 - x * x + 2j * positive_number("damping", damping) * x)
 
 
 def second_order_magnitude(frequencies, natural_frequency: float, damping: float) -> np.ndarray:
     """|H| = 1/√((1 − x²)² + (2ζx)²), x = f/f_n: the ratio of the output amplitude to the static one
     (the K_i of JJF 1537-2015 eq. (9) for this sensor)."""
     f = _frequencies(frequencies)
-    x = f / _positive("natural_frequency", natural_frequency)
-    zeta = _positive("damping", damping)
+    x = f / positive_number("natural_frequency", natural_frequency)
+    zeta = positive_number("damping", damping)
     return 1.0 / np.sqrt((1.0 - x * x) ** 2 + (2.0 * zeta * x) ** 2)
 
 
@@ -88,8 +95,8 @@ def second_order_phase(frequencies, natural_frequency: float, damping: float) ->
     """arg H = −atan2(2ζx, 1 − x²) ∈ (−π, 0], rad, x = f/f_n: the output's phase relative to the input
     rate's (negative: the output lags), continuous in f through the resonance (−π/2 at f = f_n)."""
     f = _frequencies(frequencies)
-    x = f / _positive("natural_frequency", natural_frequency)
-    zeta = _positive("damping", damping)
+    x = f / positive_number("natural_frequency", natural_frequency)
+    zeta = positive_number("damping", damping)
     return -np.arctan2(2.0 * zeta * x, 1.0 - x * x)
 
 
@@ -100,6 +107,6 @@ def second_order_bandwidth(natural_frequency: float, damping: float) -> float:
     frequency where |H| = 1/√2 on the way down (for ζ < 1/√2 the response first rises above 1 at the
     resonance), so it is the bandwidth of JJF 1535-2015 3.7. ζ = 1/√2 gives f_n.
     """
-    f_n = _positive("natural_frequency", natural_frequency)
-    b = 1.0 - 2.0 * _positive("damping", damping) ** 2
+    f_n = positive_number("natural_frequency", natural_frequency)
+    b = 1.0 - 2.0 * positive_number("damping", damping) ** 2
     return f_n * math.sqrt(b + math.sqrt(b * b + 1.0))
