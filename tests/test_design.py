@@ -175,8 +175,18 @@ import dataclasses  # noqa: E402
 
 import plansim  # noqa: E402
 from plansim.design.alias import EFFECTS, alias_matrix  # noqa: E402
-from plansim.design.catalogue import candidate_information, default_candidates, select_parameters  # noqa: E402
-from plansim.design.schedule_design import design_efficiency, exact_design, optimal_design  # noqa: E402
+from plansim.design.catalogue import (  # noqa: E402
+    Candidate,
+    candidate_information,
+    default_candidates,
+    select_parameters,
+)
+from plansim.design.schedule_design import (  # noqa: E402
+    design_efficiency,
+    exact_design,
+    optimal_design,
+    refine_dwells,
+)
 
 #: a table without position errors: the closed form of the multi-position design assumes none
 PERFECT_TABLE = ['turntable.position_accuracy="0 arcsec"', 'turntable.position_repeatability="0 arcsec"']
@@ -238,6 +248,50 @@ def test_optimal_design_is_certified_and_exact_design_keeps_the_budget():
     c = optimal_design(scenario, "c", c="Kgxx")
     kinds = {cand.kind for cand, w in c.support if w > 0.01}
     assert "rate" in kinds  # the scale factor is measured by turning
+
+
+def test_the_best_dwell_of_a_pose_is_the_closed_form():
+    """The dwell as a continuous variable. One gyro's bias from one pose, white noise N and a rate random walk K:
+    the mean's variance is N²/T + K²T/3 (IEEE Std 952, the Allan variance at τ = T) and a segment costs s + T, so
+    the information per second 1/((N²/T + K²T/3)(s + T)) is largest where 2cT³ + c·s·T² − N²s = 0, c = K²/3
+    (about 60 s here: N = 0.15 °/√h, K = 3.5e-7 rad/s/√s, s = 10 s). The grid 10/30/100/300 s puts its weight on
+    100 s; the continuous design finds the root to 0.2 s (the drift is a held process advanced every 0.1 s and the
+    segments hold whole samples, so the information steps at that scale), certified by the equivalence theorem,
+    and it is better than the grid's."""
+    base = plansim.load_scenario("linear_gaussian")
+    K = 3.5e-7
+    noise = dataclasses.replace(base.noise, gyro_bias_instability=np.zeros(3), gyro_rate_random_walk=np.full(3, K),
+                                gyro_markov_sigma=np.zeros(3))
+    scenario = dataclasses.replace(base, noise=noise)
+    N, settle = float(noise.gyro_angle_random_walk[0]), scenario.schedule.segments[0].settle
+    candidates = [Candidate("pose", "+z", 0.0, 0.0, dwell, settle) for dwell in (10.0, 30.0, 100.0, 300.0)]
+    options = dict(parameters=["Bgx"], channels=["gx"], candidates=candidates)
+    grid = optimal_design(scenario, "D", **options)
+    assert [c.dwell for c, w in grid.support] == [100.0]
+    c = K**2 / 3.0
+    roots = np.roots([2.0 * c, c * settle, 0.0, -(N**2) * settle])
+    best = float(roots[np.argmin(np.abs(roots.imag))].real)
+    assert 50.0 < best < 70.0
+    free = optimal_design(scenario, "D", **options, continuous_dwell=True)
+    (cand, weight), = free.support
+    assert cand.dwell == pytest.approx(best, abs=0.2) and weight == pytest.approx(1.0)
+    assert free.design.certificate.efficiency_bound >= 1 - 1e-4
+    assert free.design.criterion.value(free.design.information) < grid.design.criterion.value(grid.design.information)
+    with pytest.raises(ValueError, match="bounds"):
+        refine_dwells(scenario, grid, bounds=(30.0, 10.0))
+    with pytest.raises(ValueError, match="rounds"):
+        refine_dwells(scenario, grid, rounds=0)
+
+
+def test_continuous_dwells_for_the_gyro_biases_lie_between_the_grids_points():
+    """The default scenario's gyro biases (D on Bg, gyro channels): on the grid every support point dwells 30 s;
+    free, the bias instability's floor and the 10 s settling put them at about 24 s, a dwell the grid does not have,
+    with the certificate holding over every dwell of the support's poses."""
+    scenario = plansim.load_scenario("jjf2003")
+    free = optimal_design(scenario, "D", parameters="Bg", channels=["gx", "gy", "gz"], continuous_dwell=True)
+    dwells = {round(c.dwell, 6) for c, w in free.support}
+    assert all(10.0 < d < 30.0 for d in dwells), dwells
+    assert free.design.certificate.efficiency_bound >= 1 - 1e-4
 
 
 @pytest.mark.parametrize("bad, message", [

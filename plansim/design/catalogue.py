@@ -2,9 +2,11 @@
 
 A candidate is one dwell of the table: a pose (one of the 24 axis-aligned orientations — up axis × heading —
 or a pose tilted 45° about East from one of them) at rest, or a rate about a body axis on the vertical table
-axis (a grid of rates with both signs, which also drive the ω² terms), each with a dwell from a list: dwell is
-the continuous variable of the design, sampled. Its cost is its table time, settling included
-(``settle + dwell``, as :attr:`plansim.schedule.segments.Schedule.duration` counts it).
+axis (a grid of rates with both signs, which also drive the ω² terms), each with a dwell from a list (the
+dwell is a continuous variable: :func:`at_dwell` moves a candidate to any dwell, and
+:func:`plansim.design.schedule_design.refine_dwells` optimises it between the list's ends). Its cost is its
+table time, settling included (``settle + dwell``, as :attr:`plansim.schedule.segments.Schedule.duration`
+counts it).
 
 **Information.** The mean of a segment is linear in the 39 parameters of JJF 2003 eq. (1)/(2),
 ``m = F·θ`` with ``F`` (6 × 39) from the fit's model (:meth:`plansim.fit.model.MeanModel.parameter_jacobian`:
@@ -171,6 +173,20 @@ def _drift_variance(scenario: Scenario, dwell: float) -> np.ndarray:
     two = dataclasses.replace(scenario, schedule=Schedule((segment, segment), procedure="custom"))
     C = drift_covariance(two)
     return 0.5 * (C[:, 0, 0] + C[:, 1, 1] - 2.0 * C[:, 0, 1])
+
+
+def at_dwell(scenario: Scenario, information: CandidateInformation, k: int, dwell: float
+             ) -> tuple[Candidate, np.ndarray, np.ndarray]:
+    """Candidate *k* of *information* at another *dwell* (s): the candidate, its Jacobian (6, 39) — which the dwell
+    does not change — and the covariance of its mean (6, 6), whose white and drift parts follow the dwell (module
+    docstring) while the table's part stays."""
+    if not (math.isfinite(dwell) and dwell > 0):
+        raise ValueError(f"dwell = {dwell!r} s: expected a finite dwell > 0 s")
+    c = information.candidates[k]
+    white = np.asarray(kernel_arguments(scenario)["noise"])[:, NOISE_WHITE] ** 2
+    change = white / dwell - white / c.dwell + _drift_variance(scenario, dwell) - _drift_variance(scenario, c.dwell)
+    return (dataclasses.replace(c, dwell=float(dwell)), information.jacobian[k],
+            information.covariance[k] + np.diag(change))
 
 
 def candidate_information(scenario: Scenario, candidates=None) -> CandidateInformation:

@@ -19,6 +19,7 @@ from plansim.design.algorithms import ApproximateDesign, efficient_rounding, exc
 from plansim.design.catalogue import (
     Candidate,
     CandidateInformation,
+    at_dwell,
     candidate_information,
     select_parameters,
 )
@@ -102,7 +103,8 @@ class DesignResult:
 
 
 def optimal_design(scenario: Scenario, criterion: str = "D", parameters=None, channels=None, c=None,
-                   candidates=None, tolerance: float = DESIGN_TOLERANCE) -> DesignResult:
+                   candidates=None, tolerance: float = DESIGN_TOLERANCE, continuous_dwell: bool = False
+                   ) -> DesignResult:
     """The optimal allocation of table time over the candidate segments, for the scenario's unit, noise and table.
 
     Parameters
@@ -122,6 +124,9 @@ def optimal_design(scenario: Scenario, criterion: str = "D", parameters=None, ch
         Default :func:`plansim.design.catalogue.default_candidates`.
     tolerance : float
         The design's equivalence-theorem efficiency bound is ≥ 1 − *tolerance*.
+    continuous_dwell : bool
+        Treat the dwell as a continuous variable between the candidates' shortest and longest dwell
+        (:func:`refine_dwells`) instead of the candidates' grid of dwells.
 
     Raises
     ------
@@ -135,7 +140,80 @@ def optimal_design(scenario: Scenario, criterion: str = "D", parameters=None, ch
     info = candidate_information(scenario, candidates)
     crit = _criterion(criterion, index, c)
     design = multiplicative(info.blocks(index, chans), crit, costs=info.costs, tolerance=tolerance)
-    return DesignResult(design, info, index, chans)
+    result = DesignResult(design, info, index, chans)
+    return refine_dwells(scenario, result, tolerance=tolerance) if continuous_dwell else result
+
+
+#: rounds of :func:`refine_dwells` (each adds the best dwell of every family in the support, then re-optimises)
+DWELL_ROUNDS = 8
+
+
+def refine_dwells(scenario: Scenario, result: DesignResult, bounds=None, tolerance: float = DESIGN_TOLERANCE,
+                  rounds: int = DWELL_ROUNDS) -> DesignResult:
+    """The dwell as a continuous variable: an optimal design whose support dwells are free within *bounds*.
+
+    A candidate's information per second of table time, ``M(T)/(settle + T)``, depends on its dwell T through
+    the noise of its mean (white ``N²/T`` falls, the drift's Allan variance at τ = T does not, the settling is
+    paid once; :func:`plansim.design.catalogue.at_dwell`), so for each geometry (pose or rate point) there is a
+    best dwell. By the equivalence theorem (Kiefer & Wolfowitz 1960; with costs, Pukelsheim 1993 §5) a design is
+    optimal over the continuum when no dwell of any geometry has a directional derivative per cost
+    ``φ(T) = tr(G·M(T))/(settle + T)`` above the bound b. Each round maximises φ(T) over *bounds* for every
+    geometry in the support (``scipy.optimize.minimize_scalar``, bounded), adds the dwells that exceed b by more
+    than *tolerance* as candidates and runs the multiplicative algorithm again over them all; it stops when none
+    does (the design is then certified over those geometries' whole dwell range) or after *rounds*.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        As for :func:`optimal_design` (its noise sets how the information grows with the dwell).
+    result : DesignResult
+        An optimal design over a dwell grid (:func:`optimal_design`).
+    bounds : (float, float), optional
+        The dwell range, s; default the smallest and largest dwell of *result*'s candidates.
+
+    Returns
+    -------
+    DesignResult
+        Over the original candidates and the dwells added; ``design.certificate`` holds for all of them.
+    """
+    info = result.information
+    dwells = sorted({c.dwell for c in info.candidates})
+    lo, hi = (dwells[0], dwells[-1]) if bounds is None else (float(bounds[0]), float(bounds[1]))
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+        raise ValueError(f"bounds = {bounds!r}: expected two dwells 0 < lower < upper, s")
+    if isinstance(rounds, bool) or not isinstance(rounds, int) or rounds < 1:
+        raise ValueError(f"rounds = {rounds!r}: expected a whole number >= 1")
+    from scipy.optimize import minimize_scalar
+
+    design = result.design
+    for _ in range(rounds):
+        G, bound = design.criterion.gradient(design.information)
+        added, seen = [], set()
+        for k in design.support:
+            c = info.candidates[k]
+            geometry = (c.kind, c.up, c.heading, c.rate, c.tilt)
+            if geometry in seen:
+                continue
+            seen.add(geometry)
+
+            def per_cost(dwell, k=k, info=info, G=G):
+                cand, jac, cov = at_dwell(scenario, info, k, dwell)
+                one = CandidateInformation((cand,), jac[None], cov[None], np.array([cand.cost]))
+                return float(np.sum(G * one.blocks(result.parameters, result.channels)[0])) / cand.cost
+
+            best = minimize_scalar(lambda t: -per_cost(t), bounds=(lo, hi), method="bounded",
+                                   options={"xatol": 1e-4 * lo})
+            if -best.fun > bound * (1.0 + tolerance):
+                added.append(at_dwell(scenario, info, k, float(best.x)))
+        if not added:
+            break
+        info = CandidateInformation(info.candidates + tuple(a[0] for a in added),
+                                    np.concatenate([info.jacobian, np.array([a[1] for a in added])]),
+                                    np.concatenate([info.covariance, np.array([a[2] for a in added])]),
+                                    np.concatenate([info.costs, [a[0].cost for a in added]]))
+        design = multiplicative(info.blocks(result.parameters, result.channels), design.criterion,
+                                costs=info.costs, tolerance=tolerance)
+    return DesignResult(design, info, result.parameters, result.channels)
 
 
 def exact_design(result: DesignResult, table_time: float, sample_rate: float = 100.0,
