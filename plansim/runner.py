@@ -476,16 +476,19 @@ def compare_chapter_misalignment(scenario: Scenario | str = "jjf2003", trials: i
 
 
 def jjf1535_run(scenario: Scenario | str = "jjf2003", trials: int = 1000, seed: int | None = None,
-                procedure=None, path: str = "auto", keep_table: bool = False) -> Jjf1535MonteCarlo:
+                procedure=None, path: str = "auto", keep_table: bool = False,
+                progress: ProgressCallback | None = None) -> Jjf1535MonteCarlo:
     """The x gyro of *scenario*'s units through JJF 1535-2015, its items against the truth and Appendix A.
 
     *scenario* (a built-in name, a TOML path or a :class:`~plansim.config.Scenario`; default ``jjf2003``) gives the
-    unit, noise, effects and laboratory; see :func:`plansim.uncertainty.jjf1535_monte_carlo.jjf1535_monte_carlo`.
-    *seed* defaults to the scenario's.
+    unit, noise, effects and laboratory; see :func:`plansim.uncertainty.jjf1535_monte_carlo.jjf1535_monte_carlo`
+    (also for *progress*, ``progress(done, total)`` after each chunk of trials). *seed* defaults to the scenario's.
+    ``plansim run jjf1535 --unit SCENARIO`` prints its :meth:`~Jjf1535MonteCarlo.summary`.
     """
     sc = _scenario_of(scenario)
     seed = sc.seed if seed is None else seed
-    return jjf1535_monte_carlo(sc, trials, seed, procedure=procedure, path=path, keep_table=keep_table)
+    return jjf1535_monte_carlo(sc, trials, seed, procedure=procedure, path=path, keep_table=keep_table,
+                               progress=progress)
 
 
 def jjf1535_angle_random_walk(scenario: Scenario | str = "jjf2003", seed: int | None = None, trial: int = 0,

@@ -28,7 +28,7 @@ from plansim.config.saturation import saturation_report
 from plansim.config.scenario import Acquisition, ErrorDistribution
 from plansim.estimate.jjf1535_items import ITEMS, reduce_items, true_items
 from plansim.schedule.jjf1535 import Jjf1535Procedure, jjf1535_procedure
-from plansim.simulate.chunks import check_count, simulate_segment_means
+from plansim.simulate.chunks import ProgressCallback, check_count, iterate_chunks
 from plansim.simulate.paths import choose_path
 from plansim.uncertainty.appendix_a_jjf1535 import BIAS, SCALE_FACTOR
 from plansim.units import ARCSEC, DEG
@@ -148,7 +148,8 @@ class Jjf1535MonteCarlo:
 
 
 def jjf1535_monte_carlo(scenario: Scenario, trials: int, seed: int, procedure: Jjf1535Procedure | None = None,
-                        path: str = "auto", chunk_size: int = 256, keep_table: bool = False) -> Jjf1535MonteCarlo:
+                        path: str = "auto", chunk_size: int = 256, keep_table: bool = False,
+                        progress: ProgressCallback | None = None) -> Jjf1535MonteCarlo:
     """Simulate *trials* units of *scenario* through the JJF 1535 procedure and reduce each.
 
     Parameters
@@ -163,23 +164,29 @@ def jjf1535_monte_carlo(scenario: Scenario, trials: int, seed: int, procedure: J
     path : {"auto", "sample", "segment"}
         Simulation path (:func:`plansim.simulate.paths.choose_path`).
     chunk_size : int
-        Trials per chunk.
+        Trials per chunk (results do not depend on it: trial *i*'s random streams depend on the seed and *i* only).
     keep_table : bool
         Keep the scenario's turntable and acquisition (:func:`jjf1535_scenario`).
+    progress : callable, optional
+        ``progress(done, total)``, trials simulated and reduced, after each chunk (the threads simulate the next
+        chunk while this one is reduced).
     """
     world, procedure = jjf1535_scenario(scenario, procedure, keep_table)
     trials = check_count("trials", trials, minimum=2)
     seed = check_count("seed", seed, minimum=0)
     chosen, _reasons = choose_path(world, path)
-    means, truth = simulate_segment_means(world, trials, seed, chunk_size=chunk_size, path=chosen)
     gravity = scenario.reduction.reference_gravity
     items = tuple(ITEMS)
     values = np.empty((trials, len(items)))
     true = np.empty((trials, len(items)))
-    for n in range(trials):
-        v, t = reduce_items(means[n], procedure, gravity), truth_of(world, procedure, truth[n])
-        values[n] = [v[k] for k in items]
-        true[n] = [t[k] for k in items]
+    for start, stop, means, truth in iterate_chunks(world, trials, seed, chunk_size, chosen):
+        for n in range(start, stop):
+            v = reduce_items(means[n - start], procedure, gravity)
+            t = truth_of(world, procedure, truth[n - start])
+            values[n] = [v[k] for k in items]
+            true[n] = [t[k] for k in items]
+        if progress is not None:
+            progress(stop, trials)
     return Jjf1535MonteCarlo(scenario=world.name, trials=trials, seed=seed, path=chosen, items=items, values=values,
                              truth=true)
 
