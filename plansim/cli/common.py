@@ -69,7 +69,7 @@ def _silence_stdout() -> None:
 COMMANDS = {
     "run": "Monte Carlo of a calibration vs JJF 2003 Appendix A",
     "validate": "GUM budgets validated by adaptive Monte Carlo",
-    "scenarios": "list the built-in scenarios",
+    "scenarios": "list the built-in scenarios and procedures",
     "record": "write one simulated trial's raw samples",
     "import": "a plain CSV log to a recording with segments",
     "fit": "fit a recording: parameters, noise, uncertainty",

@@ -7,9 +7,13 @@ import os
 import time
 
 from plansim.cli.common import COMMANDS, add_set_option
+from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, VALIDATE_REFUSAL, run_jjf1535
 from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
 from plansim.report.progress import end_progress_line
+
+#: ``plansim run --chunk-size``'s default
+DEFAULT_CHUNK_SIZE = 4096
 
 
 def _cmd_run(args) -> int:
@@ -22,6 +26,11 @@ def _cmd_run(args) -> int:
     from plansim.runner import run, run_summary
     from plansim.uncertainty import compare_with_appendix_a
 
+    if args.scenario in PROCEDURES:  # a built-in procedure run on a unit scenario, not a scenario file
+        return run_jjf1535(args, DEFAULT_CHUNK_SIZE)
+    if args.unit is not None:
+        raise ValueError(f"--unit {args.unit!r}: only with a procedure ({', '.join(PROCEDURES)}: plansim run "
+                         f"jjf1535 --unit SCENARIO); the scenario {args.scenario!r} is its own unit")
     # every check before any work: the outputs, the scenario, the numbers
     if args.out is not None:
         check_output_path(args.out, "--out", (".nc",))
@@ -98,9 +107,11 @@ def _cmd_scenarios(args) -> int:
     for name, path in builtin_scenarios().items():
         with open(path, "rb") as fh:
             descriptions[name] = tomllib.load(fh).get("description", "")
-    width = max(map(len, descriptions), default=0)
+    width = max(map(len, [*descriptions, *PROCEDURES]), default=0)
     for name, description in descriptions.items():
         print(f"{name:{width}s}  {description}".rstrip())
+    for name, description in PROCEDURES.items():  # one line each too, marked: not scenario files
+        print(f"{name:{width}s}  [procedure, not a scenario file: plansim run {name} --unit SCENARIO] {description}")
     return 0
 
 
@@ -130,6 +141,8 @@ def _cmd_validate(args) -> int:
     from plansim.report.validation import format_report, stderr_block_progress, validation_json
     from plansim.runner import validate
 
+    if args.scenario in PROCEDURES:
+        raise ValueError(VALIDATE_REFUSAL)
     scenario = load_scenario(args.scenario, args.set)
     claims = load_claims(args.claims, scenario) if args.claims else None
     for option, value, minimum in (("--trials-per-block", args.trials_per_block, 2),
@@ -191,17 +204,23 @@ def _add_validate_command(sub) -> None:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("run", help=COMMANDS["run"],
-                       description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A")
+                       description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A; "
+                                   "'plansim run jjf1535 [--unit SCENARIO]': the JJF 1535-2015 procedure on a unit "
+                                   "scenario, compared with its Appendix A")
     p.add_argument("scenario", nargs="?", default="jjf2003",
-                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003; or the "
+                        "procedure jjf1535")
+    p.add_argument("--unit", default=None, metavar="SCENARIO",
+                   help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
+                        f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
     p.add_argument("--trials", type=int, default=None,
-                   help="number of simulated calibrations (default: the scenario's)")
-    p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's)")
+                   help="number of simulated calibrations (default: the scenario's; jjf1535: 1000)")
+    p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's, or the unit's)")
     p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
     p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
-    p.add_argument("--chunk-size", type=int, default=4096,
+    p.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
                    help="trials per kernel call (results do not depend on it; memory grows with it)")
     p.add_argument("--path", choices=("auto", "sample", "segment"), default="auto",
                    help="simulation path: auto takes the segment-statistics path only where it is exact")
@@ -211,7 +230,9 @@ def add_commands(sub) -> None:
     _add_validate_command(sub)
 
     p = sub.add_parser("scenarios", help=COMMANDS["scenarios"], description="List the built-in scenarios "
-                       "(the folder scenarios/, installed as plansim.scenarios) with their descriptions.")
+                       "(the folder scenarios/, installed as plansim.scenarios) with their descriptions, then the "
+                       "built-in procedures, which are not scenario files but run on a unit scenario "
+                       "(plansim run jjf1535 --unit SCENARIO).")
     p.set_defaults(func=_cmd_scenarios)
 
     p = sub.add_parser("record", help=COMMANDS["record"],

@@ -1,0 +1,198 @@
+"""The JJF 1535-2015 Monte Carlo as a certificate-style text report and as JSON (``plansim run jjf1535``).
+
+Both read :meth:`plansim.uncertainty.jjf1535_monte_carlo.Jjf1535MonteCarlo.summary`, whose rows are in the units
+JJF 1535 reports in (:data:`plansim.estimate.jjf1535_items.ITEMS`): the text report prints them as they are, the
+JSON converts them to SI (as ``plansim run --json`` is SI). The items are grouped as the certificate of JJF 1535
+Appendix B groups them: the scale factor items, the bias items, then the items plansim does not simulate, each
+with the reason (docs/jjf1535.md, "What is not built").
+"""
+
+from __future__ import annotations
+
+import math
+
+from plansim.estimate.jjf1535_items import ITEMS
+from plansim.units import DEG, HOUR
+
+#: the certificate's groups (JJF 1535 Appendix B) and the items of the Monte Carlo in each, in order
+GROUPS = (
+    ("Scale factor items", ("scale_factor", "nonlinearity", "asymmetry", "scale_temperature_sensitivity")),
+    ("Bias items", ("bias", "bias_up_down", "bias_stability", "g_sensitivity_x", "g_sensitivity_y",
+                    "g_sensitivity_z", "g_sensitivity", "bias_temperature_sensitivity")),
+)
+
+#: the name each item has in the text report
+LABELS = {
+    "scale_factor": "scale factor K",
+    "nonlinearity": "nonlinearity",
+    "asymmetry": "asymmetry",
+    "scale_temperature_sensitivity": "SF temperature sensitivity",
+    "bias": "bias B0 (axis up)",
+    "bias_up_down": "bias (up/down mean)",
+    "bias_stability": "bias stability",
+    "g_sensitivity_x": "g-sensitivity along x",
+    "g_sensitivity_y": "g-sensitivity along y",
+    "g_sensitivity_z": "g-sensitivity along z",
+    "g_sensitivity": "g-sensitivity (largest)",
+    "bias_temperature_sensitivity": "bias temperature sensitivity",
+}
+
+#: the SI unit of each JJF 1535 unit of :data:`~plansim.estimate.jjf1535_items.ITEMS` (its scale gives the factor)
+SI_UNITS = {
+    "(deg/s)/(deg/s)": "1",
+    "ppm": "1",
+    "ppm/degC": "1/K",
+    "deg/h": "rad/s",
+    "(deg/h)/g": "rad/s/(m/s^2)",
+    "(deg/h)/degC": "rad/s/K",
+}
+
+#: the certificate's items plansim does not simulate: (item, clause, why)
+NOT_SIMULATED = (
+    ("scale factor repeatability", "7.2.4",
+     "needs a power cycle between the Q runs (a turn-on bias drawn per cycle); the kernels have none"),
+    ("threshold", "7.2.6", "eq. (12)-(13) are built, but the simulator has no dead zone: they would measure noise"),
+    ("resolution", "7.2.7", "eq. (14) is built, but the simulator has no finite input resolution: noise only"),
+    ("warm-up time", "7.2.9", "needs a warm-up transient of the bias; the kernels have none"),
+    ("bias repeatability", "7.2.11", "needs a turn-on bias drawn per power cycle; the kernels have none"),
+    ("bandwidth", "7.2.15", "a dynamic test (JJF 1537): the -3 dB estimator is built, the vibration table is not "
+                            "simulated (docs/dynamic.md)"),
+)
+
+#: the angle random walk's display unit and its SI value
+ARW_UNIT, ARW_SCALE = "deg/sqrt(h)", DEG / math.sqrt(HOUR)
+
+#: the keys of every entry of the JSON's ``items``, always present (null where the item has no such figure)
+ITEM_KEYS = ("item", "clause", "equations", "unit", "truth", "mean_error", "std_error", "mc_U95", "budget",
+             "budget_U", "mean_relative_error", "std_relative_error", "mc_U95_relative", "coverage", "figure")
+
+
+def _number(x) -> float | None:
+    """A JSON number: None for NaN or a missing figure."""
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else float(x)
+
+
+def items_json(rows: list[dict]) -> list[dict]:
+    """The summary rows (JJF 1535 units) as the JSON's ``items``, SI.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :meth:`~plansim.uncertainty.jjf1535_monte_carlo.Jjf1535MonteCarlo.summary`.
+
+    Returns
+    -------
+    list of dict
+        One per row with the keys :data:`ITEM_KEYS`. ``unit`` is the SI unit; ``truth`` (mean true value),
+        ``mean_error``, ``std_error`` and ``mc_U95`` (95 % quantile of |error|) in it, None for an item with no
+        true value, whose ``figure`` is then the distribution of the reported value ``{mean, std, q025, q975}``
+        (SI; None otherwise). ``budget`` (``"A.1"``, ``"A.2"``), ``budget_U`` (Appendix A's printed U, relative,
+        k = 2), the relative error's ``mean_relative_error``, ``std_relative_error``, ``mc_U95_relative`` and the
+        ``coverage`` (fraction of trials with |relative error| <= U) for the items Appendix A budgets, None for
+        the others.
+    """
+    out = []
+    for r in rows:
+        scale = ITEMS[r["item"]][3]
+        entry = dict.fromkeys(ITEM_KEYS)
+        entry.update(item=r["item"], clause=r["clause"], equations=r["equations"], unit=SI_UNITS[r["unit"]])
+        if "mean_error" in r:
+            entry.update({k: r[k] * scale for k in ("truth", "mean_error", "std_error", "mc_U95")})
+        else:
+            entry["figure"] = {k: r[k] * scale for k in ("mean", "std", "q025", "q975")}
+        if "budget" in r:
+            entry.update({k: r[k] for k in ("budget", "budget_U", "mean_relative_error", "std_relative_error",
+                                            "mc_U95_relative", "coverage")})
+        out.append({k: (_number(v) if isinstance(v, float) else v) for k, v in entry.items()})
+    return out
+
+
+def not_simulated_json() -> list[dict]:
+    """:data:`NOT_SIMULATED` as ``[{item, clause, reason}]``."""
+    return [{"item": item, "clause": clause, "reason": reason} for item, clause, reason in NOT_SIMULATED]
+
+
+def _g(x: float, digits: int = 4) -> str:
+    return f"{x:.{digits}g}"
+
+
+def items_table(rows: list[dict], arw: tuple[float, float] | None = None) -> str:
+    """The certificate-style table: the scale factor items, the bias items, the items not simulated.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :meth:`~plansim.uncertainty.jjf1535_monte_carlo.Jjf1535MonteCarlo.summary` (JJF 1535 units).
+    arw : (float, float), optional
+        7.2.13 on one session, ``(reported, simulated)`` rad/√s
+        (:func:`plansim.runner.jjf1535_angle_random_walk`), printed after the bias items in °/√h.
+
+    Returns
+    -------
+    str
+        Per item with a true value: its unit, the mean true value, the mean and standard deviation of the error
+        and the 95 % quantile of |error| (error = reported − true, per trial); for the items Appendix A budgets a
+        second line with the relative error against the printed U (k = 2) and the coverage. Per item without a
+        true value: the mean, standard deviation and 95 % interval of the reported figure.
+    """
+    by_item = {r["item"]: r for r in rows}
+    head = (f"  {'item':30s} {'clause':14s} {'unit':16s} {'truth':>10s} {'mean error':>11s} {'std error':>10s} "
+            f"{'95% |err|':>10s}")
+    lines = ["error = reported − true value of the simulated unit, per trial; 95% |err| = the trials' 95 % quantile "
+             "of |error|; Appendix A: printed U (k = 2), read relative; coverage = trials with |relative error| <= U"]
+    for title, names in GROUPS:
+        lines += ["", title, head]
+        for name in names:
+            r = by_item[name]
+            start = f"  {LABELS[name]:30s} {r['clause']:14s} {r['unit']:16s}"
+            if "mean_error" in r:
+                lines.append(f"{start} {_g(r['truth'], 5):>10s} {_g(r['mean_error'], 3):>11s} "
+                             f"{_g(r['std_error'], 3):>10s} {_g(r['mc_U95'], 3):>10s}")
+            else:
+                lines.append(f"{start} {'(none)':>10s} reported figure: mean {_g(r['mean'], 3)}, std "
+                             f"{_g(r['std'], 3)}, 95 % interval [{_g(r['q025'], 3)}, {_g(r['q975'], 3)}]")
+            if "budget" in r:
+                lines.append(f"  {'':30s} {'':14s} Appendix {r['budget']} U = {r['budget_U']:.1e} (relative): "
+                             f"relative error mean {r['mean_relative_error']:+.2e}, std {r['std_relative_error']:.2e}, "
+                             f"95% |err| {r['mc_U95_relative']:.2e}; coverage {100 * r['coverage']:.1f} %")
+        if title == "Bias items" and arw is not None:
+            reported, simulated = arw
+            lines.append(f"  {'angle random walk':30s} {'7.2.13':14s} {ARW_UNIT:16s} "
+                         f"{_g(simulated / ARW_SCALE, 5):>10s} one session (trial 0), eq. (21)-(26): "
+                         f"reported {_g(reported / ARW_SCALE, 4)} "
+                         "(not in the Monte Carlo: it needs every sample)")
+    lines += ["", "Not simulated"]
+    lines += [f"  {item:30s} {clause:14s} {reason}" for item, clause, reason in NOT_SIMULATED]
+    return "\n".join(lines)
+
+
+def header(result, unit, procedure, elapsed: float | None = None) -> str:
+    """The report's first lines: the unit scenario, trials, seed, path and the procedure.
+
+    Parameters
+    ----------
+    result : plansim.uncertainty.jjf1535_monte_carlo.Jjf1535MonteCarlo
+    unit : plansim.config.Scenario
+        The unit scenario (its schedule, turntable and acquisition were replaced by JJF 1535's).
+    procedure : plansim.schedule.jjf1535.Jjf1535Procedure
+    elapsed : float, optional
+        Wall time of the run, s.
+    """
+    import plansim
+
+    schedule = procedure.schedule
+    run = procedure.room_runs[0]
+    rates = sorted(abs(schedule.segments[k].rate) / DEG for k in run.points)
+    positive = sum(schedule.segments[k].rate > 0 for k in run.points)
+    when = f" in {elapsed:.1f} s" if elapsed is not None else ""
+    overrides = f"Overrides (--set): {'; '.join(unit.overrides)}\n" if unit.overrides else ""
+    gyro = "xyz"[procedure.axis]
+    return (f"plansim {plansim.__version__} — JJF 1535-2015 procedure on the unit of scenario {unit.name!r}: "
+            f"{result.trials} trials, seed {result.seed}, {result.path} path{when}\n"
+            f"{unit.description}\n{overrides}"
+            f"The {gyro} gyro: {len(schedule)} segments, {schedule.duration / HOUR:.1f} h, Q = "
+            f"{len(procedure.room_runs)} rate runs of {positive} + {len(run.points) - positive} points "
+            f"(±{_g(rates[0])} to ±{_g(rates[-1])} °/s), bias averaging period P = "
+            f"{_g(procedure.averaging_period)} s, temperatures {', '.join(_g(t) for t in procedure.temperatures)} °C; "
+            "JJF 1535 Table 2 rate table (u = 2.5e-4 systematic, 0.05 % smoothness), 3″ position table, "
+            "21-bit acquisition")
