@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import plansim.io.scenario_file
 import plansim.runner
 from plansim import cli
 from plansim.estimate.jjf1535_items import ITEMS
@@ -103,6 +105,17 @@ def test_progress_goes_to_stderr_unless_quiet(capsys):
     code, out, err = _run(capsys, "--trials", "20", "--seed", "1")
     assert code == 0 and "plansim run jjf1535 --unit jjf2003: 20/20 trials" in err and err.endswith("\n")
     assert "20/20" not in out
+
+
+def test_unit_takes_a_toml_path_and_set_overrides_it(capsys, tmp_path):
+    unit = tmp_path / "mylab.toml"
+    unit.write_text((Path(plansim.io.scenario_file.builtin_scenarios()["linear_gaussian"])).read_text())
+    code, out, err = _run(capsys, "--unit", str(unit), "--trials", "4", "--seed", "2", "--quiet", "--json",
+                          "--set", "environment.latitude=\"30 deg\"")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["unit_scenario"] == "mylab" and doc["trials"] == 4
+    assert doc["overrides"] == ['environment.latitude="30 deg"']
 
 
 def test_the_monte_carlo_reports_progress_and_does_not_depend_on_its_chunks():
