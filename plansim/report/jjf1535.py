@@ -12,7 +12,14 @@ from __future__ import annotations
 import math
 
 from plansim.estimate.jjf1535_items import ITEMS
-from plansim.units import DEG, HOUR
+from plansim.io.recording import plansim_version
+from plansim.uncertainty.jjf1535_monte_carlo import (
+    ACQUISITION_BITS,
+    POSITION_ACCURACY,
+    TABLE_RATE_SMOOTHNESS,
+    TABLE_RATE_UNCERTAINTY,
+)
+from plansim.units import ARCSEC, DEG, HOUR
 
 #: the certificate's groups (JJF 1535 Appendix B) and the items of the Monte Carlo in each, in order
 GROUPS = (
@@ -178,8 +185,6 @@ def header(result, unit, procedure, elapsed: float | None = None) -> str:
     elapsed : float, optional
         Wall time of the run, s.
     """
-    import plansim
-
     schedule = procedure.schedule
     run = procedure.room_runs[0]
     rates = sorted(abs(schedule.segments[k].rate) / DEG for k in run.points)
@@ -187,12 +192,14 @@ def header(result, unit, procedure, elapsed: float | None = None) -> str:
     when = f" in {elapsed:.1f} s" if elapsed is not None else ""
     overrides = f"Overrides (--set): {'; '.join(unit.overrides)}\n" if unit.overrides else ""
     gyro = "xyz"[procedure.axis]
-    return (f"plansim {plansim.__version__} — JJF 1535-2015 procedure on the unit of scenario {unit.name!r}: "
+    table_u = f"{TABLE_RATE_UNCERTAINTY:.1e}".replace("e-0", "e-")  # 2.5e-4, as Appendix A prints it
+    return (f"plansim {plansim_version()} — JJF 1535-2015 procedure on the unit of scenario {unit.name!r}: "
             f"{result.trials} trials, seed {result.seed}, {result.path} path{when}\n"
             f"{unit.description}\n{overrides}"
             f"The {gyro} gyro: {len(schedule)} segments, {schedule.duration / HOUR:.1f} h, Q = "
             f"{len(procedure.room_runs)} rate runs of {positive} + {len(run.points) - positive} points "
             f"(±{_g(rates[0])} to ±{_g(rates[-1])} °/s), bias averaging period P = "
             f"{_g(procedure.averaging_period)} s, temperatures {', '.join(_g(t) for t in procedure.temperatures)} °C; "
-            "JJF 1535 Table 2 rate table (u = 2.5e-4 systematic, 0.05 % smoothness), 3″ position table, "
-            "21-bit acquisition")
+            f"JJF 1535 Table 2 rate table (u = {table_u} systematic, "
+            f"{100 * TABLE_RATE_SMOOTHNESS:.2g} % smoothness), {_g(POSITION_ACCURACY / ARCSEC)}″ position table, "
+            f"{ACQUISITION_BITS}-bit acquisition")
