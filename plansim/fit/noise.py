@@ -433,29 +433,28 @@ def quantisation_error_given_levels(step: float, values, sigma, weights=None, po
         :func:`level_clusters`): the level's posterior is then taken from all their counts, and the error is
         that of this segment's own mean.
     """
-    if weights is not None:
-        sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
-        weights = np.atleast_1d(np.asarray(weights, dtype=float))
-        if sigma.shape != weights.shape:
-            raise ValueError(f"sigma {sigma.shape} and weights {weights.shape}: expected the same shape")
-        return float(sum(w * quantisation_error_given_levels(step, values, float(r), pooled=pooled)
-                         for r, w in zip(sigma, weights)) / np.sum(weights))
-    sigma = float(sigma)
+    sigmas = np.atleast_1d(np.asarray(sigma, dtype=float))
+    weights = np.ones(1) if weights is None else np.atleast_1d(np.asarray(weights, dtype=float))
+    if sigmas.shape != weights.shape:
+        raise ValueError(f"sigma {sigmas.shape} and weights {weights.shape}: expected the same shape")
     if not step > 0:  # also NaN
         return 0.0
     evidence = values if pooled is None else pooled
-    table = _level_table(evidence, step)
+    table = _level_table(evidence, step)  # once, whatever the number of σ
     if table is None or table[0].size > MAX_LEVELS:  # spread over many levels: dithered by its own scatter (Sheppard)
         own = math.sqrt(max(float(np.var(np.asarray(values, dtype=float), ddof=1)) - step**2 / 12.0, 0.0))
-        return float(quantisation_error_variance(step, max(own, sigma)))
-    levels, counts, centre = table
-    # this segment's mean, in steps from the evidence's first sample (the table's own mean without pooling)
-    mean = centre if pooled is None else float((np.mean(np.asarray(values, dtype=float)) - evidence[0]) / step)
-    r = max(sigma / step, float(SIGMA_GRID[0]))
-    m = centre + POSTERIOR_GRID[None, :]
-    log_l = _log_likelihood(levels[None, :], counts[None, :], m, r)[0]
-    weights = np.exp(log_l - log_l.max())
-    return float(np.sum(weights * (mean - m[0]) ** 2) / np.sum(weights) * step**2)
+        errors = [float(quantisation_error_variance(step, max(own, r))) for r in sigmas]
+    else:
+        levels, counts, centre = table
+        # this segment's mean, in steps from the evidence's first sample (the table's own mean without pooling)
+        mean = centre if pooled is None else float((np.mean(np.asarray(values, dtype=float)) - evidence[0]) / step)
+        m = centre + POSTERIOR_GRID[None, :]
+        errors = []
+        for r in sigmas:
+            log_l = _log_likelihood(levels[None, :], counts[None, :], m, max(r / step, float(SIGMA_GRID[0])))[0]
+            posterior = np.exp(log_l - log_l.max())
+            errors.append(float(np.sum(posterior * (mean - m[0]) ** 2) / np.sum(posterior) * step**2))
+    return float(sum(w * e for w, e in zip(weights, errors)) / np.sum(weights))
 
 
 def level_clusters(segment_samples: list[np.ndarray], segments, indices, channel: int, step: float) -> list[list[int]]:
@@ -648,8 +647,8 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
     rate = float(np.median([segments[k].sample_rate for k in static])) if static else math.nan
     # segments at one setting read one level: they are one draw of where a level sits in a step, not several (the
     # σ likelihood counts how many levels toggle), and their pooled counts place that level
-    clusters = [level_clusters(segment_samples, segments, static, c, ch.quantisation_step) if static else []
-                for c, ch in enumerate(channels)]
+    clusters = [level_clusters(segment_samples, segments, static, c, ch.quantisation_step)
+                if ch.quantisation_step > 0 and static else [] for c, ch in enumerate(channels)]
     pooled = [{k: np.concatenate([segment_samples[r][:, c] for r in cluster]) for cluster in clusters[c]
                for k in cluster} for c in range(6)]
     sigma_before = [quantised_noise_posterior(ch.quantisation_step, [pooled[c][cluster[0]] for cluster in clusters[c]],
