@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 import os
 
 from plansim.cli.common import COMMANDS
@@ -92,25 +91,14 @@ def recording_and_fit_options(args):
     """The recording, the site and the fit's options from a command's RECORDING, --latitude/--height and
     --scenario (its turntable grade, reduction, known lever arms and stated noise), as ``plansim fit`` and
     ``plansim diagnose`` take them."""
-    from plansim.fit import resolve_site
-    from plansim.fit.noise import stated_white_noise
+    from plansim.fit import resolve_site, scenario_fit_options
     from plansim.io.recording import read_recording
     from plansim.io.scenario_file import load_scenario
 
     scenario = load_scenario(args.scenario) if args.scenario is not None else None
     recording = read_recording(args.recording)
     site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
-    options = {}
-    if scenario is not None:
-        options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
-                       reference_gravity=scenario.reduction.reference_gravity,
-                       omega_squared_sign=scenario.reduction.omega_squared_sign)
-        if scenario.effects.accel_lever_arm.any():  # the fixture's known lever arms: a model input, not absorbed by P
-            options["lever_arm"] = scenario.effects.accel_lever_arm
-        stated = stated_white_noise(scenario)
-        if any(math.isfinite(x) for x in stated):  # the sensor's stated noise: what an undithered quantiser hides
-            options["stated_white"] = stated
-    return recording, site, options
+    return recording, site, scenario_fit_options(scenario)
 
 
 def add_site_and_scenario_options(p) -> None:

@@ -2,6 +2,7 @@
 
 - :func:`~plansim.fit.joint.fit_recording` — the whole fit (docs/fitting.md);
 - :func:`~plansim.fit.site.resolve_site` — the site from the command line, the recording or the scenario;
+  :func:`~plansim.fit.site.scenario_fit_options` — the fit's options from a lab's scenario;
 - :mod:`~plansim.fit.model` — the segment means by the simulator's physics; :mod:`~plansim.fit.identify` —
   which parameters the segments identify; :mod:`~plansim.fit.noise` — Allan deviation and scatter;
   :mod:`~plansim.fit.result` — the JSON object and the NetCDF Dataset.
@@ -10,6 +11,6 @@ A layer between ``io`` (above: files) and ``uncertainty`` (below: the GUM machin
 """
 
 from plansim.fit.joint import FitResult, fit_recording
-from plansim.fit.site import TABLE_1_TURNTABLE, Site, resolve_site
+from plansim.fit.site import TABLE_1_TURNTABLE, Site, resolve_site, scenario_fit_options
 
-__all__ = ["TABLE_1_TURNTABLE", "FitResult", "Site", "fit_recording", "resolve_site"]
+__all__ = ["TABLE_1_TURNTABLE", "FitResult", "Site", "fit_recording", "resolve_site", "scenario_fit_options"]

@@ -171,3 +171,35 @@ def resolve_site(latitude_deg=None, height_m=None, attrs=None, scenario=None) ->
         env = scenario.environment
         return Site(float(env.latitude), float(env.height), earth_rate, f"scenario {scenario.name!r}")
     return Site(earth_rate=earth_rate)
+
+
+def scenario_fit_options(scenario) -> dict:
+    """The fit's options a lab's scenario gives (:func:`plansim.fit.fit_recording` keywords), one helper for every
+    caller (``plansim fit``, ``plansim diagnose``, ``plansim diagnose-check``):
+
+    - ``turntable`` and ``turntable_source``: its ``[turntable]`` grade (the Type B per-setting errors);
+    - ``reference_gravity`` and ``omega_squared_sign``: its ``[reduction]``;
+    - ``lever_arm``: the fixture's known lever arms (``[mimu.effects] accel_lever_arm``), where any is set — a model
+      input, not absorbed by P;
+    - ``stated_white``: the sensor's stated white noise (``[mimu.noise]``,
+      :func:`plansim.fit.noise.stated_white_noise`), where any is stated — the prior of the noise an undithered
+      quantiser hides.
+
+    *scenario* None gives no options (JJF 2003 Table 1 and the recording's attributes).
+    """
+    from plansim.config import Scenario
+    from plansim.fit.noise import stated_white_noise
+
+    if scenario is None:
+        return {}
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario: expected a plansim Scenario or None, got {type(scenario).__name__}")
+    options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
+                   reference_gravity=scenario.reduction.reference_gravity,
+                   omega_squared_sign=scenario.reduction.omega_squared_sign)
+    if scenario.effects.accel_lever_arm.any():
+        options["lever_arm"] = scenario.effects.accel_lever_arm
+    stated = stated_white_noise(scenario)
+    if np.any(np.isfinite(stated)):
+        options["stated_white"] = stated
+    return options
