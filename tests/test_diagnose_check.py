@@ -54,6 +54,34 @@ def test_the_effects_outside_the_catalogue_are_what_they_say():
         _add_out_of_catalogue("clock_slow", flat, 1.0, 0)
 
 
+def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(monkeypatch):
+    """--effects names only the check's cases; each recording is diagnosed with the options plansim diagnose
+    --scenario gives (plansim.fit.scenario_fit_options: the stated noise included), from the scenario as the lab
+    states it, never the injected one."""
+    from plansim.checks import diagnose_check
+    from plansim.fit import scenario_fit_options
+
+    scenario = load_scenario("jjf2003")
+    with pytest.raises(ValueError, match="clock_slow"):
+        run_diagnose_check(scenario, null=1, effects=("bias_step", "clock_slow"))
+    with pytest.raises(ValueError, match="effects"):
+        run_diagnose_check(scenario, null=1, effects=())
+    seen = []
+
+    def fake(recording, site, **options):
+        seen.append(options)
+        raise RuntimeError("stop")
+
+    monkeypatch.setattr(diagnose_check, "diagnose", fake)
+    with pytest.raises(RuntimeError, match="stop"):
+        run_diagnose_check(scenario, null=1, per_effect=0)
+    expected = scenario_fit_options(scenario)
+    assert "stated_white" in expected and np.all(np.isfinite(expected["stated_white"]))
+    got = seen[0]
+    assert set(got) >= set(expected)
+    assert np.array_equal(got["stated_white"], expected["stated_white"]) and got["turntable"] == expected["turntable"]
+
+
 @pytest.mark.slow
 def test_at_ten_times_the_effects_are_found_and_the_lever_arm_never_is():
     """One jjf2003 recording per effect at 10x its noise-equivalent size (non-centrality 100: the power of each

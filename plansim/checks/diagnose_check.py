@@ -40,7 +40,7 @@ from scipy.stats import binom
 
 from plansim.config import parse_scenario
 from plansim.diagnose.procedure import diagnose
-from plansim.fit import resolve_site
+from plansim.fit import resolve_site, scenario_fit_options
 from plansim.io.scenario_file import apply_overrides
 from plansim.kernels.layout import ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP
 from plansim.kernels.quantiser import quantise
@@ -55,6 +55,9 @@ FIELDS = {"gyro_scale_asymmetry": "gyro_asymmetry", "gyro_scale_nonlinearity": N
 #: effects outside the catalogue, added to the samples (:func:`_add_out_of_catalogue`); the lever arm the fit is
 #: not told is run with the catalogue effects
 OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst")
+#: the catalogue effects injected (the lever arm at a fixed 5 mm, the others at each size)
+CATALOGUE_CASES = ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
+                   "bias_drift", "lever_arm")
 
 
 def case_seed(root: int, case: str, index: int) -> int:
@@ -127,9 +130,12 @@ def _acquire(scenario, samples: np.ndarray) -> np.ndarray:
     return out
 
 
-def _run(scenario, recording, truth, lever, alpha, null_draws, seed):
-    d = diagnose(recording, resolve_site(scenario=scenario), scenario.turntable, lever_arm=lever, alpha=alpha,
-                 null_draws=null_draws, seed=seed)
+def _run(scenario, recording, truth, alpha, null_draws, seed):
+    """Diagnose *recording* as ``plansim diagnose REC --scenario`` would with the check's (un-injected) *scenario*:
+    its site and fit options (:func:`plansim.fit.scenario_fit_options`: turntable, reduction, known lever arms,
+    stated noise) — what the lab knows, never what was injected."""
+    d = diagnose(recording, resolve_site(scenario=scenario), alpha=alpha, null_draws=null_draws, seed=seed,
+                 **scenario_fit_options(scenario))
     z = {}
     for label, fit in (("before", d.before), ("after", d.after)):
         m = fit.joint
@@ -141,8 +147,15 @@ def _run(scenario, recording, truth, lever, alpha, null_draws, seed):
 
 
 def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes=(2.0, 5.0, 10.0),
-                       alpha: float = 0.05, seed: int = 0, null_draws: int = 500, progress=None) -> CheckReport:
-    """Run the check (module docstring) and return its figures."""
+                       alpha: float = 0.05, seed: int = 0, null_draws: int = 500, progress=None,
+                       effects=None) -> CheckReport:
+    """Run the check (module docstring) and return its figures. *effects*: the injected effects to run (names of
+    :data:`CATALOGUE_CASES` and :data:`OUT_OF_CATALOGUE`; default all); the nulls always run."""
+    allowed = CATALOGUE_CASES + OUT_OF_CATALOGUE
+    effects = allowed if effects is None else tuple(effects)
+    unknown = [e for e in effects if e not in allowed]
+    if unknown or not effects:
+        raise ValueError(f"effects = {list(effects)!r}: each must be one of {', '.join(allowed)}")
     for name, value, low in (("null", null, 1), ("per_effect", per_effect, 0), ("null_draws", null_draws, 19)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
             raise ValueError(f"{name} = {value!r}: must be a whole number >= {low}")
@@ -151,10 +164,9 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     sizes = tuple(float(k) for k in sizes)
     if not sizes or any(not k > 0 for k in sizes):
         raise ValueError(f"sizes = {sizes!r}: each must be > 0")
-    lever = scenario.effects.accel_lever_arm if scenario.effects.accel_lever_arm.any() else None
     report = CheckReport(scenario.name, alpha)
-    sized = 5  # the catalogue effects run at each size; the lever arm once
-    total = null + per_effect * (len(sizes) * (sized + len(OUT_OF_CATALOGUE)) + 1)
+    sized = sum(e in effects for e in CATALOGUE_CASES if e != "lever_arm") + sum(e in effects for e in OUT_OF_CATALOGUE)
+    total = null + per_effect * (len(sizes) * sized + ("lever_arm" in effects))  # the lever arm runs once
     done = 0
 
     def tick():
@@ -170,7 +182,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         s = case_seed(seed, "null", i)
         recording = simulate_and_record(scenario, seed=s, trial=0)
         _, _, truth = simulate_recording(scenario, s, 0)
-        d, z = _run(scenario, recording, truth, lever, alpha, null_draws, s)
+        d, z = _run(scenario, recording, truth, alpha, null_draws, s)
         reference = reference or d
         sample_rate = recording.schedule.segments[0].sample_rate
         selections += bool(d.selected)
@@ -186,8 +198,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         return report
     nes = {c.effect: c for c in reference.candidates}
     unquantised = _without_quantiser(scenario)  # effects added to the samples go in before the acquisition
-    for effect in ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
-                   "bias_drift", "lever_arm"):
+    for effect in (e for e in CATALOGUE_CASES if e in effects):
         candidate = nes[effect]
         usable = np.flatnonzero(np.isfinite(candidate.noise_equivalent_size))
         if effect == "lever_arm" or not usable.size:
@@ -213,7 +224,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 else:
                     recording = simulate_and_record(injected, seed=s, trial=0)
                 _, _, truth = simulate_recording(injected, s, 0)
-                d, z = _run(injected, recording, truth, lever, alpha, null_draws, s)
+                d, z = _run(scenario, recording, truth, alpha, null_draws, s)
                 counts["detected"] += _alarm(d)
                 counts["attributed"] += d.selected == (effect,)
                 key = "+".join(d.selected) or "(none)"
@@ -233,7 +244,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     u_mean = float(np.median(np.sqrt(np.diag(reference.before.covariance)).reshape(-1, 6)[:, 0]))
     white = reference.before.noise.channels[0].white
     sigma_sample = float(white * math.sqrt(sample_rate)) if math.isfinite(white) else u_mean
-    for effect in OUT_OF_CATALOGUE:
+    for effect in (e for e in OUT_OF_CATALOGUE if e in effects):
         for k in sizes:
             size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample)
             flagged, named = 0, 0
@@ -245,7 +256,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 _, _, truth = simulate_recording(scenario, s, 0)
                 samples = _add_out_of_catalogue(effect, np.array(recording.samples, dtype=float), size, s)
                 recording = type(recording)(_acquire(scenario, samples), recording.schedule, dict(recording.attrs))
-                d, _ = _run(scenario, recording, truth, lever, alpha, null_draws, s)
+                d, _ = _run(scenario, recording, truth, alpha, null_draws, s)
                 flagged += _alarm(d)
                 named += bool(d.selected)
                 tick()

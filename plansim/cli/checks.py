@@ -21,6 +21,7 @@ def _cmd_diagnose_check(args) -> int:
     except ValueError as exc:
         raise ValueError(f"--sizes {args.sizes!r}: expected numbers separated by commas, e.g. 2,5,10") from exc
     scenario = load_scenario(args.scenario)
+    effects = None if args.effects is None else tuple(e.strip() for e in args.effects.split(",") if e.strip())
 
     def progress(done, total):
         if not args.quiet:
@@ -28,7 +29,7 @@ def _cmd_diagnose_check(args) -> int:
                   flush=True)
 
     report = run_diagnose_check(scenario, null=args.null, per_effect=args.per_effect, sizes=sizes, alpha=args.alpha,
-                                seed=args.seed, null_draws=args.null_draws, progress=progress)
+                                seed=args.seed, null_draws=args.null_draws, progress=progress, effects=effects)
     if not args.quiet:
         print(file=sys.stderr)
     end_progress_line()
@@ -67,6 +68,10 @@ def add_commands(sub) -> None:
     p.add_argument("--null", type=int, default=100, help="null recordings (default 100)")
     p.add_argument("--per-effect", type=int, default=10, help="recordings per effect and size (default 10)")
     p.add_argument("--sizes", default="2,5,10", help="multiples of the noise-equivalent size (default 2,5,10)")
+    p.add_argument("--effects", default=None, metavar="E1,E2",
+                   help="the injected effects to run, comma-separated (default all: gyro_scale_asymmetry, "
+                        "gyro_scale_nonlinearity, gyro_g2_sensitivity, accel_quadratic, bias_drift, lever_arm, "
+                        "bias_step, clock_fast, noise_burst); the nulls always run")
     p.add_argument("--alpha", type=float, default=0.05)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--null-draws", type=int, default=500, help="simulated null draws per test (default 500)")
