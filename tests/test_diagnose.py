@@ -164,6 +164,31 @@ def test_a_refit_never_adds_components_that_together_alias_a_parameter():
     assert not _adds_rank(fit, kept, kept[0])
 
 
+def test_each_components_own_score_is_at_most_its_candidates_score():
+    """The candidate's score T_c = max over directions a in its surviving span of (aᵀr)²/(aᵀΣa) (the standardised
+    score of a 1-dof test along a; Rao 1948), so no single component's own 1-dof statistic exceeds it, and a
+    candidate with one usable component has the two equal. Checked on a linear_gaussian recording with an
+    asymmetry on x: every identifiable candidate, to round-off."""
+    scenario = _scenario("linear_gaussian", gyro_asymmetry=np.array([2e-3, 0.0, 0.0]))
+    fit = fit_recording(simulate_and_record(scenario, seed=6, trial=0), resolve_site(scenario=scenario),
+                        scenario.turntable)
+    scores = score_candidates(fit, signatures(fit), null_draws=50)
+    checked = 0
+    for s in scores:
+        if not s.identifiable:
+            assert np.all(np.isnan(s.component_statistic)) and s.strongest_component() == 0.0
+            continue
+        own = s.component_statistic[s.usable]
+        assert np.all(np.isfinite(own)) and np.all(np.isnan(s.component_statistic[~s.usable]))
+        assert own.max() <= s.statistic * (1 + 1e-9), s.effect
+        if s.usable.sum() == 1:
+            assert own[0] == pytest.approx(s.statistic, rel=1e-9)
+        checked += 1
+    assert checked >= 4
+    asymmetry = {s.effect: s for s in scores}["gyro_scale_asymmetry"]
+    assert asymmetry.strongest_component() == asymmetry.component_statistic[0]  # the x component carries it
+
+
 def test_json_keys_and_the_command(tmp_path, capsys):
     scenario = _scenario("linear_gaussian", gyro_asymmetry=np.array([3e-3, 0.0, 0.0]))
     recording = simulate_and_record(scenario, seed=3, trial=0)

@@ -30,6 +30,14 @@ documented fallback (``method="holm"``).
 **Lack of fit** (segment level): L = ‖r_w‖² against the same simulated null, p = (1 + #{L*_b ≥ L})/(B + 1),
 overall and per channel (the channel's rows of r_w).
 
+**Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
+over the rate points of one axis are both even in ω). Which one the residual is attributed to is decided by each
+candidate's strongest single component: its one-degree-of-freedom score (uᵀ r_w)²/(uᵀ M u), u = z/‖z‖ — the
+share of the whitened residual that one parameter of that effect explains, in units of its null spread. It is
+the likelihood-ratio comparison of the two one-parameter models, and unlike a p-value over the whole candidate it
+does not favour the candidate with fewer components (a six-component nonlinearity against a three-component
+asymmetry).
+
 The noise-equivalent size of a component is the size at which that component alone gives its one-degree-
 of-freedom score a non-centrality of 1: sqrt(uᵀ M u)/‖z‖, z = P⊥ W x_k, u = z/‖z‖, M = P⊥ W V Wᵀ P⊥.
 """
@@ -73,6 +81,16 @@ class CandidateScore:
     components: tuple[str, ...]
     unit: str
     usable: np.ndarray = field(repr=False, default=None)  # (m,) bool: the components the data can estimate
+    #: (m,) each usable component's own one-degree-of-freedom score statistic (NaN where not usable): the
+    #: evidence for that component alone, which :func:`plansim.diagnose.procedure.diagnose` compares between
+    #: candidates to attribute a residual (module docstring, "Attribution")
+    component_statistic: np.ndarray = field(repr=False, default=None)
+
+    def strongest_component(self) -> float:
+        """The largest one-degree-of-freedom score statistic of the candidate's usable components (0 if none)."""
+        values = np.asarray(self.component_statistic if self.component_statistic is not None else [], dtype=float)
+        finite = values[np.isfinite(values)]
+        return float(finite.max()) if finite.size else 0.0
 
 
 @dataclass(frozen=True)
@@ -198,6 +216,9 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
         spread = np.linalg.norm((Z / np.where(surviving > 0, surviving, 1.0)).T @ g.noise_map, axis=1)
         nes = np.where(usable, spread / np.where(surviving > 0, surviving, 1.0), np.inf)
+        # each component alone: its 1-dof standardised score (uᵀ r_w)² / (uᵀ M u)
+        along = (Z / np.where(surviving > 0, surviving, 1.0)).T @ g.r
+        component = np.where(usable & (spread > 0), (along / np.where(spread > 0, spread, 1.0)) ** 2, np.nan)
         if np.any(usable):
             u, s, _ = np.linalg.svd(Z[:, usable], full_matrices=False)
             basis = u[:, s > ALIAS_TOLERANCE * np.linalg.norm(Z[:, usable], axis=0).min()]
@@ -207,7 +228,7 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         aliased = () if not np.any(lost) else _aliases(
             fit, g, Wx[:, np.flatnonzero(lost)[np.argmin((surviving / np.maximum(norms, 1e-300))[lost])]])
         bases.append(basis)
-        raw.append((sig, usable, nes, aliased))
+        raw.append((sig, usable, nes, aliased, component))
     # candidate against candidate: surviving subspaces that coincide
     same = [set() for _ in sigs]
     for i in range(len(sigs)):
@@ -250,12 +271,13 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
             for i in tested:
                 adjusted[i] = (1 + np.count_nonzero(min_p <= p[i])) / (B + 1)
     out = []
-    for i, (sig, usable, nes, aliased) in enumerate(raw):
+    for i, (sig, usable, nes, aliased, component) in enumerate(raw):
         names = tuple(aliased) + tuple(sorted(same[i]))
         out.append(CandidateScore(sig.effect, bool(identifiable[i]), names,
                                   "" if identifiable[i] else SEPARATING.get(sig.effect, ""),
                                   float(statistic[i]), int(dof[i]), float(p[i]), float(adjusted[i]), nes,
-                                  sig.components, sig.unit, usable))
+                                  sig.components, sig.unit, usable,
+                                  np.where(identifiable[i], component, np.nan)))
     return tuple(out)
 
 
