@@ -65,7 +65,8 @@ def test_bench_command_quick(capsys):
     figures = json.loads(capsys.readouterr().out)
     for key in ("numpy_normal_per_s", "samples_per_s", "calibrations_per_s", "peak_rss_mb", "summary_peak_rss_mb",
                 "summary_seconds", "cold_start_s", "warm_start_s", "seconds_per_trial", "predict_seconds",
-                "predict_new_schedule_seconds", "sweep_seconds"):
+                "predict_new_schedule_seconds", "sweep_seconds", "diagnose_seconds", "diagnose_effect_seconds"):
         assert key in figures
     assert figures["sweep_cells"] == 4 and figures["sweep_seconds"] > 0
+    assert figures["diagnose_seconds"] > 0 and figures["diagnose_effect_seconds"] > 0
     assert figures["calibrations_per_s"] > 0 and figures["peak_rss_mb"] > 0 and figures["summary_peak_rss_mb"] > 0

@@ -22,7 +22,12 @@ Figures (all per second of wall time, thread count reported):
   schedule arrays, the drift coefficients) but shares the estimator matrix, which a dwell does not change;
 - ``sweep_seconds`` — :func:`plansim.planning.sweep.sweep` of the default scenario over 100 cells (25 dwell
   times × 6/12 positions × 2 ω² rates) at 10⁴ trials per cell on the thread executor, one round (the
-  planner issue's target: ≤ 60 s on a 2-core machine).
+  planner issue's target: ≤ 60 s on a 2-core machine);
+- ``diagnose_seconds`` — :func:`plansim.diagnose.procedure.diagnose` of one simulated default recording
+  (135 000 samples, 45 segments), as ``plansim diagnose REC --scenario jjf2003`` runs it: the base fit, the
+  within-segment tests, the simulated nulls (2000 draws), the score tests and the before/after, warm (kernels
+  compiled, modules imported); ``diagnose_effect_seconds`` the same for a recording with a scale asymmetry
+  on the x gyro of 10⁻³, which the diagnosis selects and refits (the diagnosis issue's target: ≤ 10 s warm).
 
 Method. The speed of these 2-core machines varies by up to 2× between identical runs (other
 work on the same host), so each throughput is the best of several rounds: the best round is the
@@ -194,6 +199,29 @@ def sweep_seconds(cells: int = 100, trials: int = 10_000) -> tuple[float, int]:
     return time.perf_counter() - start, 4 * len(dwells)
 
 
+def diagnose_seconds(rounds: int = 3, seed: int = 5) -> tuple[float, float]:
+    """Best-of-rounds wall time of ``diagnose`` (module docstring) on a null default recording and on one with an
+    effect it selects, s."""
+    import dataclasses
+
+    from plansim.diagnose.procedure import diagnose
+    from plansim.fit import resolve_site, scenario_fit_options
+    from plansim.io.scenario_file import load_scenario
+    from plansim.runner import simulate_and_record
+
+    scenario = load_scenario(SCENARIO)
+    site, options = resolve_site(scenario=scenario), scenario_fit_options(scenario)
+    asymmetry = np.array(scenario.effects.gyro_asymmetry, dtype=float) + np.array([1e-3, 0.0, 0.0])
+    with_effect = dataclasses.replace(scenario, effects=dataclasses.replace(scenario.effects,
+                                                                            gyro_asymmetry=asymmetry))
+    out = []
+    for world in (scenario, with_effect):
+        recording = simulate_and_record(world, seed=seed, trial=0)
+        diagnose(recording, site, **options)  # imports, compiled kernels
+        out.append(_best_of(lambda recording=recording: diagnose(recording, site, **options), rounds))
+    return out[0], out[1]
+
+
 def measure(quick: bool = False) -> dict:
     """Every figure in one run. *quick* shrinks the sizes (for CI correctness runs), not the method."""
     scale = 100 if quick else 1
@@ -206,6 +234,7 @@ def measure(quick: bool = False) -> dict:
     prediction = predict_seconds()
     new_prediction = predict_new_schedule_seconds()
     swept, cells = sweep_seconds(4 if quick else 100, 10_000 // scale)
+    diagnosed, diagnosed_effect = diagnose_seconds(1 if quick else 3)
     counts = sorted(per_trial, key=int)
     return {
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_implementation()} "
@@ -233,6 +262,8 @@ def measure(quick: bool = False) -> dict:
         "sweep_seconds": swept,
         "sweep_cells": cells,
         "sweep_trials_per_cell": 10_000 // scale,
+        "diagnose_seconds": diagnosed,
+        "diagnose_effect_seconds": diagnosed_effect,
     }
 
 
@@ -256,7 +287,9 @@ def format_figures(f: dict) -> str:
               f"  plansim.predict (GUM of the default schedule) {f['predict_seconds'] * 1e3:8.1f} ms "
               f"(a schedule not predicted before: {f['predict_new_schedule_seconds'] * 1e3:.1f} ms)",
               f"  plansim sweep, {f['sweep_cells']} cells × {f['sweep_trials_per_cell']:,} trials (threads): "
-              f"{f['sweep_seconds']:.1f} s"]
+              f"{f['sweep_seconds']:.1f} s",
+              f"  plansim diagnose (default recording, 2000 null draws, warm): {f['diagnose_seconds']:.1f} s; with an "
+              f"effect selected and refitted: {f['diagnose_effect_seconds']:.1f} s"]
     return "\n".join(lines)
 
 

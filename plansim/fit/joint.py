@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
+from threadpoolctl import threadpool_limits
 
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
@@ -527,6 +528,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     return theta, tilts, basis[:n] @ gain_z, design, gain_z, 2.0 * float(result.cost), result.x[len(result.x) - m:]
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
