@@ -7,9 +7,10 @@ moves a mean little and the shape a lot. These tests look at the shape. A turnin
 table's own harmonics of its angle (a tilted axis turns gravity and the Earth rate with it): they are removed
 first, by the fit's degree-2 trigonometric polynomial in the angle
 (:func:`plansim.fit.noise.turning_residuals`), from the data and from every null draw alike; its null is white
-noise at the segment's own scatter (the table's rate jitter adds noise the segments at rest do not have), it is
-tested only where that scatter is at least :data:`TURNING_DITHERED` quantiser steps, and it takes no part in the
-``scatter`` test.
+noise at the segment's own scatter (the table's rate jitter adds noise the segments at rest do not have) about the
+segment's own smooth signal, through the channel's quantiser where it has one
+(:func:`turning_noise_before_quantiser`: the σ before the quantiser that gives the observed scatter), and it takes
+no part in the ``scatter`` test.
 
 **Statistics**, for each tested segment and channel, on the samples x minus their mean, with s their standard
 deviation and n their number:
@@ -74,7 +75,8 @@ from plansim.fit.noise import (
 )
 from plansim.kernels.layout import CHANNELS
 
-__all__ = ["TESTS", "WithinResult", "within_segment_tests", "segment_statistics", "simulate_noise"]
+__all__ = ["TESTS", "WithinResult", "within_segment_tests", "segment_statistics", "simulate_noise",
+           "turning_noise_before_quantiser"]
 
 #: the statistics, in the order of every array
 TESTS = ("trend", "step", "periodic", "burst", "scatter")
@@ -83,10 +85,8 @@ TESTS = ("trend", "step", "periodic", "burst", "scatter")
 DITHERED = 0.3
 #: the null draws above this quantile make the generalised Pareto tail of :func:`tail_p_values`
 TAIL_QUANTILE = 0.9
-#: a quantised channel is tested in a turning segment where its scatter there is at least this many steps: below
-#: it the quantiser's error follows the turning signal's level along the turn and is not white (measured on
-#: jjf2003's 12-bit channels at 0.5–1 step: the burst test ran at 0.18–0.24 for 0.05)
-TURNING_DITHERED = 2.0
+#: common draws with which :func:`turning_noise_before_quantiser` matches the scatter
+MATCH_DRAWS = 8
 #: blocks of the burst statistic
 BLOCKS = 10
 #: null draws per segment (p resolves to 1/(B + 1))
@@ -189,6 +189,36 @@ def simulate_noise(channel, n: int, sample_rate: float, draws: int, rng: np.rand
         offset = rng.uniform(-0.5, 0.5, size=(draws, 1)) * q if level is None else level
         x = np.round((x + offset) / q) * q
     return x
+
+
+def turning_noise_before_quantiser(smooth: np.ndarray, q: float, sd: float, rate: float, sample_rate: float) -> float:
+    """The white noise σ before a quantiser of step *q* that gives a turning segment's quantised samples the
+    scatter *sd* they show about its fitted trigonometric polynomial, given the segment's smooth signal *smooth*
+    (n,) (its mean and the table's harmonics of the angle): E[s(σ)] = sd, s(σ) the scatter of
+    ``turning_residuals(round((smooth + σ z)/q)·q)``, averaged over :data:`MATCH_DRAWS` fixed draws z (common random
+    numbers, so s is monotone in σ), solved by Brent's method to 1 % of *sd*. 0 where even σ = 0 gives at least
+    *sd* (the signal sweeping the codes makes all the scatter).
+
+    Below about two steps of scatter the quantiser's error follows the signal's level along the turn and is not
+    white, so white noise at the observed scatter is not the null there (the burst test ran at 0.18–0.24 for 0.05
+    on jjf2003's 12-bit gyros at 0.5–1 step). Through the quantiser it is.
+    """
+    from scipy.optimize import brentq
+
+    smooth = np.asarray(smooth, dtype=float)
+    z = np.random.default_rng(0).standard_normal((MATCH_DRAWS, smooth.size))
+
+    def scatter(sigma: float) -> float:
+        y = np.round((smooth + sigma * z) / q) * q
+        r = turning_residuals(y.T, rate, sample_rate)
+        return float(np.mean(np.std(r, axis=0, ddof=1 + 2 * TURNING_HARMONICS))) - sd
+
+    if scatter(0.0) >= 0.0:
+        return 0.0
+    high = max(sd, q)
+    while scatter(high) < 0.0:
+        high *= 2.0
+    return float(brentq(scatter, 0.0, high, xtol=0.01 * sd))
 
 
 @dataclass(frozen=True)
@@ -319,18 +349,29 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
         fs = segment.sample_rate
         turning = segment.is_rotating
         level = np.sqrt(np.mean(x**2, axis=0))  # (6,): the round-off floor is relative to the samples themselves
+        raw = x
         if turning:  # the table's own harmonics of its angle out, in the data and in every null draw alike
             x = turning_residuals(x, segment.rate, fs)
         for c in range(C):
             channel = noise.channels[c]
             rng = np.random.default_rng(streams[j * C + c])
             if turning:
-                # the turning signal sweeps the quantiser's codes and carries the table's rate jitter: the null is
-                # white noise at the segment's own scatter, its shape tests free of the scale
+                # the turning signal carries the table's rate jitter: the null is white noise at the segment's own
+                # scatter (its shape tests free of the scale) about the segment's own smooth signal (its mean and
+                # the table's harmonics), through the channel's quantiser, so that the quantiser shapes the null
+                # as the signal sweeps its codes along the turn just as it shapes the data
                 sd = float(np.std(x[:, c], ddof=1 + 2 * TURNING_HARMONICS))
-                if channel.quantisation_step and not sd >= TURNING_DITHERED * channel.quantisation_step:
-                    continue
-                simulated = turning_residuals((sd * rng.standard_normal((draws, x.shape[0]))).T, segment.rate, fs).T
+                q = channel.quantisation_step
+                if q and q > 0:
+                    smooth = raw[:, c] - x[:, c]
+                    sigma = turning_noise_before_quantiser(smooth, q, sd, segment.rate, fs)
+                    if not sigma >= DITHERED * q:
+                        continue  # not dithered: its samples sit on one or two codes, as at rest
+                    noisy = smooth + sigma * rng.standard_normal((draws, x.shape[0]))
+                    simulated = turning_residuals((np.round(noisy / q) * q).T, segment.rate, fs).T
+                else:
+                    simulated = turning_residuals((sd * rng.standard_normal((draws, x.shape[0]))).T, segment.rate,
+                                                  fs).T
             else:
                 sigma = before[c]
                 if sigma is not None and not sigma >= DITHERED * channel.quantisation_step:
