@@ -16,9 +16,10 @@
    procedure stops when none is significant. Each step tests the intersection hypothesis of the candidates
    still out with a min-p test at level α, so the family-wise error of the selections stays ≤ α (the
    step-down procedure of Westfall & Young 1993 is a shortcut of the closed test).
-5. **What remains**: the lack of fit of the final model and the within-segment findings; if flagged, where
-   (channels and segments) and the pattern (a trend's slope, a step's time and size, a periodic component's
-   frequency and amplitude, a burst's stretch), never named after a candidate.
+5. **What remains**: the lack of fit of the final model (the omnibus and the largest step in one channel's level
+   between segments adjacent in time) and the within-segment findings; if flagged, where (channels and segments,
+   or the step's channel, place and size) and the pattern (a trend's slope, a step's time and size, a periodic
+   component's frequency and amplitude, a burst's stretch), never named after a candidate.
 6. **Before and after**: residual r.m.s. per channel and χ²/dof, every parameter before and after with u, which
    parameters absorbed the effects, and a leave-one-segment-out prediction error with both models.
 
@@ -62,6 +63,7 @@ class Diagnosis:
     steps: tuple[tuple[CandidateScore, ...], ...]  # the scores at each step of the closed testing
     information: dict  # AIC and BIC of each model (information only)
     alpha: float
+    attribution: tuple = ()  # per selection: the runner-up and how reliably the schedule tells them apart
 
 
 def _rms_per_channel(fit) -> dict:
@@ -138,6 +140,28 @@ def _where(fit, lof: LackOfFit) -> list[dict]:
                                   "residual": float(fit.residuals[s, c]),
                                   "unit": UNITS_SI[channel_kind(c)]["mean"]} for s in rows[:10]]})
     return out
+
+
+def _attribution(best, significant) -> dict:
+    """How reliable the choice of *best* among the *significant* candidates is: the runner-up (the next strongest
+    single component), the cosine ρ of the two components' efficient scores under the null, and the probability
+    that the true one wins at this size, Φ(δ·√((1 − |ρ|)/2)) with δ = √T of the chosen one's strongest component
+    (two one-parameter models whose scores correlate by ρ: the difference of their √T is normal with mean
+    δ(1 − |ρ|) and variance 2(1 − |ρ|)); 1 with no significant runner-up."""
+    from scipy.stats import norm
+
+    others = [c for c in significant if c.effect != best.effect]
+    entry = {"effect": best.effect, "statistic": best.strongest_component(), "runner_up": None,
+             "runner_up_statistic": None, "cosine": None, "probability_correct": 1.0}
+    if not others:
+        return entry
+    runner = max(others, key=lambda c: c.strongest_component())
+    rho = abs(best.cosine_with.get(runner.effect, math.nan))
+    delta = math.sqrt(max(best.strongest_component(), 0.0))
+    probability = float(norm.cdf(delta * math.sqrt((1.0 - rho) / 2.0))) if math.isfinite(rho) else math.nan
+    entry.update(runner_up=runner.effect, runner_up_statistic=runner.strongest_component(),
+                 cosine=rho if math.isfinite(rho) else None, probability_correct=probability)
+    return entry
 
 
 def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
@@ -219,6 +243,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     first = scores
     steps = [scores]
     selected: list[str] = []
+    attribution: list[dict] = []
     extra: dict = {}
     current = before
     by_effect = {s.effect: s for s in sigs}
@@ -233,6 +258,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         # held-out prediction error (it penalised the six-component nonlinearity against the three-component
         # asymmetry: 0–1 of 5 quadratic nonlinearities at 5× were named) compares like with like.
         best = max(open_, key=lambda c: (c.strongest_component(), -c.adjusted_p_value))
+        attribution.append(_attribution(best, open_))
         signature = by_effect[best.effect]
         best_extra = dict(extra)
         for j, component in enumerate(signature.components):
@@ -273,14 +299,19 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
             sizes[effect] = {"components": [n[len(effect) + 1:-1] for n in names],
                              "value": [float(after.extra.estimate[i]) for i in idx],
                              "u": [float(after.extra.u[i]) for i in idx], "unit": unit}
+    step = lof_after.step if lof_after.flagged and lof_after.step is not None and \
+        lof_after.step["p_value"] <= lof_after.omnibus_p_value else None
     unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged),
                    "where": _where(after, lof_after) if lof_after.flagged else [],
+                   "step": None if step is None else {**step, "unit": UNITS_SI[channel_kind(
+                       CHANNELS.index(step["channel"]))]["mean"]},
                    "within_segments": [dict(item) for item in within.flagged]}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
     return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=within,
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,
                      holdout=hold, steps=tuple(steps),
-                     information={"before": _information(before), "after": _information(after)}, alpha=alpha)
+                     information={"before": _information(before), "after": _information(after)}, alpha=alpha,
+                     attribution=tuple(attribution))
 
 
 def _number(value):
@@ -299,7 +330,9 @@ def diagnosis_json(d: Diagnosis) -> dict:
     """The issue's stable keys, SI (NaN -> null)."""
     def lof(x: LackOfFit):
         return {"statistic": _number(x.statistic), "dof": int(x.dof), "p_value": _number(x.p_value),
-                "flagged": bool(x.flagged)}
+                "flagged": bool(x.flagged), "omnibus_p_value": _number(x.omnibus_p_value),
+                "step": None if x.step is None else {k: (_number(v) if isinstance(v, float) else v)
+                                                     for k, v in x.step.items()}}
 
     def side(fit, hold):
         return {"residual_rms": {k: _number(v) for k, v in _rms_per_channel(fit).items()},
@@ -326,6 +359,8 @@ def diagnosis_json(d: Diagnosis) -> dict:
             "unexplained": d.unexplained, "before": side(d.before, d.holdout["before"]),
             "after": side(d.after, d.holdout["after"]), "parameters": parameters, "absorbed": absorbed(d),
             "information": d.information, "alpha": d.alpha,
+            "attribution": [{k: (_number(v) if isinstance(v, float) else v) for k, v in a.items()}
+                            for a in d.attribution],
             "within_segment": {"alpha": d.within.alpha, "draws": d.within.draws,
                                "segments_tested": len(d.within.segments),
                                "smallest_adjusted_p_value": d.within.smallest_adjusted_p(),

@@ -28,15 +28,24 @@ p_c), estimated as (1 + #{b: min_d p*_{d,b} ≤ p_c})/(B + 1). Holm (1979) on th
 documented fallback (``method="holm"``).
 
 **Lack of fit** (segment level): L = ‖r_w‖² against the same simulated null, p = (1 + #{L*_b ≥ L})/(B + 1),
-overall and per channel (the channel's rows of r_w).
+overall and per channel (the channel's rows of r_w); and the largest **step** in one channel's level between two
+segments adjacent in time (:func:`step_columns`), max over channels and boundaries of each step column's own 1-dof
+score, against the max of the same over the null draws. A bias that jumps part-way through a run moves every later
+segment's mean: the omnibus test barely sees it, because the slow noise between segments, estimated from the
+same residuals, takes it up (a correlation time of 300 s and a σ of about half the step), while a step is one
+abrupt change where that noise changes little from one 30 s segment to the next. The two tests are held together at
+α by their min-p over the same draws (each draw's p-values its ranks among the draws).
 
 **Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
 over the rate points of one axis are both even in ω). Which one the residual is attributed to is decided by each
-candidate's strongest single component: its one-degree-of-freedom score (uᵀ r_w)²/(uᵀ M u), u = z/‖z‖ — the
-share of the whitened residual that one parameter of that effect explains, in units of its null spread. It is
-the likelihood-ratio comparison of the two one-parameter models, and unlike a p-value over the whole candidate it
-does not favour the candidate with fewer components (a six-component nonlinearity against a three-component
-asymmetry).
+candidate's strongest single component: its efficient one-degree-of-freedom score (zᵀ M⁺ r_w)²/(zᵀ M⁺ z), z = P⊥ W x
+and M = P⊥ W V Wᵀ P⊥ — what one parameter of that effect explains of the residual, by generalised least squares
+under the fitted noise. It is the likelihood-ratio comparison of the one-parameter models: by Cauchy–Schwarz in
+the M⁺ metric the true component's expected statistic is the largest. The plain projection (uᵀ r_w)²/(uᵀ M u),
+u = z/‖z‖, is not (W is a working whitening, so M is not the identity): with it an injected x asymmetry was
+named a quadratic nonlinearity in 6 of 10 jjf2003 recordings at 5×, its x2 component scoring 24–30 against the
+asymmetry's 21. Unlike a p-value over the whole candidate, neither favours the candidate with fewer components (a
+six-component nonlinearity against a three-component asymmetry).
 
 The noise-equivalent size of a component is the size at which that component alone gives its one-degree-
 of-freedom score a non-centrality of 1: sqrt(uᵀ M u)/‖z‖, z = P⊥ W x_k, u = z/‖z‖, M = P⊥ W V Wᵀ P⊥.
@@ -60,6 +69,11 @@ ALIAS_TOLERANCE = 1e-3
 #: largest (a second-order path only, such as a lever arm across an accelerometer's own axis through Ka's
 #: cross-couplings)
 EXCITATION_TOLERANCE = 1e-2
+#: the step test leaves out a channel whose segment means' predicted variance is more than this share an undithered
+#: quantiser's (jjf2003's 12-bit accelerometers: all of it). Their means sit on a few codes, V describes their
+#: scatter only roughly, and a step statistic — the largest of many 1-dof scores, sensitive to one odd segment —
+#: flagged 6 of 40 jjf2003 null recordings there at α/2 = 0.025, every one on an accelerometer
+UNDITHERED_SHARE = 0.9
 #: default number of simulated null draws
 NULL_DRAWS = 2000
 METHODS = ("westfall_young", "holm")
@@ -85,6 +99,8 @@ class CandidateScore:
     #: evidence for that component alone, which :func:`plansim.diagnose.procedure.diagnose` compares between
     #: candidates to attribute a residual (module docstring, "Attribution")
     component_statistic: np.ndarray = field(repr=False, default=None)
+    #: effect -> cosine (M⁺ metric) between this candidate's strongest component and that candidate's
+    cosine_with: dict = field(repr=False, default_factory=dict)
 
     def strongest_component(self) -> float:
         """The largest one-degree-of-freedom score statistic of the candidate's usable components (0 if none)."""
@@ -95,11 +111,18 @@ class CandidateScore:
 
 @dataclass(frozen=True)
 class LackOfFit:
+    """The segment-level lack of fit (module docstring): ``statistic`` and ``dof`` of the omnibus ‖r_w‖²,
+    ``p_value`` the family's (omnibus and step, min-p), ``flagged`` p_value < α; ``omnibus_p_value`` and
+    ``step`` (the largest step's statistic, p, channel, place and size) each against the simulated null;
+    ``per_channel`` channel -> (statistic, dof, p) of the omnibus on the channel's rows."""
+
     statistic: float
     dof: int
     p_value: float
     flagged: bool
     per_channel: dict  # channel -> (statistic, dof, p_value)
+    omnibus_p_value: float = math.nan
+    step: dict | None = None
 
 
 #: what would separate each effect from what it aliases with, when it is not identifiable
@@ -144,6 +167,31 @@ class _Geometry:
         values, vectors = np.linalg.eigh(L @ L.T)
         keep = values > 1e-12 * max(values.max(), 1e-300)
         return (vectors[:, keep] / np.sqrt(values[keep])).T @ basis.T
+
+    def _pinv(self) -> np.ndarray:
+        """M⁺, M = P⊥ W V Wᵀ P⊥ (cached)."""
+        if not hasattr(self, "_M_pinv"):
+            M = self.noise_map @ self.noise_map.T
+            values, vectors = np.linalg.eigh(M)
+            keep = values > 1e-10 * max(values.max(), 1e-300)
+            self._M_pinv = (vectors[:, keep] / values[keep]) @ vectors[:, keep].T
+        return self._M_pinv
+
+    def cosine(self, a: np.ndarray, b: np.ndarray) -> float:
+        """aᵀM⁺b / √(aᵀM⁺a · bᵀM⁺b): the correlation of the two columns' efficient scores under the null."""
+        P = self._pinv()
+        denominator = math.sqrt(max(float(a @ P @ a) * float(b @ P @ b), 0.0))
+        return float(a @ P @ b) / denominator if denominator > 0 else math.nan
+
+    def efficient_scores(self, Z: np.ndarray) -> np.ndarray:
+        """(m,) each column z of *Z* (whitened, projected)'s own efficient 1-dof score statistic
+        (zᵀ M⁺ r_w)² / (zᵀ M⁺ z), M = P⊥ W V Wᵀ P⊥ the whitened residual's null covariance (GLS in that metric:
+        W is a working whitening, so M is not the identity and the plain projection uᵀ r_w is not efficient);
+        NaN where zᵀ M⁺ z vanishes."""
+        MZ = self._pinv() @ Z
+        information = np.sum(Z * MZ, axis=0)
+        ok = information > 0
+        return np.where(ok, (MZ.T @ self.r) ** 2 / np.where(ok, information, 1.0), np.nan)
 
     def project(self, y: np.ndarray) -> np.ndarray:
         """P⊥ y along the first axis."""
@@ -216,9 +264,8 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
         spread = np.linalg.norm((Z / np.where(surviving > 0, surviving, 1.0)).T @ g.noise_map, axis=1)
         nes = np.where(usable, spread / np.where(surviving > 0, surviving, 1.0), np.inf)
-        # each component alone: its 1-dof standardised score (uᵀ r_w)² / (uᵀ M u)
-        along = (Z / np.where(surviving > 0, surviving, 1.0)).T @ g.r
-        component = np.where(usable & (spread > 0), (along / np.where(spread > 0, spread, 1.0)) ** 2, np.nan)
+        # each component alone: its efficient 1-dof score (zᵀ M⁺ r_w)² / (zᵀ M⁺ z)
+        component = np.where(usable, g.efficient_scores(Z), np.nan)
         if np.any(usable):
             u, s, _ = np.linalg.svd(Z[:, usable], full_matrices=False)
             basis = u[:, s > ALIAS_TOLERANCE * np.linalg.norm(Z[:, usable], axis=0).min()]
@@ -228,7 +275,8 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         aliased = () if not np.any(lost) else _aliases(
             fit, g, Wx[:, np.flatnonzero(lost)[np.argmin((surviving / np.maximum(norms, 1e-300))[lost])]])
         bases.append(basis)
-        raw.append((sig, usable, nes, aliased, component))
+        strongest = int(np.nanargmax(np.where(usable, component, -np.inf))) if np.any(usable) else None
+        raw.append((sig, usable, nes, aliased, component, None if strongest is None else Z[:, strongest]))
     # candidate against candidate: surviving subspaces that coincide
     same = [set() for _ in sigs]
     for i in range(len(sigs)):
@@ -271,19 +319,53 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
             for i in tested:
                 adjusted[i] = (1 + np.count_nonzero(min_p <= p[i])) / (B + 1)
     out = []
-    for i, (sig, usable, nes, aliased, component) in enumerate(raw):
+    # the cosine, in the M⁺ metric, between each pair of candidates' strongest components: how far the schedule
+    # tells the two apart (procedure: the attribution's reliability)
+    directions = {i: r[5] for i, r in enumerate(raw) if r[5] is not None and identifiable[i]}
+    cosines = [{} for _ in sigs]
+    for i in directions:
+        for j in directions:
+            if i != j:
+                cosines[i][sigs[j].effect] = g.cosine(directions[i], directions[j])
+    for i, (sig, usable, nes, aliased, component, _) in enumerate(raw):
         names = tuple(aliased) + tuple(sorted(same[i]))
         out.append(CandidateScore(sig.effect, bool(identifiable[i]), names,
                                   "" if identifiable[i] else SEPARATING.get(sig.effect, ""),
                                   float(statistic[i]), int(dof[i]), float(p[i]), float(adjusted[i]), nes,
                                   sig.components, sig.unit, usable,
-                                  np.where(identifiable[i], component, np.nan)))
+                                  np.where(identifiable[i], component, np.nan), cosines[i]))
     return tuple(out)
+
+
+def step_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+    """The columns (6S, m) of a step in one channel's level between two segments adjacent in time: for channel
+    c and the k-th boundary of the used segments in time order, 1 on c's fitted rows of every segment after it;
+    and each column's (channel, last segment before, first segment after) (indices into the fit's segments)."""
+    times = np.asarray(fit.segment_times, dtype=float)
+    S = times.size
+    order = np.argsort(times, kind="stable")
+    rows = np.asarray(fit.fitted_rows, dtype=bool)
+    columns, where = [], []
+    noise = getattr(fit, "noise", None)
+    for c in range(6):
+        if noise is not None and np.median(noise.quantisation_variance[:, c] / np.maximum(
+                noise.mean_variance[:, c], 1e-300)) > UNDITHERED_SHARE:
+            continue  # its means' noise is an undithered quantiser's, which V describes only roughly
+        for k in range(1, S):
+            column = np.zeros((S, 6))
+            column[order[k:], c] = 1.0
+            column[~rows] = 0.0
+            if column.any() and column[rows].sum() < rows[:, c].sum():  # a change, not the whole channel
+                columns.append(column.ravel())
+                where.append((c, int(order[k - 1]), int(order[k])))
+    return (np.array(columns).T if columns else np.zeros((6 * S, 0))), where
 
 
 def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
                 null: np.ndarray | None = None) -> LackOfFit:
-    """The segment-level omnibus test ‖r_w‖² against the simulated null (module docstring), and per channel."""
+    """The segment-level lack of fit against the simulated null (module docstring, "Lack of fit"): the omnibus
+    ‖r_w‖² (overall and per channel) and the largest step in one channel's level between segments adjacent in
+    time, the two held together at α by their min-p over the same null draws."""
     if not 0 < alpha < 1:
         raise ValueError(f"alpha = {alpha!r}: must be between 0 and 1")
     g = _Geometry(fit)
@@ -292,8 +374,37 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     B = null.shape[1]
     L = float(g.r @ g.r)
     L_null = np.sum(null**2, axis=0)
-    p = (1 + np.count_nonzero(L_null >= L)) / (B + 1)
+    p_omnibus = (1 + np.count_nonzero(L_null >= L)) / (B + 1)
     dof = int(g.r.size - g.Q.shape[1])
+    # the largest step: each column's own 1-dof score (uᵀ r_w)²/(uᵀ M u), maximised over channels and boundaries
+    columns, where = step_columns(fit)
+    step = None
+    p = p_omnibus
+    if columns.shape[1]:
+        Z = g.project(g.W @ columns)
+        norms = np.linalg.norm(Z, axis=0)
+        keep = norms > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(g.W @ columns, axis=0), 1e-300)
+        if np.any(keep):
+            Z, where = Z[:, keep], [w for w, k in zip(where, keep) if k]
+            U = Z / np.linalg.norm(Z, axis=0)
+            spread = np.linalg.norm(U.T @ g.noise_map, axis=1)
+            ok = spread > 0
+            U, spread, where = U[:, ok], spread[ok], [w for w, k in zip(where, ok) if k]
+            scores = (U.T @ g.r / spread) ** 2
+            null_scores = np.max((U.T @ null / spread[:, None]) ** 2, axis=0)
+            best = int(np.argmax(scores))
+            T = float(scores[best])
+            p_step = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
+            # min-p of the two over the same draws: each draw's own p-values against the others' (ranks)
+            rank_L = (B - np.argsort(np.argsort(L_null, kind="stable"), kind="stable")) / B
+            rank_T = (B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B
+            p = (1 + np.count_nonzero(np.minimum(rank_L, rank_T) <= min(p_omnibus, p_step))) / (B + 1)
+            c, before, after = where[best]
+            size = float((U[:, best] @ g.r) / (U[:, best] @ Z[:, best]))  # GLS size along the column, SI
+            step = {"statistic": T, "p_value": float(p_step), "channel": CHANNELS[c],
+                    "between": [int(fit.used[before]), int(fit.used[after])],
+                    "labels": [fit.labels[before], fit.labels[after]],
+                    "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])), "size": size}
     per_channel = {}
     for c, name in enumerate(CHANNELS):
         sel = g.channel_of_row == c
@@ -302,7 +413,7 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         Lc = float(np.sum(g.r[sel] ** 2))
         pc = (1 + np.count_nonzero(np.sum(null[sel] ** 2, axis=0) >= Lc)) / (B + 1)
         per_channel[name] = (Lc, int(sel.sum()), float(pc))
-    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel)
+    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step)
 
 
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:

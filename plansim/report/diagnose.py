@@ -60,6 +60,12 @@ def diagnose_report(d) -> str:
             parts = ", ".join(f"{c} = {v:.4g} ± {u:.2g}" for c, v, u in zip(size["components"], size["value"],
                                                                               size["u"]))
             lines.append(f"  {effect}: {parts} ({size['unit']}; ± standard uncertainty)")
+        for a in d.attribution:
+            if a["runner_up"] is not None:
+                lines.append(f"  {a['effect']} chosen over {a['runner_up']} (strongest 1-dof scores "
+                             f"{a['statistic']:.1f} against {a['runner_up_statistic']:.1f}; their signatures' cosine "
+                             f"{a['cosine']:.3f}: at this size the schedule tells them apart about "
+                             f"{100 * a['probability_correct']:.0f} % of the time)")
     else:
         lines.append("Found: no catalogue effect is significant.")
     after = d.lack_of_fit_after
@@ -72,6 +78,13 @@ def diagnose_report(d) -> str:
             segs = "; ".join(f"{s['segment']} {s['label']} ({s['residual'] / factor:+.3g} {unit}, z = {s['z']:+.1f})"
                              for s in where["segments"]) or "spread over the segments, none beyond 3u"
             lines.append(f"  {where['channel']} (p = {_p(where['p_value'])}): {segs}")
+        step = d.unexplained.get("step")
+        if step is not None:
+            c = CHANNELS.index(step["channel"])
+            unit, factor = OUTPUT_UNITS[_kind(c)]
+            lines.append(f"  a step in {step['channel']} of {step['size'] / factor:+.3g} {unit} between segment "
+                         f"{step['between'][0]} {step['labels'][0]} and {step['between'][1]} {step['labels'][1]} "
+                         f"(at about {step['at_s']:.0f} s; p = {_p(step['p_value'])})")
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
     lines += _within_lines(d)
