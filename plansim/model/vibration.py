@@ -24,7 +24,7 @@ Hann-windowed, linear phase; :func:`shaping_filter`), with the white numbers dra
 from streams derived from the seed (:mod:`plansim.kernels.vibration`): the same seed gives the same
 record in chunks of any size. The filter's own PSD (:func:`filter_psd`) and variance Σh²
 (:func:`filter_variance`) are the exact truth of the generated process; they differ from the profile
-by the window's smoothing at the band edges (0.5 % of the variance for the paper's profile at
+by the window's smoothing at the band edges (Σh² is 0.09 % short of ∫P df for the paper's profile at
 4800 Hz and 1025 taps).
 
 **The gyro model.** With the specific force f (m/s², body axes) and the true rate ω (rad/s),
