@@ -41,7 +41,7 @@ def vibration_json(result, elapsed: float, version: str) -> dict:
         "rate_true": _list(r.rate),
         "shift": {"measured": _list(result.shift), "predicted": _list(result.predicted_shift)},
         "accel_power": {"generated": _list(r.variance), "sampled": _list(result.accel_power_sampled)},
-        "truth": {"g2": result.truth.dynamic.tolist(), "columns": list(MONOMIALS)},
+        "truth": {"dynamic": result.truth.dynamic.tolist(), "columns": list(MONOMIALS)},
         "fitted": {name: c.tolist() for name, c in result.coefficients.items()},
         "errors": {name: {k: _list(v) for k, v in e.items()} for name, e in result.errors.items()},
         "paper_deg_per_h": PAPER,
