@@ -274,6 +274,47 @@ def predicted_shift(gyro: VibrationGyro, gravity_body: np.ndarray, variances: np
     return gyro.S2 @ v + 3.0 * gyro.D @ (g * v)
 
 
+def interval_moments(taps: np.ndarray, oversampling: int) -> tuple[float, float, float]:
+    """(σ², s², m₄): the process *taps*'s variance E[a²], the variance E[ā²] of the mean ā of *oversampling*
+    consecutive samples (an integrate-and-dump output sample), and E[ā² q] with q the mean of a² over the same
+    samples; (unit of h)², (unit of h)², (unit of h)⁴.
+
+    From the autocorrelation R(k) = Σ_m h[m] h[m + k]: σ² = R(0), s² = (1/n²) Σ_ij R(i − j), and, a being
+    Gaussian (Isserlis), E[ā² q] = s²σ² + (2/n) Σ_i c_i² with c_i = E[ā a_i] = (1/n) Σ_j R(i − j).
+    """
+    n = check_count("oversampling", oversampling)
+    h = np.asarray(taps, dtype=float)
+    full = np.correlate(h, h, mode="full")  # R(k) for k = −(L − 1) … L − 1
+    centre = len(h) - 1
+    lags = np.subtract.outer(np.arange(n), np.arange(n))
+    R = np.where(np.abs(lags) < len(h), full[np.clip(centre + lags, 0, len(full) - 1)], 0.0)
+    c = R.mean(axis=1)
+    s2 = float(c.mean())
+    variance = float(full[centre])
+    return variance, s2, s2 * variance + 2.0 * float(np.mean(c * c))
+
+
+def g2_fit_ratio(gravity: float, taps: np.ndarray, oversampling: int, fraction: float) -> float:
+    """Ŝ/S₂: what the least-squares g² coefficient comes out as, against the truth, when the accelerometer's
+    integrate-and-dump samples see only part of the vibration (docs/dynamic.md, "The simulation against the
+    paper").
+
+    One axis shaken along gravity (f = g + a), the column f̄² = (g + ā)² fitted without an intercept over a
+    record whose share *fraction* is under vibration, the gyro rectifying the full band: r = S₂(g² + 2gā + q),
+    q the interval mean of a². Still samples give m = g², r = S₂g²; under vibration E[m²] = g⁴ + 6g²s² + 3s⁴
+    and E[m r]/S₂ = g⁴ + g²(σ² + 5s²) + E[ā² q] (odd moments vanish), so with p = *fraction*
+
+        Ŝ/S₂ = [(1 − p) g⁴ + p (g⁴ + g²(σ² + 5s²) + E[ā² q])] / [(1 − p) g⁴ + p (g⁴ + 6g²s² + 3s⁴)],
+
+    the moments of :func:`interval_moments`. It is 1 when the accelerometer sees everything (s² = σ²,
+    E[ā² q] = 3σ⁴). Left out: the noise, the static calibration's errors, the g³ and cross terms.
+    """
+    v, s2, m4 = interval_moments(taps, oversampling)
+    g2, p = float(gravity) ** 2, float(fraction)
+    numerator = (1 - p) * g2 * g2 + p * (g2 * g2 + g2 * (v + 5 * s2) + m4)
+    return numerator / ((1 - p) * g2 * g2 + p * (g2 * g2 + 6 * g2 * s2 + 3 * s2 * s2))
+
+
 def check_count(name: str, value, low: int = 1) -> int:
     """*value* as an int ≥ *low*, or a TypeError / ValueError naming *name*."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):

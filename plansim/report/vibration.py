@@ -44,6 +44,9 @@ def vibration_json(result, elapsed: float, version: str) -> dict:
         "truth": {"dynamic": result.truth.dynamic.tolist(), "columns": list(MONOMIALS)},
         "fitted": {name: c.tolist() for name, c in result.coefficients.items()},
         "errors": {name: {k: _list(v) for k, v in e.items()} for name, e in result.errors.items()},
+        "predicted": None if result.predicted is None else {
+            "sampled_variance": result.predicted["sampled_variance"], "g2_ratio": result.predicted["g2_ratio"],
+            "static": _list(result.predicted["static"]), "g2": _list(result.predicted["g2"])},
         "paper_deg_per_h": PAPER,
     }
 
@@ -70,6 +73,17 @@ def vibration_text(result, elapsed: float) -> str:
         lines.append(f"{'mean error, ' + label:42s}" + _row(result.errors[name]["mean"]))
     for name, label in MODELS.items():
         lines.append(f"{'r.m.s. of 1 s means, ' + label:42s}" + _row(result.errors[name]["rms_averaged"]))
+    if result.predicted is not None:
+        p = result.predicted
+        lines += [
+            f"{'predicted mean error, ' + MODELS['static']:42s}" + _row(p["static"]),
+            f"{'predicted mean error, ' + MODELS['g2']:42s}" + _row(p["g2"]),
+            "",
+            f"fitted g² coefficient / truth: "
+            f"{', '.join(f'{c:.2f}' for c in result.coefficients['g2'][:, 2] / result.truth.S2[:, 2])} (x, y, z); "
+            f"predicted {p['g2_ratio']:.2f} (the 2.5 ms samples see {p['sampled_variance'] / G2_PER_HZ:.2f} of "
+            f"{r.variance[2] / G2_PER_HZ:.2f} g^2; predictions without noise or calibration errors)",
+        ]
     lines += ["", f"the paper: shift ≈ {PAPER['shift']:g} deg/h, compensation {PAPER['before']} -> {PAPER['after']} "
                   "deg/h (docs/dynamic.md compares)"]
     return "\n".join(lines)

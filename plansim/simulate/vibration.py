@@ -47,6 +47,8 @@ from plansim.model.vibration import (
     check_count,
     filter_variance,
     flat_profile,
+    g2_fit_ratio,
+    interval_moments,
     paper_profile,
     predicted_shift,
     seed_key,
@@ -334,6 +336,7 @@ class VibrationResult:
     psd: dict                       # "frequency", "gyro", "accel", "profile"
     accel_power_sampled: np.ndarray  # (3,) variance of the 2.5 ms accelerometer output during vibration, (m/s²)²
     rate_estimates: dict            # "static", "g2_g3": (n, 3) rad/s
+    predicted: dict | None          # predicted_errors(), or None unless the shaken axis is z alone
 
 
 def run_vibration_experiment(settings: VibrationExperiment | None = None, seed: int = 20200612,
@@ -366,4 +369,25 @@ def run_vibration_experiment(settings: VibrationExperiment | None = None, seed: 
         psd={"frequency": freq, "gyro": p_gyro, "accel": p_accel, "profile": settings.psd_profile().level(freq)},
         accel_power_sampled=record.accel[record.during].var(axis=0),
         rate_estimates={"static": estimates["static"], "g2_g3": estimates["g2_g3"]},
+        predicted=predicted_errors(settings, record) if settings.vibration_axes == "z" else None,
     )
+
+
+def predicted_errors(settings: VibrationExperiment, record: VibrationRecord) -> dict:
+    """What the model predicts for a shaker along z (gravity's axis), without noise or calibration errors.
+
+    ``sampled_variance``: E[ā²] of the integrate-and-dump accelerometer samples, (m/s²)²
+    (:func:`plansim.model.vibration.interval_moments`); ``g2_ratio``: the fitted g² coefficient over the true
+    one (:func:`plansim.model.vibration.g2_fit_ratio`); ``static`` (3,), rad/s: the mean error of the static
+    model during vibration, S₂(g² + σ²) + D(g³ + 3gσ²) (the g² and g³ terms at rest included, since the
+    static model has none); ``g2`` (3,): that minus what the fitted column removes, Ŝ(g² + s²).
+    """
+    truth = settings.gyro()
+    g = record.gravity[2]
+    variance, sampled, _ = interval_moments(record.taps, settings.oversampling)
+    fraction = float(np.mean(record.during))
+    ratio = g2_fit_ratio(g, record.taps, settings.oversampling, fraction)
+    S, D = truth.S2[:, 2], truth.D[:, 2]
+    static = S * (g * g + variance) + D * (g**3 + 3 * g * variance)
+    return {"sampled_variance": sampled, "g2_ratio": ratio, "static": static,
+            "g2": static - ratio * S * (g * g + sampled)}
