@@ -55,7 +55,7 @@ from plansim.model.vibration import (
     shaped_samples,
     shaping_filter,
 )
-from plansim.units import DEG, HOUR, KINDS, MICRO_G, STANDARD_GRAVITY, parse_quantity
+from plansim.units import DEG, HOUR, MICRO_G, STANDARD_GRAVITY, parse_quantity
 
 #: the streams of a record (:func:`plansim.model.vibration.shaped_samples`)
 STREAM_VIBRATION, STREAM_GYRO_NOISE, STREAM_ACCEL_NOISE, STREAM_CALIBRATION = 0, 3, 6, 9
@@ -229,23 +229,13 @@ def with_overrides(settings: VibrationExperiment, overrides) -> VibrationExperim
             try:
                 changes[key] = int(text)
             except ValueError:
-                raise ValueError(f"--set {item!r}: {key} expects an integer") from None
+                raise ValueError(f"--set {item!r}: {key} expects an integer >= {FIELDS[key][1]}") from None
         else:
-            value = float(text) if kind == "dimensionless" and _is_number(text) else text
-            try:
-                changes[key] = parse_quantity(value, kind, key)
+            try:  # a bare number is a dimensionless quantity with the unit ''
+                changes[key] = parse_quantity(text, kind, key)
             except ValueError as exc:
-                raise ValueError(f"--set {item!r}: {exc}; units of {kind}: "
-                                 f"{', '.join(u for u in KINDS[kind] if u)}") from None
+                raise ValueError(f"--set {item!r}: {exc}") from None
     return dataclasses.replace(settings, **changes, overrides=tuple(settings.overrides) + tuple(overrides))
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 @dataclass(frozen=True)
