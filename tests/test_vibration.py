@@ -216,3 +216,10 @@ def test_cli_bad_input_exits_2_naming_the_field(capsys):
     assert "--trials 5: not available with the experiment vibration_g2" in capsys.readouterr().err
     assert cli.main(["run", "vibration_g2", "--seed", "-1"]) == 2
     assert "--seed -1: must be >= 0" in capsys.readouterr().err
+
+
+def test_scenarios_lists_vibration_g2_as_an_experiment_last(capsys):
+    assert cli.main(["scenarios"]) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.startswith("vibration_g2 ")
+    assert "[experiment, not a scenario file: plansim run vibration_g2 [--set KEY=VALUE]]" in last
