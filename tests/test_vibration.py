@@ -214,6 +214,8 @@ def test_cli_bad_input_exits_2_naming_the_field(capsys):
     assert err.startswith("plansim: error: oversampling: 3") and "allowed" in err
     assert cli.main(["run", "vibration_g2", "--trials", "5"]) == 2
     assert "--trials 5: not available with the experiment vibration_g2" in capsys.readouterr().err
+    assert cli.main(["run", "vibration_g2", "--path", "segment"]) == 2
+    assert "--path segment: not available with the experiment vibration_g2" in capsys.readouterr().err
     assert cli.main(["run", "vibration_g2", "--seed", "-1"]) == 2
     assert "--seed -1: must be >= 0" in capsys.readouterr().err
 

@@ -31,6 +31,9 @@ def run_vibration(args, default_chunk_size: int) -> int:
         if value is not None:
             raise ValueError(f"{option} {value!r}: not available with the experiment vibration_g2 (one simulated "
                              "record; its settings change with --set KEY=VALUE)")
+    if args.path != "auto":
+        raise ValueError(f"--path {args.path}: not available with the experiment vibration_g2 (it has one simulation "
+                         "path of its own, plansim/simulate/vibration.py)")
     if args.chunk_size != default_chunk_size:
         raise ValueError(f"--chunk-size {args.chunk_size}: not available with the experiment vibration_g2 "
                          "(the record does not depend on its chunks)")
