@@ -52,6 +52,13 @@ KINDS: dict[str, dict[str, float]] = {
         "mg/(rad/s)^2": MILLI_G,
         "ug/(rad/s)^2": MICRO_G,
     },
+    # one-sided acceleration power spectral density, (m/s^2)^2/Hz (random vibration, docs/dynamic.md)
+    "acceleration_psd": {"(m/s^2)^2/Hz": 1.0, "g^2/Hz": STANDARD_GRAVITY**2},
+    # g³ sensitivity, rad/s per (m/s^2)^3
+    "rate_per_acceleration_cubed": {
+        "rad/s/(m/s^2)^3": 1.0,
+        "deg/h/g^3": DEG / HOUR / STANDARD_GRAVITY**3,
+    },
     # accelerometer K2: output per squared input, 1/(m/s^2)
     "per_acceleration": {"1/(m/s^2)": 1.0, "ug/g^2": 1e-6 / STANDARD_GRAVITY, "1/g": 1.0 / STANDARD_GRAVITY},
     # gyro nonlinearity coefficients: quadratic 1/(rad/s), cubic 1/(rad/s)^2

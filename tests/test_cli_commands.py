@@ -55,8 +55,9 @@ def test_scenarios_are_aligned_whatever_the_length_of_the_names(capsys, monkeypa
     monkeypatch.setattr(plansim.io.scenario_file, "builtin_scenarios", lambda: {**builtins, long_name: path})
     assert cli.main(["scenarios"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    # the scenarios, then the procedures (run on a unit scenario), in the same columns
-    assert [line.split()[0] for line in lines] == [*builtins, long_name, *cli.simulation.PROCEDURES]
+    # the scenarios, then the procedures (run on a unit scenario) and the experiments, in the same columns
+    assert [line.split()[0] for line in lines] == [*builtins, long_name, *cli.simulation.PROCEDURES,
+                                                   *cli.simulation.EXPERIMENTS]
     starts = {re.match(r"\S+\s+", line).end() for line in lines}
     assert len(starts) == 1, lines  # every description starts in the same column
     assert starts.pop() == len(long_name) + 2

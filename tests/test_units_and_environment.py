@@ -60,6 +60,10 @@ CONVERSIONS = [
     ("rate_per_acceleration_squared", "2 deg/h/g^2", 2 * PI / 180 / 3600 / G0**2),
     ("rate_per_acceleration_squared", "1 deg/s/g^2", PI / 180 / G0**2),
     ("rate_per_acceleration_squared", "3 rad/s/(m/s^2)^2", 3.0),
+    ("acceleration_psd", "0.04 g^2/Hz", 0.04 * G0**2),
+    ("acceleration_psd", "2 (m/s^2)^2/Hz", 2.0),
+    ("rate_per_acceleration_cubed", "0.01 deg/h/g^3", 0.01 * PI / 180 / 3600 / G0**3),
+    ("rate_per_acceleration_cubed", "3 rad/s/(m/s^2)^3", 3.0),
     # P: µg/(rad/s)² = 1e-6·9.80665 m/s² per (rad/s)²
     ("acceleration_per_rate_squared", "40 ug/(rad/s)^2", 40e-6 * G0),
     ("acceleration_per_rate_squared", "2 mg/(rad/s)^2", 2e-3 * G0),

@@ -8,6 +8,7 @@ import time
 
 from plansim.cli.common import COMMANDS, add_set_option
 from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, VALIDATE_REFUSAL, run_jjf1535
+from plansim.cli.vibration import EXPERIMENTS, run_vibration
 from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
 from plansim.report.progress import end_progress_line
@@ -28,6 +29,8 @@ def _cmd_run(args) -> int:
 
     if args.scenario in PROCEDURES:  # a built-in procedure run on a unit scenario, not a scenario file
         return run_jjf1535(args, DEFAULT_CHUNK_SIZE)
+    if args.scenario in EXPERIMENTS:  # a built-in experiment with its own settings (--set), not a scenario file
+        return run_vibration(args, DEFAULT_CHUNK_SIZE)
     if args.unit is not None:
         raise ValueError(f"--unit {args.unit!r}: only with a procedure ({', '.join(PROCEDURES)}: plansim run "
                          f"jjf1535 --unit SCENARIO); the scenario {args.scenario!r} is its own unit")
@@ -107,11 +110,13 @@ def _cmd_scenarios(args) -> int:
     for name, path in builtin_scenarios().items():
         with open(path, "rb") as fh:
             descriptions[name] = tomllib.load(fh).get("description", "")
-    width = max(map(len, [*descriptions, *PROCEDURES]), default=0)
+    width = max(map(len, [*descriptions, *PROCEDURES, *EXPERIMENTS]), default=0)
     for name, description in descriptions.items():
         print(f"{name:{width}s}  {description}".rstrip())
     for name, description in PROCEDURES.items():  # one line each too, marked: not scenario files
         print(f"{name:{width}s}  [procedure, not a scenario file: plansim run {name} --unit SCENARIO] {description}")
+    for name, description in EXPERIMENTS.items():
+        print(f"{name:{width}s}  [experiment, not a scenario file: plansim run {name} [--set KEY=VALUE]] {description}")
     return 0
 
 
@@ -206,10 +211,11 @@ def add_commands(sub) -> None:
     p = sub.add_parser("run", help=COMMANDS["run"],
                        description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A; "
                                    "'plansim run jjf1535 [--unit SCENARIO]': the JJF 1535-2015 procedure on a unit "
-                                   "scenario, compared with its Appendix A")
+                                   "scenario, compared with its Appendix A; 'plansim run vibration_g2': the vibration "
+                                   "paper's g² experiment (docs/dynamic.md)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003; or the "
-                        "procedure jjf1535")
+                        "procedure jjf1535, or the experiment vibration_g2")
     p.add_argument("--unit", default=None, metavar="SCENARIO",
                    help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
                         f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
@@ -218,7 +224,8 @@ def add_commands(sub) -> None:
                    help="number of simulated calibrations (default: the scenario's; jjf1535: 1000)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's, or the unit's)")
     p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
-    p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg)")
+    p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg); "
+                   "vibration_g2: the PSDs and the compensated output")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
     p.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
                    help="trials per kernel call (results do not depend on it; memory grows with it)")

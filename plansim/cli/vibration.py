@@ -1,0 +1,61 @@
+"""``plansim run vibration_g2``: the vibration paper's g² experiment, simulated and reduced (docs/dynamic.md).
+
+Like ``jjf1535`` it is built in, not a scenario file: its settings are
+:class:`plansim.simulate.vibration.VibrationExperiment`, changed with ``--set KEY=VALUE``
+(:data:`plansim.simulate.vibration.FIELDS`).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+#: the built-in experiments (``plansim run NAME``), with a description
+EXPERIMENTS = {
+    "vibration_g2": "the vibration paper's experiment: 100 s still, 300 s random vibration (0.04 g^2/Hz, "
+                    "6.06 g rms), 100 s still; gyro output shift from g^2, Welch PSD, static vs g^2 compensation",
+}
+#: ``--seed``'s default (the paper's date)
+DEFAULT_SEED = 20200612
+
+
+def run_vibration(args, default_chunk_size: int) -> int:
+    """``plansim run vibration_g2``: every check first, then the record, the reduction and the report."""
+    from plansim.io.files import OutputSet, check_output_path
+    from plansim.io.recording import plansim_version
+    from plansim.report.plot import FIGURE_SUFFIXES
+    from plansim.report.vibration import vibration_figure, vibration_json, vibration_text
+    from plansim.simulate.vibration import VibrationExperiment, run_vibration_experiment, with_overrides
+
+    for option, value in (("--out", args.out), ("--unit", args.unit), ("--trials", args.trials)):
+        if value is not None:
+            raise ValueError(f"{option} {value!r}: not available with the experiment vibration_g2 (one simulated "
+                             "record; its settings change with --set KEY=VALUE)")
+    if args.path != "auto":
+        raise ValueError(f"--path {args.path}: not available with the experiment vibration_g2 (it has one simulation "
+                         "path of its own, plansim/simulate/vibration.py)")
+    if args.chunk_size != default_chunk_size:
+        raise ValueError(f"--chunk-size {args.chunk_size}: not available with the experiment vibration_g2 "
+                         "(the record does not depend on its chunks)")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    settings = with_overrides(VibrationExperiment(), args.set)
+    seed = DEFAULT_SEED if args.seed is None else args.seed
+
+    with OutputSet() as outputs:
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        start = time.perf_counter()
+        result = run_vibration_experiment(settings, seed=seed)
+        elapsed = time.perf_counter() - start
+        if plot is not None:
+            vibration_figure(result, plot, format=args.plot.rsplit(".", 1)[-1])
+        outputs.commit()
+    if args.json:
+        print(json.dumps(vibration_json(result, elapsed, plansim_version()), indent=2))
+    else:
+        print(vibration_text(result, elapsed))
+        if args.plot:
+            print(f"\nwrote figure: {args.plot}")
+    return 0
