@@ -211,6 +211,33 @@ def test_the_attribution_says_how_reliably_the_schedule_tells_two_candidates_apa
     assert _attribution(best, [best])["probability_correct"] == 1.0
 
 
+def test_a_bias_step_between_segments_is_unexplained_and_placed():
+    """A step of 20 times a gx segment mean's standard uncertainty from the middle sample of a linear_gaussian
+    recording (no quantiser): the lack of fit flags it and its step test places it on gx at the boundary where
+    it happened (segment 22 holds the middle sample), and the report says so; never named after a candidate
+    other than a drift (a step and a linear drift correlate). Power: at 10× this seed gave p = 0.036 (jjf2003:
+    flagged in 6 of 10 recordings at 10×); at 20× the non-centrality is four times that."""
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=9, trial=0)
+    site = resolve_site(scenario=scenario)
+    base = fit_recording(recording, site, scenario.turntable)
+    u = float(np.median(np.sqrt(np.diag(base.covariance)).reshape(-1, 6)[:, 0]))
+    samples = np.array(recording.samples, dtype=float)
+    middle = samples.shape[0] // 2
+    samples[middle:, 0] += 20 * u
+    stepped = type(recording)(samples, recording.schedule, dict(recording.attrs))
+    d = diagnose(stepped, site, scenario.turntable, null_draws=500)
+    step = d.lack_of_fit.step
+    assert d.lack_of_fit.flagged and step["channel"] == "gx"
+    starts = np.cumsum([0] + [s.samples for s in recording.schedule.segments])
+    holding = int(np.searchsorted(starts, middle, side="right") - 1)
+    assert holding in step["between"] and step["size"] > 0
+    assert set(d.selected) <= {"bias_drift"}
+    if not d.selected:
+        assert d.unexplained["step"]["channel"] == "gx"
+        assert "a step in gx" in diagnose_report(d)
+
+
 def test_json_keys_and_the_command(tmp_path, capsys):
     scenario = _scenario("linear_gaussian", gyro_asymmetry=np.array([3e-3, 0.0, 0.0]))
     recording = simulate_and_record(scenario, seed=3, trial=0)
