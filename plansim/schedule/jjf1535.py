@@ -42,6 +42,7 @@ segment means by the JJF 1535 Monte Carlo.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -170,26 +171,36 @@ class Jjf1535Procedure:
         return (self.room_temperature,) + tuple(r.temperature for r in self.temperature_runs)
 
     def recording_starts(self) -> np.ndarray:
-        """Time of each segment's first sample from the start of the schedule, s, shape (S,): the schedule's
-        clock, each segment's settle then its samples (as ``plansim.io.recording_data.nominal_time``)."""
-        clock, out = 0.0, []
-        for segment in self.schedule.segments:
-            clock += segment.settle
-            out.append(clock)
-            clock += segment.samples / segment.sample_rate
-        return np.array(out)
+        """Time of each segment's first sample from the start of the schedule, s, shape (S,), read-only: the
+        schedule's clock, each segment's settle then its samples (as ``plansim.io.recording_data.nominal_time``)."""
+        return self._clock[0]
 
     def power_cycles(self) -> tuple[np.ndarray, np.ndarray]:
         """Per segment, the index into :attr:`power_on` of the power cycle it is recorded in and the time of its
-        first sample since that power-on (s); shapes (S,). Without power-on times: cycle 0, time ``inf``."""
-        starts = self.recording_starts()
+        first sample since that power-on (s); shapes (S,), read-only. Without power-on times: cycle 0, time
+        ``inf``."""
+        return self._clock[1], self._clock[2]
+
+    @functools.cached_property
+    def _clock(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        # computed once per procedure (the Monte Carlo asks for it in every trial)
+        clock, starts = 0.0, []
+        for segment in self.schedule.segments:
+            clock += segment.settle
+            starts.append(clock)
+            clock += segment.samples / segment.sample_rate
+        starts = np.array(starts)
         if not self.power_on:
-            return np.zeros(starts.size, dtype=np.int64), np.full(starts.size, np.inf)
-        on = np.asarray(self.power_on, dtype=float)
-        cycle = np.searchsorted(on, starts, side="right") - 1
-        if np.any(cycle < 0):
-            raise ValueError("power_on: the first power-on must come before the first segment's first sample")
-        return cycle.astype(np.int64), starts - on[cycle]
+            cycle, since = np.zeros(starts.size, dtype=np.int64), np.full(starts.size, np.inf)
+        else:
+            on = np.asarray(self.power_on, dtype=float)
+            cycle = np.searchsorted(on, starts, side="right") - 1
+            if np.any(cycle < 0):
+                raise ValueError("power_on: the first power-on must come before the first segment's first sample")
+            cycle, since = cycle.astype(np.int64), starts - on[cycle]
+        for array in (starts, cycle, since):
+            array.flags.writeable = False
+        return starts, cycle, since
 
 
 # the heading that puts the gyro's input axis East–West when another axis is up (body_to_level: axis i+1 -> East
