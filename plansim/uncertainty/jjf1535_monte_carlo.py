@@ -10,7 +10,14 @@ noise, its effects and the laboratory stay the scenario's.
   rate smoothness 0.05 %), a two-axis position table of 3″, a 6½-digit acquisition (21 bits);
 - :func:`jjf1535_monte_carlo` — N trials, each a different unit, reduced by
   :func:`plansim.estimate.jjf1535_items.reduce_items`, against :func:`~plansim.estimate.jjf1535_items.true_items`;
-  :meth:`Jjf1535MonteCarlo.summary` compares the scale factor and the bias with Appendix A's U.
+  :meth:`Jjf1535MonteCarlo.summary` compares the scale factor and the bias with Appendix A's U, and shows the
+  distribution of the reported figure for the items without a true value and for threshold, resolution, warm-up
+  time and the repeatabilities (:data:`FIGURE_ALSO`).
+
+The unit's JJF 1535 effects (dead zone, resolution, warm-up transient, turn-on bias per power cycle;
+:mod:`plansim.model.jjf1535_effects`) are not in the kernels: the kernels simulate the unit without them and
+:func:`plansim.simulate.jjf1535_effects.apply_jjf1535_effects` adds them to each trial's segment means in closed
+form, before the reduction. With none set, nothing is added and the results are those of the kernels alone.
 
 The angle random walk of 7.2.13 needs the samples of one recording: :func:`plansim.runner.jjf1535_angle_random_walk`.
 """
