@@ -14,6 +14,7 @@ import pytest
 from plansim import cli
 from plansim.config import parse_scenario
 from plansim.estimate.jjf1535_items import reduce_items, true_items
+from plansim.model.environment import EARTH_RATE
 from plansim.model.jjf1535_effects import exponential_segment_mean, input_response
 from plansim.model.parameters import unpack
 from plansim.runner import jjf1535_run
@@ -92,6 +93,23 @@ def test_threshold_zero_noise_identity(ideal_document, dead_zone, reported):
     got, want, _kg = _noise_free(ideal_document, jjf1535_procedure(100 * DEG), gyro_dead_zone=dead_zone * DEG)
     assert want["threshold"] == dead_zone * DEG
     assert got["threshold"] == reported * DEG
+
+
+def test_a_threshold_above_every_tested_rate_is_undetermined(ideal_document):
+    """A dead zone of 0.2 °/s, above the largest threshold rate (0.1 °/s): every rate of both directions reads 0,
+    eq. (13) fails at the first, and the threshold is NaN (undetermined), whichever direction fails."""
+    got, want, _kg = _noise_free(ideal_document, jjf1535_procedure(100 * DEG), gyro_dead_zone=0.2 * DEG)
+    assert math.isnan(got["threshold"]) and want["threshold"] == 0.2 * DEG
+    got, _want, _kg = _noise_free(ideal_document, jjf1535_procedure(100 * DEG), gyro_dead_zone=0.0)
+    assert got["threshold"] == 0.001 * DEG  # none: the smallest tested rate
+    # with the Earth rate's vertical component E (0.0027 °/s) and d = 0.1 °/s + E/2, the + direction senses
+    # 0.1 + E >= d and reports 0.1 °/s, the − direction senses 0.1 − E < d at every rate: undetermined, so the
+    # threshold is (the second direction's NaN is not dropped by taking the larger)
+    ideal_document["environment"]["earth_rate"] = True
+    vertical = EARTH_RATE * math.sin(parse_scenario(ideal_document).environment.latitude)
+    got, _want, _kg = _noise_free(ideal_document, jjf1535_procedure(100 * DEG),
+                                  gyro_dead_zone=0.1 * DEG + vertical / 2)
+    assert math.isnan(got["threshold"])
 
 
 def test_resolution_zero_noise_identity(ideal_document):

@@ -146,7 +146,7 @@ def _threshold_resolution_warm_up(means: np.ndarray, procedure: Jjf1535Procedure
             rates = np.array([sched.segments[k].rate for k in run.points])
             zero = 0.5 * (means[run.rest_before, i] + means[run.rest_after, i])
             per_direction.append(threshold(K, rates, means[list(run.points), i], zero))
-        out["threshold"] = max(per_direction)  # NaN if a direction is undetermined
+        out["threshold"] = _larger(per_direction)
     if procedure.resolution_pairs:
         # eq. (14) per direction on the output increments F(base + ΔΩ_j) − F(base); the larger (7.2.7.1 f))
         per_direction = []
@@ -154,10 +154,16 @@ def _threshold_resolution_warm_up(means: np.ndarray, procedure: Jjf1535Procedure
             increments = sign * np.asarray(procedure.resolution_increments)  # as commanded
             output_increments = np.array([means[b, i] - means[a, i] for a, b in pairs])
             per_direction.append(resolution(K, increments, output_increments))
-        out["resolution"] = max(per_direction)
+        out["resolution"] = _larger(per_direction)
     if procedure.warm_up:
         out["warm_up_time"] = _mean_warm_up_time([means[list(rec), i] / K for rec in procedure.warm_up], procedure)
     return out
+
+
+def _larger(per_direction: list[float]) -> float:
+    """7.2.6.1 e), 7.2.7.1 f): the larger of the two directions' figures; NaN if either is undetermined (Python's
+    ``max`` would drop a NaN that comes second)."""
+    return math.nan if any(math.isnan(x) for x in per_direction) else max(per_direction)
 
 
 def _mean_warm_up_time(records: list[np.ndarray], procedure: Jjf1535Procedure) -> float:
