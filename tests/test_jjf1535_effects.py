@@ -17,10 +17,12 @@ from plansim.estimate.jjf1535_items import reduce_items, true_items
 from plansim.model.environment import EARTH_RATE
 from plansim.model.jjf1535_effects import exponential_segment_mean, input_response
 from plansim.model.parameters import unpack
+from plansim.report.jjf1535 import GROUPS, items_json, items_table
 from plansim.runner import jjf1535_run
 from plansim.schedule.jjf1535 import jjf1535_procedure
 from plansim.simulate.chunks import simulate_recording
 from plansim.simulate.jjf1535_effects import TURN_ON_STREAM, apply_jjf1535_effects, input_axis_rates
+from plansim.uncertainty.jjf1535_monte_carlo import Jjf1535MonteCarlo
 from plansim.units import DEG, HOUR
 
 DEG_H = DEG / HOUR
@@ -110,6 +112,22 @@ def test_a_threshold_above_every_tested_rate_is_undetermined(ideal_document):
     got, _want, _kg = _noise_free(ideal_document, jjf1535_procedure(100 * DEG),
                                   gyro_dead_zone=0.1 * DEG + vertical / 2)
     assert math.isnan(got["threshold"])
+
+
+def test_the_summary_counts_undetermined_trials_and_reports_the_others():
+    """Three trials of a threshold, one undetermined (NaN): the row says 1/3 and its statistics are those of the
+    other two (mean error (0.01 + 0.016)/2 − 0.005 °/s); the text report and the JSON say so too."""
+    items = ("threshold",)
+    values = np.array([[0.01], [np.nan], [0.016]]) * DEG
+    truth = np.full((3, 1), 0.005 * DEG)
+    result = Jjf1535MonteCarlo("unit", 3, 1, "segment", items, values, truth)
+    row = result.summary()[0]
+    assert row["undetermined"] == pytest.approx(1 / 3)
+    assert row["mean_error"] == pytest.approx(0.013 - 0.005) and row["mean"] == pytest.approx(0.013)
+    assert items_json([row])[0]["undetermined"] == pytest.approx(1 / 3)
+    assert "undetermined in 33.3 % of trials" in items_table([row] + [
+        {"item": name, "clause": "", "unit": "", "truth": 0.0, "mean_error": 0.0, "std_error": 0.0, "mc_U95": 0.0}
+        for _title, names in GROUPS for name in names if name != "threshold"])
 
 
 def test_resolution_zero_noise_identity(ideal_document):
