@@ -50,6 +50,7 @@ from plansim.simulate.chunks import (
     iterate_blocks,
     simulate_recording,
 )
+from plansim.simulate.jjf1535_effects import without_jjf1535_effects
 from plansim.simulate.paths import PATH_NAMES, choose_path
 from plansim.uncertainty import APPENDIX_A, AppendixABudget
 from plansim.uncertainty.chapter_comparison import CHAPTER_TURN_RATE, MisalignmentComparison, compare_misalignment
@@ -505,7 +506,8 @@ def jjf1535_angle_random_walk(scenario: Scenario | str = "jjf2003", seed: int | 
     sc = _scenario_of(scenario)
     seed = sc.seed if seed is None else seed
     world, procedure = jjf1535_scenario(sc, procedure, keep_table)
-    samples, means, _truth = simulate_recording(world, seed, trial)
+    # the record of 7.2.13 is long after every power-on: the JJF 1535 effects (added to means only) left out
+    samples, means, _truth = simulate_recording(without_jjf1535_effects(world), seed, trial)
     K = reduce_items(means, procedure, sc.reduction.reference_gravity)["scale_factor"]
     schedule = procedure.schedule
     start = int(segment_first_samples(schedule)[procedure.allan])

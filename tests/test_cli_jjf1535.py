@@ -16,7 +16,7 @@ from plansim.estimate.jjf1535_items import ITEMS
 from plansim.io.scenario_file import load_scenario
 from plansim.report.jjf1535 import GROUPS, ITEM_KEYS, LABELS, NOT_SIMULATED, SI_UNITS
 from plansim.runner import jjf1535_run
-from plansim.uncertainty.jjf1535_monte_carlo import jjf1535_monte_carlo
+from plansim.uncertainty.jjf1535_monte_carlo import FIGURE_ALSO, jjf1535_monte_carlo
 
 TRIALS, SEED = 50, 3
 
@@ -63,10 +63,11 @@ def test_the_text_report_groups_the_items_as_the_certificate_with_their_units(ca
     assert bias.count("Appendix A.2 U = 1.1e-03 (relative)") == 2  # B0 and the up/down mean
     assert "reported figure: mean" in bias  # the bias stability has no true value
     assert "angle random walk" in bias and "deg/sqrt(h)" in bias
-    for item in ("threshold", "resolution", "warm-up time", "bias repeatability", "scale factor repeatability",
-                 "bandwidth"):
-        assert f"  {item} " in sections["Not simulated"]
-    assert len(NOT_SIMULATED) == 6
+    assert "reported figure: mean" in sections["Threshold, resolution, warm-up time"]  # a tested rate, its scatter
+    assert "  bandwidth " in sections["Not simulated"]
+    for item in ("threshold", "resolution", "warm-up time", "bias repeatability", "SF repeatability"):
+        assert f"  {item} " not in sections["Not simulated"]
+    assert len(NOT_SIMULATED) == 1
 
 
 def test_the_json_has_stable_keys_and_the_numbers_of_the_python_summary_in_si(capsys):
@@ -85,11 +86,17 @@ def test_the_json_has_stable_keys_and_the_numbers_of_the_python_summary_in_si(ca
         if "mean_error" in row:
             for key in ("truth", "mean_error", "std_error", "mc_U95"):
                 assert item[key] == pytest.approx(row[key] * scale, rel=1e-12, abs=1e-300), (row["item"], key)
-            assert item["figure"] is None
+            if "mean" in row:  # threshold, resolution, warm-up time, the repeatabilities: the figure's scatter too
+                assert row["item"] in FIGURE_ALSO
+                assert item["figure"] == pytest.approx({k: row[k] * scale for k in ("mean", "std", "q025", "q975")},
+                                                       rel=1e-12)
+            else:
+                assert item["figure"] is None
         else:
             assert all(item[key] is None for key in ("truth", "mean_error", "std_error", "mc_U95"))
             assert item["figure"] == pytest.approx({k: row[k] * scale for k in ("mean", "std", "q025", "q975")},
                                                    rel=1e-12)
+        assert item["undetermined"] == row["undetermined"] == 0.0
         budgeted = ("budget_U", "coverage", "mean_relative_error", "std_relative_error", "mc_U95_relative")
         if "budget" in row:
             assert item["budget"] == row["budget"]

@@ -39,7 +39,9 @@ def _small():
 def test_zero_noise_identity(ideal_document, reference_temperature):
     """The ideal world (no noise, no table error, no Earth rate, no quantisation) with temperature coefficients
     and an asymmetry on the x gyro: every item with a true value comes back to round-off, except eq. (15)–(17)'s
-    bias, whose axis-up record also holds G[x, x]·g (checked below by hand: offset = G[x, x]·g/K)."""
+    bias, whose axis-up record also holds G[x, x]·g (checked below by hand: offset = G[x, x]·g/K), and the
+    threshold and resolution of a unit without a dead zone or resolution (truth 0), which the procedure reports as
+    its smallest tested rate (the JJF 1535 effects themselves: tests/test_jjf1535_effects.py)."""
     procedure = _small()
     zeros = np.zeros(3)
     scenario, means, truth = _session(
@@ -63,8 +65,13 @@ def test_zero_noise_identity(ideal_document, reference_temperature):
             assert math.isnan(want[item]) and got[item] == pytest.approx(0.0, abs=1e-15)
             continue
         expected = want[item] + (p["G"][0, 0] * g / K if item == "bias" else 0.0)
+        if item in ("threshold", "resolution"):
+            # no dead zone or resolution (truth 0): the procedure reports its smallest tested rate (increment)
+            assert want[item] == 0.0
+            expected = procedure.resolution_increments[-1]
         scale = ITEMS[item][3]
-        assert abs(got[item] - expected) <= 1e-9 * scale + 1e-12 * abs(expected), item
+        tolerance = 1e-12 if item == "scale_repeatability" else 1e-9 * scale  # eq. (10) of three equal K: round-off
+        assert abs(got[item] - expected) <= tolerance + 1e-12 * abs(expected), item
 
 
 def test_earth_rate_enters_the_axis_up_bias_and_the_x_g_sensitivity(ideal_document):

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -98,6 +98,22 @@ class Effects:
     accel_lever_arm: np.ndarray  # 3×3, row i = position of accelerometer i from the table axis, m
     gyro_output_range: float  # rad/s; inf = no saturation
     accel_output_range: float  # m/s²
+    # the effects JJF 1535-2015 measures (7.2.6, 7.2.7, 7.2.9, 7.2.11); applied to the segment means of the JJF 1535
+    # Monte Carlo only (plansim.simulate.jjf1535_effects); the JJF 2003 kernels refuse a scenario that sets one
+    gyro_dead_zone: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s: |w_i| below it -> no output
+    gyro_resolution: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s: input steps of this size
+    gyro_warm_up_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s of output at power-on
+    gyro_warm_up_time_constant: np.ndarray = field(default_factory=lambda: np.zeros(3))  # s
+    gyro_turn_on_bias: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s: σ per power cycle
+
+    def jjf1535_effects_set(self) -> tuple[str, ...]:
+        """The names of :data:`JJF1535_EFFECTS` this unit sets (non-zero), in that order."""
+        return tuple(name for name in JJF1535_EFFECTS if np.any(np.asarray(getattr(self, name)) != 0))
+
+
+#: the effects of :class:`Effects` that only the JJF 1535 Monte Carlo simulates (on segment means, in closed form)
+JJF1535_EFFECTS = tuple(f.name for f in fields(Effects) if f.name.startswith(("gyro_dead_zone", "gyro_resolution",
+                                                                                "gyro_warm_up", "gyro_turn_on")))
 
 
 @dataclass(frozen=True)
@@ -271,6 +287,15 @@ class _Section:
 
 def _missing(where: str, what: str):
     raise ValueError(f"{where} is required: {what}")
+
+
+def _nonnegative_vector(section: _Section, key: str, kind: str, what: str) -> np.ndarray:
+    """A per-axis vector of *kind* whose every component is >= 0 (*what* says what it is, for the message)."""
+    value = section.vector(key, kind)
+    if np.any(value < 0):
+        raise ValueError(f"{section.where(key)} = {section.data.get(key)!r}: {what} must be >= 0 on every axis; "
+                         "allowed: values >= 0 (0 = off)")
+    return value
 
 
 def _nonneg(value: float, where: str) -> float:
@@ -485,8 +510,20 @@ def parse_scenario(document: dict, name: str | None = None, source: str = "") ->
         accel_lever_arm=e.matrix("accel_lever_arm", "length"),
         gyro_output_range=gyro_range,
         accel_output_range=accel_range,
+        gyro_dead_zone=_nonnegative_vector(e, "gyro_dead_zone", "angular_rate", "a dead zone"),
+        gyro_resolution=_nonnegative_vector(e, "gyro_resolution", "angular_rate", "a resolution"),
+        gyro_warm_up_amplitude=e.vector("gyro_warm_up_amplitude", "angular_rate"),
+        gyro_warm_up_time_constant=_nonnegative_vector(e, "gyro_warm_up_time_constant", "time", "a time constant"),
+        gyro_turn_on_bias=_nonnegative_vector(e, "gyro_turn_on_bias", "angular_rate", "a standard deviation"),
     )
     e.check_unknown()
+    missing = (effects.gyro_warm_up_amplitude != 0) & ~(effects.gyro_warm_up_time_constant > 0)
+    if np.any(missing):
+        i = int(np.argmax(missing))
+        raise ValueError(f"mimu.effects.gyro_warm_up_time_constant = {e.data.get('gyro_warm_up_time_constant')!r}: "
+                         f"gyro {'xyz'[i]} has a warm-up amplitude "
+                         f"({e.data.get('gyro_warm_up_amplitude')!r}), so its time constant must be > 0 s; allowed: "
+                         "a time constant > 0 wherever the amplitude is set")
 
     a = _Section(document, "acquisition")
     bits = a.integer("bits", 0, minimum=0)

@@ -19,7 +19,13 @@ The mapping (gyro *i* = the procedure's axis; plansim's eq. (1) plus its effects
 - bias temperature sensitivity (eq. (27), each B_i = F̄_i/K with the room K): ``|β_i|/K``;
 - nonlinearity (eq. (6)–(7)) and asymmetry (eq. (8)–(9)): the figure of the unit's noise-free response
   ``K·Ω + n2·Ω² + n3·Ω³ + ½·α·Kg[i, i]·|Ω|`` at the schedule's rates (with only α set, the asymmetry is |α|);
-- bias stability (eq. (18)–(19)) has no value in the model: it is a property of the noise and the averaging.
+- bias stability (eq. (18)–(19)) has no value in the model: it is a property of the noise and the averaging;
+- scale-factor repeatability (7.2.4, eq. (10)): 0 (the model's scale factor does not change at a power-on);
+- threshold (7.2.6, eq. (12)–(13)): the dead zone d_i; resolution (7.2.7, eq. (14)): the input step r_i
+  (:mod:`plansim.model.jjf1535_effects`). Both are properties of the unit, not of the procedure: the procedure
+  reports a tested rate (increment), so its error is at least the distance to the next tested one;
+- warm-up time (7.2.9): the 7.2.9.2 criterion on the noise-free warm-up transient (:func:`true_warm_up_time`);
+- bias repeatability (7.2.11, eq. (20)): the turn-on bias's standard deviation referred to the input, σ_on/K.
 """
 
 from __future__ import annotations
@@ -31,13 +37,19 @@ import numpy as np
 from plansim.estimate.jjf1535 import (
     bias,
     bias_g_sensitivity,
+    bias_repeatability,
     bias_stability,
     rate_point_mean,
+    resolution,
     scale_factor_asymmetry,
     scale_factor_fit,
     scale_factor_nonlinearity,
+    scale_factor_repeatability,
     temperature_sensitivity,
+    threshold,
+    warm_up_time,
 )
+from plansim.model.jjf1535_effects import exponential_segment_mean
 from plansim.model.parameters import unpack
 from plansim.schedule.jjf1535 import Jjf1535Procedure, RateRun
 from plansim.units import DEG, HOUR, STANDARD_GRAVITY
@@ -57,6 +69,11 @@ ITEMS = {
     "g_sensitivity_z": ("7.2.12", "(F_up - F_down)/(2gK)", "(deg/h)/g", _DEG_H / STANDARD_GRAVITY),
     "g_sensitivity": ("7.2.12", "largest |g-sensitivity|", "(deg/h)/g", _DEG_H / STANDARD_GRAVITY),
     "bias_temperature_sensitivity": ("7.2.14", "(27)", "(deg/h)/degC", _DEG_H),
+    "scale_repeatability": ("7.2.4", "(10)", "ppm", 1e-6),
+    "threshold": ("7.2.6", "(12)-(13)", "deg/s", DEG),
+    "resolution": ("7.2.7", "(14)", "deg/s", DEG),
+    "warm_up_time": ("7.2.9", "7.2.9.2, mean of N", "s", 1.0),
+    "bias_repeatability": ("7.2.11", "(20)", "deg/h", _DEG_H),
 }
 
 
@@ -109,13 +126,78 @@ def reduce_items(means, procedure: Jjf1535Procedure, gravity: float) -> dict[str
     hot_cold = [float(rate_point_mean(means[list(rec), i])) / K for rec in procedure.temperature_bias]
     out["bias_temperature_sensitivity"] = temperature_sensitivity([out["bias"], *hot_cold], procedure.temperatures,
                                                                   relative=False)
+    # 7.2.4 eq. (10): the Q room runs' K, a power cycle between them
+    out["scale_repeatability"] = scale_factor_repeatability(K_runs)
+    # 7.2.11 eq. (20): the Q room bias records' B0m, each in its own power cycle
+    out["bias_repeatability"] = bias_repeatability([bias(K, rec) for rec in records])
+    out.update(_threshold_resolution_warm_up(means, procedure, K))
     return out
+
+
+def _threshold_resolution_warm_up(means: np.ndarray, procedure: Jjf1535Procedure, K: float) -> dict[str, float]:
+    """7.2.6, 7.2.7 and 7.2.9 from one session's means, with the room K (7.2.6.1 a), 7.2.7.1 a)); NaN for an item
+    the procedure does not record (a procedure built without those segments) or cannot determine."""
+    i, sched = procedure.axis, procedure.schedule
+    out = dict.fromkeys(("threshold", "resolution", "warm_up_time"), math.nan)
+    if procedure.threshold_runs:
+        # eq. (12)-(13) per direction, F̄_0,j the mean of the at-rest outputs before and after; the larger (7.2.6.1 e))
+        per_direction = []
+        for run in procedure.threshold_runs:
+            rates = np.array([sched.segments[k].rate for k in run.points])
+            zero = 0.5 * (means[run.rest_before, i] + means[run.rest_after, i])
+            per_direction.append(threshold(K, rates, means[list(run.points), i], zero))
+        out["threshold"] = _larger(per_direction)
+    if procedure.resolution_pairs:
+        # eq. (14) per direction on the output increments F(base + ΔΩ_j) − F(base); the larger (7.2.7.1 f))
+        per_direction = []
+        for sign, pairs in zip((1.0, -1.0), procedure.resolution_pairs):
+            increments = sign * np.asarray(procedure.resolution_increments)  # as commanded
+            output_increments = np.array([means[b, i] - means[a, i] for a, b in pairs])
+            per_direction.append(resolution(K, increments, output_increments))
+        out["resolution"] = _larger(per_direction)
+    if procedure.warm_up:
+        out["warm_up_time"] = _mean_warm_up_time([means[list(rec), i] / K for rec in procedure.warm_up], procedure)
+    return out
+
+
+def _larger(per_direction: list[float]) -> float:
+    """7.2.6.1 e), 7.2.7.1 f): the larger of the two directions' figures; NaN if either is undetermined (Python's
+    ``max`` would drop a NaN that comes second)."""
+    return math.nan if any(math.isnan(x) for x in per_direction) else max(per_direction)
+
+
+def _mean_warm_up_time(records: list[np.ndarray], procedure: Jjf1535Procedure) -> float:
+    """7.2.9.2: each record's warm-up time (its segments are the P-second period means from power-on), their mean."""
+    since = procedure.power_cycles()[1]  # each record starts at power-on: its times are those since then
+    times = [since[list(rec)] for rec in procedure.warm_up]
+    values = [warm_up_time(t, rates, procedure.specified_stability, 1) for t, rates in zip(times, records)]
+    return float(np.mean(values))
+
+
+def true_warm_up_time(procedure: Jjf1535Procedure, scale_factor: float, amplitude: float,
+                      time_constant: float) -> float:
+    """The unit's warm-up time by 7.2.9's own definition: :func:`~plansim.estimate.jjf1535.warm_up_time` on the
+    noise-free transient ``A·exp(−t/τ)`` (:mod:`plansim.model.jjf1535_effects`) of each warm-up record, its
+    period means in closed form, divided by the true K; 0 without a transient. So the zero-noise identity holds by
+    construction, and with noise the error is what the noise adds to the criterion."""
+    if not procedure.warm_up:
+        return math.nan
+    _cycle, since = procedure.power_cycles()
+    records = []
+    for rec in procedure.warm_up:
+        segments = [procedure.schedule.segments[k] for k in rec]
+        transient = exponential_segment_mean(since[list(rec)], [s.samples for s in segments],
+                                             [1.0 / s.sample_rate for s in segments], amplitude, time_constant)
+        records.append(transient / scale_factor)
+    return _mean_warm_up_time(records, procedure)
 
 
 def true_items(truth, procedure: Jjf1535Procedure, *, scale_temperature_coefficient: float = 0.0,
                bias_temperature_coefficient: float = 0.0, reference_temperature: float = 20.0,
                asymmetry: float = 0.0, nonlinearity_quadratic: float = 0.0,
-               nonlinearity_cubic: float = 0.0) -> dict[str, float]:
+               nonlinearity_cubic: float = 0.0, dead_zone: float = 0.0, resolution: float = 0.0,
+               warm_up_amplitude: float = 0.0, warm_up_time_constant: float = 0.0,
+               turn_on_bias: float = 0.0) -> dict[str, float]:
     """The simulated unit's value of each item that has one (the module docstring's mapping), SI.
 
     Parameters
@@ -128,6 +210,9 @@ def true_items(truth, procedure: Jjf1535Procedure, *, scale_temperature_coeffici
         κ (1/°C), β (rad/s/°C) and T_ref (°C) of the gyro under test (``Scenario.effects``).
     asymmetry, nonlinearity_quadratic, nonlinearity_cubic : float
         α (1), n2 (1/(rad/s)), n3 (1/(rad/s)²) of the gyro under test.
+    dead_zone, resolution, warm_up_amplitude, warm_up_time_constant, turn_on_bias : float
+        d (rad/s), r (rad/s), A (rad/s), τ (s) and σ_on (rad/s) of the gyro under test
+        (:mod:`plansim.model.jjf1535_effects`).
     """
     p = unpack(np.asarray(truth, dtype=float))
     i = procedure.axis
@@ -146,7 +231,12 @@ def true_items(truth, procedure: Jjf1535Procedure, *, scale_temperature_coeffici
            "bias": bias_room / K,
            "bias_up_down": bias_room / K,
            "bias_stability": math.nan,
-           "bias_temperature_sensitivity": abs(beta) / K}
+           "bias_temperature_sensitivity": abs(beta) / K,
+           "scale_repeatability": 0.0,
+           "threshold": float(dead_zone),
+           "resolution": float(resolution),
+           "warm_up_time": true_warm_up_time(procedure, K, float(warm_up_amplitude), float(warm_up_time_constant)),
+           "bias_repeatability": float(turn_on_bias) / K}
     for a, name in enumerate("xyz"):
         out[f"g_sensitivity_{name}"] = float(p["G"][i, a]) / K
     out["g_sensitivity"] = max(abs(out[f"g_sensitivity_{a}"]) for a in "xyz")

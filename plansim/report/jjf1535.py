@@ -3,8 +3,8 @@
 Both read :meth:`plansim.uncertainty.jjf1535_monte_carlo.Jjf1535MonteCarlo.summary`, whose rows are in the units
 JJF 1535 reports in (:data:`plansim.estimate.jjf1535_items.ITEMS`): the text report prints them as they are, the
 JSON converts them to SI (as ``plansim run --json`` is SI). The items are grouped as the certificate of JJF 1535
-Appendix B groups them: the scale factor items, the bias items, then the items plansim does not simulate, each
-with the reason (docs/jjf1535.md, "What is not built").
+Appendix B groups them: the scale factor items, the bias items, the threshold, resolution and warm-up time, then
+the items plansim does not simulate, each with the reason (docs/jjf1535.md, "What is not built").
 """
 
 from __future__ import annotations
@@ -23,9 +23,11 @@ from plansim.units import ARCSEC, DEG, HOUR
 
 #: the certificate's groups (JJF 1535 Appendix B) and the items of the Monte Carlo in each, in order
 GROUPS = (
-    ("Scale factor items", ("scale_factor", "nonlinearity", "asymmetry", "scale_temperature_sensitivity")),
-    ("Bias items", ("bias", "bias_up_down", "bias_stability", "g_sensitivity_x", "g_sensitivity_y",
-                    "g_sensitivity_z", "g_sensitivity", "bias_temperature_sensitivity")),
+    ("Scale factor items", ("scale_factor", "nonlinearity", "asymmetry", "scale_repeatability",
+                            "scale_temperature_sensitivity")),
+    ("Bias items", ("bias", "bias_up_down", "bias_stability", "bias_repeatability", "g_sensitivity_x",
+                    "g_sensitivity_y", "g_sensitivity_z", "g_sensitivity", "bias_temperature_sensitivity")),
+    ("Threshold, resolution, warm-up time", ("threshold", "resolution", "warm_up_time")),
 )
 
 #: the name each item has in the text report
@@ -42,6 +44,11 @@ LABELS = {
     "g_sensitivity_z": "g-sensitivity along z",
     "g_sensitivity": "g-sensitivity (largest)",
     "bias_temperature_sensitivity": "bias temperature sensitivity",
+    "scale_repeatability": "SF repeatability",
+    "threshold": "threshold",
+    "resolution": "resolution",
+    "warm_up_time": "warm-up time",
+    "bias_repeatability": "bias repeatability",
 }
 
 #: the SI unit of each JJF 1535 unit of :data:`~plansim.estimate.jjf1535_items.ITEMS` (its scale gives the factor)
@@ -52,16 +59,12 @@ SI_UNITS = {
     "deg/h": "rad/s",
     "(deg/h)/g": "rad/s/(m/s^2)",
     "(deg/h)/degC": "rad/s/K",
+    "deg/s": "rad/s",
+    "s": "s",
 }
 
 #: the certificate's items plansim does not simulate: (item, clause, why)
 NOT_SIMULATED = (
-    ("scale factor repeatability", "7.2.4",
-     "needs a power cycle between the Q runs (a turn-on bias drawn per cycle); the kernels have none"),
-    ("threshold", "7.2.6", "eq. (12)-(13) are built, but the simulator has no dead zone: they would measure noise"),
-    ("resolution", "7.2.7", "eq. (14) is built, but the simulator has no finite input resolution: noise only"),
-    ("warm-up time", "7.2.9", "needs a warm-up transient of the bias; the kernels have none"),
-    ("bias repeatability", "7.2.11", "needs a turn-on bias drawn per power cycle; the kernels have none"),
     ("bandwidth", "7.2.15", "a dynamic test (JJF 1537): the -3 dB estimator is built, the vibration table is not "
                             "simulated (docs/dynamic.md)"),
 )
@@ -71,7 +74,8 @@ ARW_UNIT, ARW_SCALE = "deg/sqrt(h)", DEG / math.sqrt(HOUR)
 
 #: the keys of every entry of the JSON's ``items``, always present (null where the item has no such figure)
 ITEM_KEYS = ("item", "clause", "equations", "unit", "truth", "mean_error", "std_error", "mc_U95", "budget",
-             "budget_U", "mean_relative_error", "std_relative_error", "mc_U95_relative", "coverage", "figure")
+             "budget_U", "mean_relative_error", "std_relative_error", "mc_U95_relative", "coverage", "figure",
+             "undetermined")
 
 
 def _number(x) -> float | None:
@@ -92,11 +96,14 @@ def items_json(rows: list[dict]) -> list[dict]:
     list of dict
         One per row with the keys :data:`ITEM_KEYS`. ``unit`` is the SI unit; ``truth`` (mean true value),
         ``mean_error``, ``std_error`` and ``mc_U95`` (95 % quantile of |error|) in it, None for an item with no
-        true value, whose ``figure`` is then the distribution of the reported value ``{mean, std, q025, q975}``
-        (SI; None otherwise). ``budget`` (``"A.1"``, ``"A.2"``), ``budget_U`` (Appendix A's printed U, relative,
-        k = 2), the relative error's ``mean_relative_error``, ``std_relative_error``, ``mc_U95_relative`` and the
-        ``coverage`` (fraction of trials with |relative error| <= U) for the items Appendix A budgets, None for
-        the others.
+        true value. ``figure`` is the distribution of the reported value ``{mean, std, q025, q975}`` (SI) for an
+        item with no true value and for those of
+        :data:`~plansim.uncertainty.jjf1535_monte_carlo.FIGURE_ALSO` (threshold, resolution, warm-up time, the
+        repeatabilities), None otherwise. ``undetermined`` is the fraction of trials in which the procedure could
+        not determine the item (0 for most; the statistics are over the others). ``budget`` (``"A.1"``,
+        ``"A.2"``), ``budget_U`` (Appendix A's printed U, relative, k = 2), the relative error's
+        ``mean_relative_error``, ``std_relative_error``, ``mc_U95_relative`` and the ``coverage`` (fraction of
+        trials with |relative error| <= U) for the items Appendix A budgets, None for the others.
     """
     out = []
     for r in rows:
@@ -105,8 +112,9 @@ def items_json(rows: list[dict]) -> list[dict]:
         entry.update(item=r["item"], clause=r["clause"], equations=r["equations"], unit=SI_UNITS[r["unit"]])
         if "mean_error" in r:
             entry.update({k: r[k] * scale for k in ("truth", "mean_error", "std_error", "mc_U95")})
-        else:
-            entry["figure"] = {k: r[k] * scale for k in ("mean", "std", "q025", "q975")}
+        if "mean" in r:
+            entry["figure"] = {k: _number(r[k] * scale) for k in ("mean", "std", "q025", "q975")}
+        entry["undetermined"] = r.get("undetermined", 0.0)
         if "budget" in r:
             entry.update({k: r[k] for k in ("budget", "budget_U", "mean_relative_error", "std_relative_error",
                                             "mc_U95_relative", "coverage")})
@@ -124,7 +132,8 @@ def _g(x: float, digits: int = 4) -> str:
 
 
 def items_table(rows: list[dict], arw: tuple[float, float] | None = None) -> str:
-    """The certificate-style table: the scale factor items, the bias items, the items not simulated.
+    """The certificate-style table: the scale factor items, the bias items, threshold, resolution and warm-up time,
+    the items not simulated.
 
     Parameters
     ----------
@@ -152,12 +161,17 @@ def items_table(rows: list[dict], arw: tuple[float, float] | None = None) -> str
         for name in names:
             r = by_item[name]
             start = f"  {LABELS[name]:30s} {r['clause']:14s} {r['unit']:16s}"
+            figure = (f"reported figure: mean {_g(r['mean'], 3)}, std {_g(r['std'], 3)}, 95 % interval "
+                      f"[{_g(r['q025'], 3)}, {_g(r['q975'], 3)}]" if "mean" in r else "")
+            if r.get("undetermined"):
+                figure += f"; undetermined in {100 * r['undetermined']:.1f} % of trials"
             if "mean_error" in r:
                 lines.append(f"{start} {_g(r['truth'], 5):>10s} {_g(r['mean_error'], 3):>11s} "
                              f"{_g(r['std_error'], 3):>10s} {_g(r['mc_U95'], 3):>10s}")
+                if figure:
+                    lines.append(f"  {'':30s} {'':14s} {figure}")
             else:
-                lines.append(f"{start} {'(none)':>10s} reported figure: mean {_g(r['mean'], 3)}, std "
-                             f"{_g(r['std'], 3)}, 95 % interval [{_g(r['q025'], 3)}, {_g(r['q975'], 3)}]")
+                lines.append(f"{start} {'(none)':>10s} {figure}")
             if "budget" in r:
                 lines.append(f"  {'':30s} {'':14s} Appendix {r['budget']} U = {r['budget_U']:.1e} (relative): "
                              f"relative error mean {r['mean_relative_error']:+.2e}, std {r['std_relative_error']:.2e}, "
@@ -202,4 +216,29 @@ def header(result, unit, procedure, elapsed: float | None = None) -> str:
             f"{_g(procedure.averaging_period)} s, temperatures {', '.join(_g(t) for t in procedure.temperatures)} °C; "
             f"JJF 1535 Table 2 rate table (u = {table_u} systematic, "
             f"{100 * TABLE_RATE_SMOOTHNESS:.2g} % smoothness), {_g(POSITION_ACCURACY / ARCSEC)}″ position table, "
-            f"{ACQUISITION_BITS}-bit acquisition")
+            f"{ACQUISITION_BITS}-bit acquisition{_extras(procedure)}\n"
+            f"{_effects_line(unit, procedure)}")
+
+
+def _extras(procedure) -> str:
+    """The threshold, resolution and warm-up tests of the header, '' for a procedure without them."""
+    if not (procedure.threshold_runs and procedure.resolution_pairs and procedure.warm_up):
+        return ""
+    small = procedure.resolution_increments
+    base = abs(procedure.schedule.segments[procedure.resolution_pairs[0][0][0]].rate)
+    record = procedure.warm_up[0]
+    return (f"; threshold rates and resolution increments ±{_g(small[-1] / DEG)} to ±{_g(small[0] / DEG)} °/s "
+            f"(base rate {_g(base / DEG)} °/s); {len(procedure.warm_up)} warm-up records of "
+            f"{_g(len(record) * procedure.averaging_period)} s from power-on, specified stability "
+            f"{_g(procedure.specified_stability / (DEG / HOUR))} °/h; {len(procedure.power_on)} power-ons")
+
+
+def _effects_line(unit, procedure) -> str:
+    """The JJF 1535 effects of the gyro under test (plansim.model.jjf1535_effects), or that there are none."""
+    e, i = unit.effects, procedure.axis
+    if not e.jjf1535_effects_set():
+        return "JJF 1535 effects of the unit: none (no dead zone, resolution, warm-up transient or turn-on bias)"
+    return (f"JJF 1535 effects of the {'xyz'[i]} gyro: dead zone {_g(e.gyro_dead_zone[i] / DEG)} °/s, resolution "
+            f"{_g(e.gyro_resolution[i] / DEG)} °/s, warm-up {_g(e.gyro_warm_up_amplitude[i] / (DEG / HOUR))} °/h × "
+            f"exp(−t/{_g(e.gyro_warm_up_time_constant[i])} s), turn-on bias σ "
+            f"{_g(e.gyro_turn_on_bias[i] / (DEG / HOUR))} °/h per power cycle")

@@ -19,13 +19,34 @@ What it records (JJF 1535-2015 clause 7.2; all angles rad, rates rad/s, times s,
   input axis, when horizontal, lies East–West and senses no Earth rate;
 - 7.2.13 one long static record, input axis up, for the Allan analysis;
 - 7.2.5/7.2.14 at the upper and the lower temperature, after a soak (the first segment's settle time),
-  one rate test and one bias record; the room-temperature ones are those above.
+  one rate test and one bias record; the room-temperature ones are those above;
+- 7.2.6 the threshold test, input axis up at room temperature: for each direction the at-rest output, the small
+  rates of :func:`r5_rate_points` from the largest down (30 samples each, 7.2.6.1 b)–d)), the at-rest output
+  again (their mean is F̄_0,j of eq. (13));
+- 7.2.7 the resolution test: for each direction and each rate increment ΔΩ_j, from the largest down, the base
+  rate (20–50 × the expected threshold, 7.2.7.1 b)) and then the base rate plus ΔΩ_j (30 samples each);
+- 7.2.9 the warm-up records: the unit powered off for *repeat_interval*, then recorded from power-on as
+  consecutive segments of one averaging period each, *warm_up_records* times (7.2.9.2: the mean over N records).
+
+These last three come after all the others (the segments before them, and so their random draws, are those of
+the procedure without them).
+
+Power cycles (:attr:`Jjf1535Procedure.power_on`): the unit is switched on *power_on_lead* (30 min, the warm-up
+7.2.8.1 a) allows) before the first segment; it is switched off and on again at the start of the
+*repeat_interval* before each further room rate test (7.2.4.1: powered off between the Q calibrations) and each
+further bias record (7.2.11.1), and at the start of each warm-up record. The JJF 2003 kernels know no power
+cycle: the turn-on bias and the warm-up transient of :mod:`plansim.model.jjf1535_effects` are added to the
+segment means by the JJF 1535 Monte Carlo.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 from dataclasses import dataclass
+
+import numpy as np
 
 from plansim.schedule.segments import Schedule, Segment
 
@@ -131,11 +152,55 @@ class Jjf1535Procedure:
     temperature_runs: tuple[RateRun, ...]
     temperature_bias: tuple[tuple[int, ...], ...]
     averaging_period: float  # P, s
+    #: 7.2.6: one RateRun per direction (+, −), its points the small rates from the largest down
+    threshold_runs: tuple[RateRun, ...] = ()
+    #: 7.2.7: per direction (+, −), per increment from the largest down, (base segment, base + increment segment)
+    resolution_pairs: tuple[tuple[tuple[int, int], ...], ...] = ()
+    #: 7.2.7: the commanded rate increments ΔΩ_j of each pair, rad/s, > 0, from the largest down (signed by direction)
+    resolution_increments: tuple[float, ...] = ()
+    #: 7.2.9: the warm-up records, each from power-on, one averaging period P per segment
+    warm_up: tuple[tuple[int, ...], ...] = ()
+    #: 7.2.9.2: the specified ("nominal") bias stability the warm-up time is measured against, rad/s (eq. (18), P)
+    specified_stability: float = float("nan")
+    #: times the unit is switched on, s from the start of the schedule (the first is before it: negative)
+    power_on: tuple[float, ...] = ()
 
     @property
     def temperatures(self) -> tuple[float, ...]:
         """Room, upper, lower (°C)."""
         return (self.room_temperature,) + tuple(r.temperature for r in self.temperature_runs)
+
+    def recording_starts(self) -> np.ndarray:
+        """Time of each segment's first sample from the start of the schedule, s, shape (S,), read-only: the
+        schedule's clock, each segment's settle then its samples (as ``plansim.io.recording_data.nominal_time``)."""
+        return self._clock[0]
+
+    def power_cycles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per segment, the index into :attr:`power_on` of the power cycle it is recorded in and the time of its
+        first sample since that power-on (s); shapes (S,), read-only. Without power-on times: cycle 0, time
+        ``inf``."""
+        return self._clock[1], self._clock[2]
+
+    @functools.cached_property
+    def _clock(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        # computed once per procedure (the Monte Carlo asks for it in every trial)
+        clock, starts = 0.0, []
+        for segment in self.schedule.segments:
+            clock += segment.settle
+            starts.append(clock)
+            clock += segment.samples / segment.sample_rate
+        starts = np.array(starts)
+        if not self.power_on:
+            cycle, since = np.zeros(starts.size, dtype=np.int64), np.full(starts.size, np.inf)
+        else:
+            on = np.asarray(self.power_on, dtype=float)
+            cycle = np.searchsorted(on, starts, side="right") - 1
+            if np.any(cycle < 0):
+                raise ValueError("power_on: the first power-on must come before the first segment's first sample")
+            cycle, since = cycle.astype(np.int64), starts - on[cycle]
+        for array in (starts, cycle, since):
+            array.flags.writeable = False
+        return starts, cycle, since
 
 
 # the heading that puts the gyro's input axis East–West when another axis is up (body_to_level: axis i+1 -> East
@@ -149,7 +214,11 @@ def jjf1535_procedure(maximum_rate: float, axis: str = "x", points: int | None =
                       settle: float = 10.0, sample_rate: float = 1.0 / SAMPLE_PERIOD, averaging_period: float = 10.0,
                       bias_periods: int = 60, position_dwell: float = 60.0, allan_duration: float = 7200.0,
                       room_temperature: float = 20.0, upper_temperature: float = 60.0,
-                      lower_temperature: float = -20.0, soak: float = 3600.0) -> Jjf1535Procedure:
+                      lower_temperature: float = -20.0, soak: float = 3600.0,
+                      threshold_maximum: float = 0.1 * DEG, threshold_minimum: float = 0.001 * DEG,
+                      resolution_base_rate: float = 0.5 * DEG, warm_up_duration: float = 1200.0,
+                      warm_up_records: int = 2, specified_stability: float = 10.0 * DEG / 3600.0,
+                      power_on_lead: float = 1800.0) -> Jjf1535Procedure:
     """Build the JJF 1535 procedure's segments for the gyro *axis* of the MIMU (see the module docstring).
 
     Parameters
@@ -178,6 +247,22 @@ def jjf1535_procedure(maximum_rate: float, axis: str = "x", points: int | None =
         °C; upper > room > lower.
     soak : float
         Settle time before the first segment at the upper and the lower temperature, s.
+    threshold_maximum, threshold_minimum : float
+        7.2.6: the small rates of the threshold test, and 7.2.7: the rate increments of the resolution test, are
+        the R5 points (:func:`r5_rate_points`) from the minimum to the maximum, rad/s (default 0.001 to 0.1 °/s:
+        11 points), recorded from the largest down.
+    resolution_base_rate : float
+        7.2.7.1 b): the base rate of the resolution test, rad/s (20–50 × the expected threshold; default 0.5 °/s).
+    warm_up_duration : float
+        Length of each 7.2.9 warm-up record from power-on, s (a whole number of averaging periods, at least 10).
+    warm_up_records : int
+        N, the number of warm-up records (>= 1); the warm-up time is their mean (7.2.9.2).
+    specified_stability : float
+        7.2.9.2: the specified bias stability (eq. (18) with this P) the warm-up time is measured against, rad/s
+        (default 10 °/h).
+    power_on_lead : float
+        Time from the first power-on to the first segment's first sample, s (7.2.8.1 a): a warm-up of at most
+        30 min; default 30 min).
     """
     where = "jjf1535_procedure"
     if axis not in ("x", "y", "z"):
@@ -196,6 +281,17 @@ def jjf1535_procedure(maximum_rate: float, axis: str = "x", points: int | None =
                          "hold a whole number (>= 1) of samples")
     for name in ("position_dwell", "allan_duration"):
         _number(name, locals()[name], where)
+    threshold_rates = r5_rate_points(threshold_maximum, threshold_minimum)
+    base_rate = _number("resolution_base_rate", resolution_base_rate, where)
+    warm_up_records = _whole("warm_up_records", warm_up_records, where, 1)
+    specified_stability = _number("specified_stability", specified_stability, where)
+    power_on_lead = _number("power_on_lead", power_on_lead, where, positive=False, minimum=0.0)
+    warm_up_duration = _number("warm_up_duration", warm_up_duration, where)
+    warm_up_periods = warm_up_duration / period
+    if abs(warm_up_periods - round(warm_up_periods)) > 1e-9 or round(warm_up_periods) < 10:
+        raise ValueError(f"{where}: warm_up_duration = {warm_up_duration!r} s with averaging_period = {period!r} s; "
+                         "it must hold a whole number (>= 10) of averaging periods (7.2.9: the stability of "
+                         "eq. (18) needs at least 10 periods after the warm-up time)")
     room = _number("room_temperature", room_temperature, where, positive=False)
     upper = _number("upper_temperature", upper_temperature, where, positive=False)
     lower = _number("lower_temperature", lower_temperature, where, positive=False)
@@ -245,9 +341,44 @@ def jjf1535_procedure(maximum_rate: float, axis: str = "x", points: int | None =
     for name, t in (("upper", upper), ("lower", lower)):
         temperature_runs.append(rate_run(f"7.2.5 {name} {t:g} degC", t, soak))
         temperature_bias.append(bias_record(f"7.2.14 {name} {t:g} degC", t, settle))
+    # 7.2.6, 7.2.7, 7.2.9: after every other segment, so that those keep their random draws
+    threshold_runs = []
+    for sign, name in ((1.0, "+"), (-1.0, "-")):
+        before = add(label=f"7.2.6 threshold {name}: at rest before", test="static", group=gyro, up=up, rate_axis=up,
+                     dwell=SAMPLES_BELOW / sample_rate, settle=settle, temperature=room)
+        idx = tuple(add(label=f"7.2.6 threshold: {sign * r / DEG:+.6g} deg/s", test="rotation", group=gyro, up=up,
+                        rate=sign * r, rate_axis=up, dwell=SAMPLES_BELOW / sample_rate, settle=settle,
+                        temperature=room) for r in reversed(threshold_rates))
+        after = add(label=f"7.2.6 threshold {name}: at rest after", test="static", group=gyro, up=up, rate_axis=up,
+                    dwell=SAMPLES_BELOW / sample_rate, settle=settle, temperature=room)
+        threshold_runs.append(RateRun(room, before, idx, after))
+    resolution_pairs = []
+    for sign in (1.0, -1.0):
+        pairs = []
+        for r in reversed(threshold_rates):
+            pair = tuple(add(label=f"7.2.7 resolution: {sign * base_rate / DEG:+.6g} {extra} deg/s", test="rotation",
+                             group=gyro, up=up, rate=sign * (base_rate + step), rate_axis=up,
+                             dwell=SAMPLES_BELOW / sample_rate, settle=settle, temperature=room)
+                         for extra, step in (("+ 0", 0.0), (f"{sign * r / DEG:+.6g}", r)))
+            pairs.append(pair)
+        resolution_pairs.append(tuple(pairs))
+    warm_up = tuple(
+        tuple(add(label=f"7.2.9 warm-up record {n + 1}: period {j + 1}", test="static", group=gyro, up=up,
+                  rate_axis=up, dwell=period, settle=repeat_interval if j == 0 else 0.0, temperature=room)
+              for j in range(round(warm_up_periods)))
+        for n in range(warm_up_records))
     notes = {"jjf1535": f"gyro {axis}; {len(rates)} R5 rate points per direction up to "
                         f"{maximum_rate / DEG:g} deg/s; Q = {repeats}; P = {period:g} s"}
-    return Jjf1535Procedure(schedule=Schedule(tuple(segments), procedure="jjf1535", notes=notes), axis=gyro,
-                            room_temperature=room, room_runs=room_runs, room_bias=room_bias, g_positions=g_positions,
-                            allan=allan, temperature_runs=tuple(temperature_runs),
-                            temperature_bias=tuple(temperature_bias), averaging_period=period)
+    procedure = Jjf1535Procedure(
+        schedule=Schedule(tuple(segments), procedure="jjf1535", notes=notes), axis=gyro,
+        room_temperature=room, room_runs=room_runs, room_bias=room_bias, g_positions=g_positions,
+        allan=allan, temperature_runs=tuple(temperature_runs), temperature_bias=tuple(temperature_bias),
+        averaging_period=period, threshold_runs=tuple(threshold_runs), resolution_pairs=tuple(resolution_pairs),
+        resolution_increments=tuple(reversed(threshold_rates)), warm_up=warm_up,
+        specified_stability=specified_stability)
+    starts = procedure.recording_starts()
+    on = [-power_on_lead]
+    on += [float(starts[run.rest_before] - segments[run.rest_before].settle) for run in room_runs[1:]]
+    on += [float(starts[rec[0]] - segments[rec[0]].settle) for rec in room_bias[1:]]
+    on += [float(starts[rec[0]]) for rec in warm_up]
+    return dataclasses.replace(procedure, power_on=tuple(sorted(on)))

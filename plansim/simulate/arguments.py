@@ -93,8 +93,19 @@ def _axis_vector(name: str) -> np.ndarray:
 
 
 def kernel_arguments(scenario: Scenario) -> dict[str, object]:
-    """Every model input of the kernels, in SI (see :mod:`plansim.kernels.sample_path`)."""
+    """Every model input of the kernels, in SI (see :mod:`plansim.kernels.sample_path`).
+
+    Raises ``ValueError`` if the scenario sets an effect the kernels do not simulate
+    (:data:`plansim.config.scenario.JJF1535_EFFECTS`: the JJF 1535 Monte Carlo applies those to segment means,
+    :mod:`plansim.simulate.jjf1535_effects`, and hands the kernels the unit without them).
+    """
     e, n, a, t = scenario.effects, scenario.noise, scenario.acquisition, scenario.turntable
+    unsimulated = e.jjf1535_effects_set()
+    if unsimulated:
+        raise ValueError(f"mimu.effects.{unsimulated[0]} = {getattr(e, unsimulated[0]).tolist()!r} (SI): the "
+                         "simulation kernels do not simulate it; only the JJF 1535 Monte Carlo does "
+                         "('plansim run jjf1535 --unit SCENARIO', docs/jjf1535.md); allowed here: 0 (off) for "
+                         + ", ".join(f"mimu.effects.{name}" for name in unsimulated))
     errors = [getattr(t, name) for name in TABLE_ERRORS]
     sensor = np.array([getattr(e, row) for row in EFFECT_ROWS], dtype=float)
     noise = np.column_stack([

@@ -10,7 +10,14 @@ noise, its effects and the laboratory stay the scenario's.
   rate smoothness 0.05 %), a two-axis position table of 3″, a 6½-digit acquisition (21 bits);
 - :func:`jjf1535_monte_carlo` — N trials, each a different unit, reduced by
   :func:`plansim.estimate.jjf1535_items.reduce_items`, against :func:`~plansim.estimate.jjf1535_items.true_items`;
-  :meth:`Jjf1535MonteCarlo.summary` compares the scale factor and the bias with Appendix A's U.
+  :meth:`Jjf1535MonteCarlo.summary` compares the scale factor and the bias with Appendix A's U, and shows the
+  distribution of the reported figure for the items without a true value and for threshold, resolution, warm-up
+  time and the repeatabilities (:data:`FIGURE_ALSO`).
+
+The unit's JJF 1535 effects (dead zone, resolution, warm-up transient, turn-on bias per power cycle;
+:mod:`plansim.model.jjf1535_effects`) are not in the kernels: the kernels simulate the unit without them and
+:func:`plansim.simulate.jjf1535_effects.apply_jjf1535_effects` adds them to each trial's segment means in closed
+form, before the reduction. With none set, nothing is added and the results are those of the kernels alone.
 
 The angle random walk of 7.2.13 needs the samples of one recording: :func:`plansim.runner.jjf1535_angle_random_walk`.
 """
@@ -29,6 +36,7 @@ from plansim.config.scenario import Acquisition, ErrorDistribution
 from plansim.estimate.jjf1535_items import ITEMS, reduce_items, true_items
 from plansim.schedule.jjf1535 import Jjf1535Procedure, jjf1535_procedure
 from plansim.simulate.chunks import ProgressCallback, check_count, iterate_chunks
+from plansim.simulate.jjf1535_effects import apply_jjf1535_effects, input_axis_rates, without_jjf1535_effects
 from plansim.simulate.paths import choose_path
 from plansim.uncertainty.appendix_a_jjf1535 import BIAS, SCALE_FACTOR
 from plansim.units import ARCSEC, DEG
@@ -44,6 +52,9 @@ POSITION_ACCURACY = 3.0 * ARCSEC
 ACQUISITION_BITS = 21
 #: the items Appendix A budgets, with its budget: Appendix A reads both relative
 BUDGETED = {"scale_factor": SCALE_FACTOR, "bias": BIAS, "bias_up_down": BIAS}
+#: items with a true value whose reported figure's distribution is shown too: a lab quotes the figure, and the
+#: procedure reports a tested rate (7.2.6, 7.2.7) or a sample std of Q values (7.2.4, 7.2.11), not the property
+FIGURE_ALSO = ("scale_repeatability", "threshold", "resolution", "warm_up_time", "bias_repeatability")
 
 
 def jjf1535_scenario(scenario: Scenario, procedure: Jjf1535Procedure | None = None,
@@ -91,7 +102,11 @@ def truth_of(scenario: Scenario, procedure: Jjf1535Procedure, truth) -> dict[str
                       bias_temperature_coefficient=float(e.gyro_bias_temperature_coefficient[i]),
                       reference_temperature=e.reference_temperature, asymmetry=float(e.gyro_asymmetry[i]),
                       nonlinearity_quadratic=float(e.gyro_nonlinearity_quadratic[i]),
-                      nonlinearity_cubic=float(e.gyro_nonlinearity_cubic[i]))
+                      nonlinearity_cubic=float(e.gyro_nonlinearity_cubic[i]),
+                      dead_zone=float(e.gyro_dead_zone[i]), resolution=float(e.gyro_resolution[i]),
+                      warm_up_amplitude=float(e.gyro_warm_up_amplitude[i]),
+                      warm_up_time_constant=float(e.gyro_warm_up_time_constant[i]),
+                      turn_on_bias=float(e.gyro_turn_on_bias[i]))
 
 
 @dataclass(frozen=True)
@@ -121,21 +136,23 @@ class Jjf1535MonteCarlo:
         With a true value: the mean, standard deviation (n − 1) and 95 % quantile of |error| of the error, and the
         mean true value. For the budgeted items also the relative error's statistics, Appendix A's printed U and
         the fraction of trials whose |relative error| is within it (its coverage). Without: the mean, standard
-        deviation and 2.5 %/97.5 % quantiles of the reported figure.
+        deviation and 2.5 %/97.5 % quantiles of the reported figure. ``undetermined``: the fraction of trials in
+        which the procedure could not determine the item (NaN: a threshold or resolution above every tested rate,
+        a warm-up never reaching the specified stability); the statistics are those of the other trials (NaN if
+        fewer than two).
         """
         rows = []
         for item in self.items:
             clause, equations, unit, scale = ITEMS[item]
             x, t = self.column(item), self.column(item, "truth")
-            row = {"item": item, "clause": clause, "equations": equations, "unit": unit, "trials": self.trials}
-            if np.all(np.isnan(t)):
-                q = np.quantile(x, [0.025, 0.975]) / scale
-                row.update(truth=math.nan, mean=float(x.mean() / scale), std=float(np.std(x, ddof=1) / scale),
-                           q025=float(q[0]), q975=float(q[1]))
-            else:
-                err = (x - t) / scale
-                row.update(truth=float(t.mean() / scale), mean_error=float(err.mean()),
-                           std_error=float(np.std(err, ddof=1)), mc_U95=float(np.quantile(np.abs(err), 0.95)))
+            found = np.isfinite(x)
+            row = {"item": item, "clause": clause, "equations": equations, "unit": unit, "trials": self.trials,
+                   "undetermined": float(1.0 - found.mean())}
+            has_truth = not np.all(np.isnan(t))
+            x, t = x[found], t[found]
+            row.update(_error_statistics(x, t, scale) if has_truth else {"truth": math.nan})
+            if not has_truth or item in FIGURE_ALSO:
+                row.update(_figure_statistics(x, scale))
             if item in BUDGETED:
                 rel = self.relative_errors(item)
                 budget = BUDGETED[item].printed_expanded_uncertainty
@@ -145,6 +162,25 @@ class Jjf1535MonteCarlo:
                            coverage=float(np.mean(np.abs(rel) <= budget)))
             rows.append(row)
         return rows
+
+
+def _figure_statistics(x: np.ndarray, scale: float) -> dict[str, float]:
+    """Mean, std (n − 1), 2.5 % and 97.5 % quantiles of the reported values *x* (SI) in units of *scale*."""
+    if x.size < 2:
+        return dict.fromkeys(("mean", "std", "q025", "q975"), math.nan)
+    q = np.quantile(x, [0.025, 0.975]) / scale
+    return {"mean": float(x.mean() / scale), "std": float(np.std(x, ddof=1) / scale), "q025": float(q[0]),
+            "q975": float(q[1])}
+
+
+def _error_statistics(x: np.ndarray, t: np.ndarray, scale: float) -> dict[str, float]:
+    """The mean true value, the error's mean and std (n − 1) and the 95 % quantile of |error|, units of *scale*."""
+    if x.size < 2:
+        return {"truth": float(np.mean(t) / scale) if t.size else math.nan,
+                **dict.fromkeys(("mean_error", "std_error", "mc_U95"), math.nan)}
+    err = (x - t) / scale
+    return {"truth": float(t.mean() / scale), "mean_error": float(err.mean()), "std_error": float(np.std(err, ddof=1)),
+            "mc_U95": float(np.quantile(np.abs(err), 0.95))}
 
 
 def jjf1535_monte_carlo(scenario: Scenario, trials: int, seed: int, procedure: Jjf1535Procedure | None = None,
@@ -174,14 +210,20 @@ def jjf1535_monte_carlo(scenario: Scenario, trials: int, seed: int, procedure: J
     world, procedure = jjf1535_scenario(scenario, procedure, keep_table)
     trials = check_count("trials", trials, minimum=2)
     seed = check_count("seed", seed, minimum=0)
-    chosen, _reasons = choose_path(world, path)
+    kernel_world = without_jjf1535_effects(world)  # the kernels' part; the JJF 1535 effects are added to the means
+    chosen, _reasons = choose_path(kernel_world, path)
     gravity = scenario.reduction.reference_gravity
     items = tuple(ITEMS)
     values = np.empty((trials, len(items)))
     true = np.empty((trials, len(items)))
-    for start, stop, means, truth in iterate_chunks(world, trials, seed, chunk_size, chosen):
+    effects = bool(world.effects.jjf1535_effects_set())
+    rates = input_axis_rates(world, procedure) if effects else None
+    for start, stop, means, truth in iterate_chunks(kernel_world, trials, seed, chunk_size, chosen):
         for n in range(start, stop):
-            v = reduce_items(means[n - start], procedure, gravity)
+            session = means[n - start]
+            if effects:
+                session = apply_jjf1535_effects(session, truth[n - start], world, procedure, seed, n, rates)
+            v = reduce_items(session, procedure, gravity)
             t = truth_of(world, procedure, truth[n - start])
             values[n] = [v[k] for k in items]
             true[n] = [t[k] for k in items]
