@@ -62,21 +62,12 @@ STREAM_VIBRATION, STREAM_GYRO_NOISE, STREAM_ACCEL_NOISE, STREAM_CALIBRATION = 0,
 DEG_H = DEG / HOUR
 
 
-def _default_gyro() -> VibrationGyro:
-    """The unit: K, B and the cross-axis G of the jjf2003 scenario's ADIS16465-1-class MEMS IMU
-    (scenarios/jjf2003.toml). :meth:`VibrationExperiment.gyro` sets G's diagonal (``g_own``, 72 °/h/g =
-    0.02 °/s/g, a MEMS gyro's usual linear-g figure: large enough that the gyro output's PSD follows the
-    vibration's above the white noise, as in the paper's Figure 4) and the g² and g³ terms: 1.6 °/h/g² on
-    the own axis and 0.8 °/h/g² across (so that the z gyro shifts by ≈ 59 °/h under the paper's 36.7 g²,
-    its ≈ 60 °/h), products 0.3 °/h/g², g³ 0.002 °/h/g³ (a shift of 3 D g E[a²] ≈ 0.2 °/h: negligible,
-    as the paper found)."""
-    K = np.array([[1.0021, 0.0004, -0.0007], [-0.0003, 0.9985, 0.0005], [0.0006, -0.0002, 1.0012]])
-    B = np.array([0.12, -0.08, 0.05]) * DEG
-    G = np.array([[18.0, -9.0, 6.0], [-7.0, 12.0, 5.0], [4.0, -6.0, 15.0]]) * DEG_H / STANDARD_GRAVITY
-    S2 = np.where(np.eye(3, dtype=bool), 1.6, 0.8) * DEG_H / STANDARD_GRAVITY**2
-    Sx = np.full((3, 3), 0.3) * DEG_H / STANDARD_GRAVITY**2
-    D = np.full((3, 3), 0.002) * DEG_H / STANDARD_GRAVITY**3
-    return VibrationGyro(K, B, G, S2, Sx, D)
+#: the unit: K and B of the jjf2003 scenario's ADIS16465-1-class MEMS IMU (scenarios/jjf2003.toml), and the
+#: cross-axis terms of its g-sensitivity G (rad/s per m/s²; G's diagonal is the setting ``g_own``). The g² and g³
+#: terms are settings too (:meth:`VibrationExperiment.gyro`)
+UNIT_K = np.array([[1.0021, 0.0004, -0.0007], [-0.0003, 0.9985, 0.0005], [0.0006, -0.0002, 1.0012]])
+UNIT_B = np.array([0.12, -0.08, 0.05]) * DEG
+UNIT_G_CROSS = np.array([[0.0, -9.0, 6.0], [-7.0, 0.0, 5.0], [4.0, -6.0, 0.0]]) * DEG_H / STANDARD_GRAVITY
 
 
 #: the fields ``--set`` may change: name -> (unit kind, or "count", "choice", "axes"; lower bound; description)
@@ -196,11 +187,16 @@ class VibrationExperiment:
         return flat_profile(self.psd_level, self.band_low, self.band_high)
 
     def gyro(self) -> VibrationGyro:
-        """The unit's truth: :func:`_default_gyro` with the g² and g³ figures of these settings."""
-        base = _default_gyro()
-        G = np.where(np.eye(3, dtype=bool), self.g_own, base.G)
-        S2 = np.where(np.eye(3, dtype=bool), self.g2_own, self.g2_cross)
-        return dataclasses.replace(base, G=G, S2=S2, Sx=np.full((3, 3), self.g2_product), D=np.full((3, 3), self.g3))
+        """The unit's truth: :data:`UNIT_K`, :data:`UNIT_B` and :data:`UNIT_G_CROSS`, with G's diagonal and the g²
+        and g³ terms of these settings. The defaults: ``g_own`` 72 °/h/g = 0.02 °/s/g, a MEMS gyro's usual
+        linear-g figure (large enough that the gyro output's PSD follows the vibration's above the white noise,
+        as in the paper's Figure 4); g² 1.6 °/h/g² on the own axis and 0.8 °/h/g² across (so that the z gyro
+        shifts by ≈ 59 °/h under the paper's 36.7 g², its ≈ 60 °/h), products 0.3 °/h/g²; g³ 0.002 °/h/g³ (a
+        shift of 3 D g E[a²] ≈ 0.2 °/h: negligible, as the paper found)."""
+        eye = np.eye(3, dtype=bool)
+        return VibrationGyro(UNIT_K, UNIT_B, np.where(eye, self.g_own, UNIT_G_CROSS),
+                             np.where(eye, self.g2_own, self.g2_cross), np.full((3, 3), self.g2_product),
+                             np.full((3, 3), self.g3))
 
     def axes(self) -> list[int]:
         return ["xyz".index(c) for c in self.vibration_axes]
