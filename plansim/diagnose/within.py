@@ -158,6 +158,12 @@ def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[n
     return out, np.where(varies, freq, np.nan)
 
 
+def codes(x: np.ndarray, q: float) -> np.ndarray:
+    """*x* through the null's quantiser of step *q*: the nearest code k·q (no range, no full scale: the null
+    draws stay near the segment's own level)."""
+    return np.round(x / q) * q
+
+
 def simulate_noise(channel, n: int, sample_rate: float, draws: int, rng: np.random.Generator,
                    sigma: float | None = None, level: float | None = None) -> np.ndarray:
     """(draws, n) samples of one channel's fitted noise (module docstring: white, flicker, random walk,
@@ -187,7 +193,7 @@ def simulate_noise(channel, n: int, sample_rate: float, draws: int, rng: np.rand
     q = channel.quantisation_step
     if q and q > 0:
         offset = rng.uniform(-0.5, 0.5, size=(draws, 1)) * q if level is None else level
-        x = np.round((x + offset) / q) * q
+        x = codes(x + offset, q)
     return x
 
 
@@ -209,7 +215,7 @@ def turning_noise_before_quantiser(smooth: np.ndarray, q: float, sd: float, rate
     z = np.random.default_rng(0).standard_normal((MATCH_DRAWS, smooth.size))
 
     def scatter(sigma: float) -> float:
-        y = np.round((smooth + sigma * z) / q) * q
+        y = codes(smooth + sigma * z, q)
         r = turning_residuals(y.T, rate, sample_rate)
         return float(np.mean(np.std(r, axis=0, ddof=1 + 2 * TURNING_HARMONICS))) - sd
 
@@ -368,7 +374,7 @@ def within_segment_tests(segment_samples, segments, noise, *, alpha: float = 0.0
                     if not sigma >= DITHERED * q:
                         continue  # not dithered: its samples sit on one or two codes, as at rest
                     noisy = smooth + sigma * rng.standard_normal((draws, x.shape[0]))
-                    simulated = turning_residuals((np.round(noisy / q) * q).T, segment.rate, fs).T
+                    simulated = turning_residuals(codes(noisy, q).T, segment.rate, fs).T
                 else:
                     simulated = turning_residuals((sd * rng.standard_normal((draws, x.shape[0]))).T, segment.rate,
                                                   fs).T
