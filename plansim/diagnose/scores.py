@@ -168,6 +168,11 @@ class _Geometry:
         keep = values > 1e-12 * max(values.max(), 1e-300)
         return (vectors[:, keep] / np.sqrt(values[keep])).T @ basis.T
 
+    def spread(self, U: np.ndarray) -> np.ndarray:
+        """(m,) the null standard deviation of each column u of *U*'s plain score uᵀ r_w: √(uᵀ M u),
+        M = P⊥ W V Wᵀ P⊥."""
+        return np.linalg.norm(U.T @ self.noise_map, axis=1)
+
     def _pinv(self) -> np.ndarray:
         """M⁺, M = P⊥ W V Wᵀ P⊥ (cached)."""
         if not hasattr(self, "_M_pinv"):
@@ -262,7 +267,7 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         usable = excited & (surviving > ALIAS_TOLERANCE * np.maximum(norms, 1e-300))
         # noise-equivalent size: the size at which the component alone gives its 1-dof score a non-centrality of 1,
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
-        spread = np.linalg.norm((Z / np.where(surviving > 0, surviving, 1.0)).T @ g.noise_map, axis=1)
+        spread = g.spread(Z / np.where(surviving > 0, surviving, 1.0))
         nes = np.where(usable, spread / np.where(surviving > 0, surviving, 1.0), np.inf)
         # each component alone: its efficient 1-dof score (zᵀ M⁺ r_w)² / (zᵀ M⁺ z)
         component = np.where(usable, g.efficient_scores(Z), np.nan)
@@ -376,7 +381,8 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     L_null = np.sum(null**2, axis=0)
     p_omnibus = (1 + np.count_nonzero(L_null >= L)) / (B + 1)
     dof = int(g.r.size - g.Q.shape[1])
-    # the largest step: each column's own 1-dof score (uᵀ r_w)²/(uᵀ M u), maximised over channels and boundaries
+    # the largest step: each column's own standardised 1-dof score (uᵀ r_w)²/(uᵀ M u), u = z/‖z‖ (the plain
+    # projection, not the efficient score of the attribution), maximised over channels and boundaries
     columns, where = step_columns(fit)
     step = None
     p = p_omnibus
@@ -387,7 +393,7 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         if np.any(keep):
             Z, where = Z[:, keep], [w for w, k in zip(where, keep) if k]
             U = Z / np.linalg.norm(Z, axis=0)
-            spread = np.linalg.norm(U.T @ g.noise_map, axis=1)
+            spread = g.spread(U)
             ok = spread > 0
             U, spread, where = U[:, ok], spread[ok], [w for w, k in zip(where, ok) if k]
             scores = (U.T @ g.r / spread) ** 2
