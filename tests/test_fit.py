@@ -777,3 +777,23 @@ def test_the_ferraris_example_session_imports_and_fits():
     assert [estimate[f"Kg{a}{a}"] for a in "xyz"] == pytest.approx([1.0278, 0.9825, 0.9982], abs=0.001)
     assert result.chi2 / result.chi2_dof > 3 and "larger than" in result.chi2_verdict
     assert len(result.placed) == 13 and result.hand_axes == (0, 1, 2)
+
+
+def test_a_given_noise_estimate_gives_the_same_fit_and_a_wrong_one_is_refused():
+    """``fit_recording(noise=recording_noise(rec))`` — what plansim diagnose passes to its refits — is the same fit
+    to the last bit as letting the fit estimate the noise itself; a noise estimate of another schedule is refused
+    by name."""
+    from plansim.fit import recording_noise
+
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=3, trial=0)
+    site = resolve_site(scenario=scenario)
+    own = fit_recording(recording, site, scenario.turntable)
+    given = fit_recording(recording, site, scenario.turntable, noise=recording_noise(recording))
+    assert np.array_equal(own.joint.estimate, given.joint.estimate, equal_nan=True)
+    assert np.array_equal(own.joint.u, given.joint.u, equal_nan=True)
+    assert np.array_equal(own.covariance, given.covariance)
+    noise = recording_noise(recording)
+    shorter = dataclasses.replace(noise, within_std=noise.within_std[:-1])
+    with pytest.raises(ValueError, match="noise: estimated over"):
+        fit_recording(recording, site, scenario.turntable, noise=shorter)

@@ -88,7 +88,7 @@ class BetweenSegmentNoise:
 
     def covariance(self, c: int, times: np.ndarray) -> np.ndarray:
         """(S, S) covariance of channel *c*'s term over segments at middle *times* (s)."""
-        return self.variance[c] * _time_correlation(times, self.correlation_time[c])
+        return self.variance[c] * time_correlation(times, self.correlation_time[c])
 
 
 #: the likelihood-ratio statistic 2·Δlog L (against σ² = 0) above which the between-segment noise is taken:
@@ -100,7 +100,8 @@ BETWEEN_LR_THRESHOLD = 3.0
 BETWEEN_CORRELATION_TIMES = (0.0, 30.0, 100.0, 300.0)
 
 
-def _time_correlation(times: np.ndarray, tau: float) -> np.ndarray:
+def time_correlation(times: np.ndarray, tau: float) -> np.ndarray:
+    """(S, S) exp(−|t_s − t_r|/τ) between segments at middle *times* (s); the identity for τ ≤ 0."""
     lag = np.abs(np.asarray(times, dtype=float)[:, None] - np.asarray(times, dtype=float)[None, :])
     return np.eye(lag.shape[0]) if tau <= 0 else np.exp(-lag / tau)
 
@@ -148,7 +149,7 @@ def between_segment_noise(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, 
         scale = float(np.median(d))  # σ² is searched relative to the predicted residual variance
         best = (0.0, 0.0, -0.5 * float(y @ y))  # σ² = 0: the prediction alone
         for tau in BETWEEN_CORRELATION_TIMES:
-            A = U.T @ Rcc @ _time_correlation(times[segments], tau) @ Rcc.T @ U
+            A = U.T @ Rcc @ time_correlation(times[segments], tau) @ Rcc.T @ U
             lam, Q = np.linalg.eigh(A)
             lam = np.maximum(lam, 0.0)
             z2 = (Q.T @ y) ** 2
@@ -528,11 +529,26 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     return theta, tilts, basis[:n] @ gain_z, design, gain_z, 2.0 * float(result.cost), result.x[len(result.x) - m:]
 
 
+def _noise_segments(schedule) -> list[int]:
+    """The segments whose samples show the sensors' noise: every one that is not a move."""
+    return [k for k, s in enumerate(schedule.segments) if s.test != "move"]
+
+
+def recording_noise(recording, stated_white=None) -> NoiseEstimate:
+    """The noise of a recording's samples (:func:`plansim.fit.noise.estimate_noise` over every segment that is
+    not a move), which :func:`fit_recording` takes as its ``noise`` so that refits of the same samples share it."""
+    schedule = recording.schedule
+    segments = _noise_segments(schedule)
+    return estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in segments],
+                          [schedule.segments[k] for k in segments], stated_white)
+
+
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
-                  between_noise: BetweenSegmentNoise | None = None, stated_white=None) -> FitResult:
+                  between_noise: BetweenSegmentNoise | None = None, stated_white=None,
+                  noise: NoiseEstimate | None = None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -565,6 +581,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         The sensor's stated white-noise densities (rad/s/√Hz for gx gy gz, m/s²/√Hz for ax ay az; NaN where not
         stated), as a scenario's ``[mimu.noise]`` gives them: the prior of the noise before a quantiser the noise
         does not dither, which the data show only weakly (:func:`plansim.fit.noise.quantised_noise_posterior`).
+    noise : NoiseEstimate, optional
+        The noise of the recording's samples, as :func:`recording_noise` returns it for this recording and
+        *stated_white*: given, it is not estimated again (it depends on the samples alone, and ``plansim
+        diagnose`` refits the same recording several times).
 
     Returns
     -------
@@ -628,9 +648,12 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
 
     # noise: every segment that is not a move (any pose at rest shows the sensors' noise)
-    noise_segments = [k for k, s in enumerate(schedule.segments) if s.test != "move"]
-    all_noise = estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in noise_segments],
-                               [schedule.segments[k] for k in noise_segments], stated_white)
+    noise_segments = _noise_segments(schedule)
+    all_noise = recording_noise(recording, stated_white) if noise is None else noise
+    if all_noise.within_std.shape[0] != len(noise_segments):
+        raise ValueError(f"noise: estimated over {all_noise.within_std.shape[0]} segments, but this recording has "
+                         f"{len(noise_segments)} that are not moves; pass recording_noise(recording) of this "
+                         "recording")
     keep = [noise_segments.index(k) for k in used]
     noise = NoiseEstimate(all_noise.channels, all_noise.within_std[keep], all_noise.mean_variance[keep],
                           all_noise.mean_variance_dof[keep], all_noise.quantisation_variance[keep],
