@@ -29,11 +29,13 @@ documented fallback (``method="holm"``).
 
 **Lack of fit** (segment level): L = ‖r_w‖² against the same simulated null, p = (1 + #{L*_b ≥ L})/(B + 1),
 overall and per channel (the channel's rows of r_w); and the largest **step** in one channel's level between two
-segments adjacent in time (:func:`step_columns`), max over channels and boundaries of each step column's own 1-dof
-score, against the max of the same over the null draws. A bias that jumps part-way through a run moves every later
-segment's mean: the omnibus test barely sees it, because the slow noise between segments, estimated from the
-same residuals, takes it up (a correlation time of 300 s and a σ of about half the step), while a step is one
-abrupt change where that noise changes little from one 30 s segment to the next. The two tests are held together at
+segments adjacent in time (:func:`step_columns`), max over channels and boundaries of each step column's profile
+likelihood ratio with the channel's between-segment noise re-estimated under the step
+(:func:`_step_likelihood_ratios`), against the max of the same over the null draws. A bias that jumps part-way
+through a run moves every later segment's mean: the omnibus test barely sees it, because the slow noise between
+segments, estimated from the same residuals, takes it up (a correlation time of 300 s and a σ of about half the
+step) — and so would a step score measured against that noise — while a step is one abrupt change where that noise
+changes little from one 30 s segment to the next. The two tests are held together at
 α by their min-p over the same draws (each draw's p-values its ranks among the draws).
 
 **Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
@@ -366,6 +368,98 @@ def step_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     return (np.array(columns).T if columns else np.zeros((6 * S, 0))), where
 
 
+#: the grid of σ²·λ_max over which the step test profiles a channel's between-segment noise (0: none; then
+#: 10⁻² … 10⁴): the same grid for the data and every null draw, so a coarse grid costs a little power, not level
+STEP_PROFILE_GRID = np.concatenate([[0.0], np.logspace(-2.0, 4.0, 25)])
+
+
+def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list, null: np.ndarray):
+    """The profile likelihood ratio of a step in one channel's level, for each step column, on the data and on
+    every null draw; ``None`` if no column survives the base model.
+
+    A bias that jumps part-way through a run puts a step into the residuals, and the between-segment noise the
+    base fit estimates from those same residuals (:func:`plansim.fit.joint.between_segment_noise`: a term of
+    variance σ_c² correlated as exp(−|t_s − t_r|/τ_c) between segments) takes it up: scored against that
+    inflated noise a step scores almost the same whatever its size (a linear_gaussian recording's p went from
+    0.020 at 10× to 0.008 at 20× and 0.004 at 40× a segment mean's u). So the nuisance is re-estimated under each
+    alternative, as a likelihood-ratio test does. For channel c, with M₀ the whitened residual covariance without
+    c's between term and N_c(τ) = P⊥ W Σ_c(τ) Wᵀ P⊥ that term's shape, both diagonalised at once (T = M₀^{-1/2}
+    on its range, T N_c T = Q Λ Qᵀ), the whitened residual z = Qᵀ T r and a step column x = Qᵀ T P⊥ W s give
+
+        ℓ₀(σ², τ) = −½ Σ_i [log(1 + σ²λ_i) + z_i²/(1 + σ²λ_i)],
+        ℓ₁(σ², τ) = ℓ₀ + ½ (Σ w_i x_i z_i)² / Σ w_i x_i²,   w_i = 1/(1 + σ²λ_i),
+
+    and the statistic 2·(max ℓ₁ − max ℓ₀), both maximised over τ in
+    :data:`plansim.fit.joint.BETWEEN_CORRELATION_TIMES` and σ² on :data:`STEP_PROFILE_GRID` — for the data and
+    for each null draw alike, so the simulated null calibrates it whatever the grid. The other channels' between
+    terms stay as the fit estimated them.
+
+    Returns
+    -------
+    (K,) statistics, (B,) the largest over columns of each null draw, (K,) each step's size at its maximum
+    (SI, the GLS estimate in the channel's own unit), and the (channel, before, after) of each kept column.
+    """
+    from plansim.fit.joint import BETWEEN_CORRELATION_TIMES, time_correlation
+
+    WS = g.project(g.W @ columns)
+    norms = np.linalg.norm(WS, axis=0)
+    keep = norms > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(g.W @ columns, axis=0), 1e-300)
+    if not np.any(keep):
+        return None
+    WS, where = WS[:, keep], [w for w, k in zip(where, keep) if k]
+    channel = np.array([w[0] for w in where])
+    times = np.asarray(fit.segment_times, dtype=float)
+    fitted = np.asarray(fit.fitted_rows, dtype=bool)
+    slow = fit.between_noise
+    Wp = g.project(g.W)  # P⊥ W, (n, 6S)
+    M = g.noise_map @ g.noise_map.T
+    B = null.shape[1]
+    statistic, size = np.full(channel.size, -np.inf), np.zeros(channel.size)
+    null_max = np.full(B, -np.inf)
+    for c in np.unique(channel):
+        cols = np.flatnonzero(channel == c)
+        segments = np.flatnonzero(fitted[:, c])
+        shape_of = {tau: Wp[:, segments * 6 + c] @ time_correlation(times[segments], tau)
+                    @ Wp[:, segments * 6 + c].T for tau in BETWEEN_CORRELATION_TIMES}
+        M0 = M
+        if slow is not None and slow.variance[c] > 0:
+            M0 = M - slow.variance[c] * shape_of[float(slow.correlation_time[c])]
+        values, vectors = np.linalg.eigh(0.5 * (M0 + M0.T))
+        ok = values > 1e-10 * max(values.max(), 1e-300)
+        T = vectors[:, ok] / np.sqrt(values[ok])
+        best0, best0_null = -np.inf, np.full(B, -np.inf)
+        best1, best1_null = np.full(cols.size, -np.inf), np.full((cols.size, B), -np.inf)
+        best_size = np.zeros(cols.size)
+        for tau in BETWEEN_CORRELATION_TIMES:
+            lam, Q = np.linalg.eigh(T.T @ shape_of[tau] @ T)
+            lam = np.maximum(lam, 0.0)
+            if lam.max() <= 0:
+                continue
+            G = (T @ Q).T
+            z, Z, X = G @ g.r, G @ null, G @ WS[:, cols]
+            for t in STEP_PROFILE_GRID:
+                w = 1.0 / (1.0 + (t / lam.max()) * lam)
+                half_log_det = 0.5 * float(np.sum(np.log(1.0 / w)))
+                l0 = -half_log_det - 0.5 * float(w @ z**2)
+                l0_null = -half_log_det - 0.5 * (w @ Z**2)
+                wX = X * w[:, None]
+                information = np.sum(wX * X, axis=0)
+                information = np.where(information > 0, information, np.inf)
+                cross = wX.T @ z
+                l1 = l0 + 0.5 * cross**2 / information
+                l1_null = l0_null[None, :] + 0.5 * (wX.T @ Z) ** 2 / information[:, None]
+                better = l1 > best1
+                best_size = np.where(better, cross / information, best_size)
+                best1 = np.maximum(best1, l1)
+                best0 = max(best0, l0)
+                best0_null = np.maximum(best0_null, l0_null)
+                best1_null = np.maximum(best1_null, l1_null)
+        statistic[cols] = 2.0 * (best1 - best0)
+        size[cols] = best_size
+        null_max = np.maximum(null_max, np.max(2.0 * (best1_null - best0_null[None, :]), axis=0))
+    return statistic, null_max, size, where
+
+
 def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
                 null: np.ndarray | None = None) -> LackOfFit:
     """The segment-level lack of fit against the simulated null (module docstring, "Lack of fit"): the omnibus
@@ -381,36 +475,27 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     L_null = np.sum(null**2, axis=0)
     p_omnibus = (1 + np.count_nonzero(L_null >= L)) / (B + 1)
     dof = int(g.r.size - g.Q.shape[1])
-    # the largest step: each column's own standardised 1-dof score (uᵀ r_w)²/(uᵀ M u), u = z/‖z‖ (the plain
-    # projection, not the efficient score of the attribution), maximised over channels and boundaries
+    # the largest step: each column's profile likelihood ratio, the channel's between-segment noise re-estimated
+    # with the step in the model (_step_likelihood_ratios), maximised over channels and boundaries
     columns, where = step_columns(fit)
     step = None
     p = p_omnibus
-    if columns.shape[1]:
-        Z = g.project(g.W @ columns)
-        norms = np.linalg.norm(Z, axis=0)
-        keep = norms > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(g.W @ columns, axis=0), 1e-300)
-        if np.any(keep):
-            Z, where = Z[:, keep], [w for w, k in zip(where, keep) if k]
-            U = Z / np.linalg.norm(Z, axis=0)
-            spread = g.spread(U)
-            ok = spread > 0
-            U, spread, where = U[:, ok], spread[ok], [w for w, k in zip(where, ok) if k]
-            scores = (U.T @ g.r / spread) ** 2
-            null_scores = np.max((U.T @ null / spread[:, None]) ** 2, axis=0)
-            best = int(np.argmax(scores))
-            T = float(scores[best])
-            p_step = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
-            # min-p of the two over the same draws: each draw's own p-values against the others' (ranks)
-            rank_L = (B - np.argsort(np.argsort(L_null, kind="stable"), kind="stable")) / B
-            rank_T = (B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B
-            p = (1 + np.count_nonzero(np.minimum(rank_L, rank_T) <= min(p_omnibus, p_step))) / (B + 1)
-            c, before, after = where[best]
-            size = float((U[:, best] @ g.r) / (U[:, best] @ Z[:, best]))  # GLS size along the column, SI
-            step = {"statistic": T, "p_value": float(p_step), "channel": CHANNELS[c],
-                    "between": [int(fit.used[before]), int(fit.used[after])],
-                    "labels": [fit.labels[before], fit.labels[after]],
-                    "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])), "size": size}
+    profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
+    if profiled is not None:
+        scores, null_scores, sizes, where = profiled
+        best = int(np.argmax(scores))
+        T = float(scores[best])
+        p_step = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
+        # min-p of the two over the same draws: each draw's own p-values against the others' (ranks)
+        rank_L = (B - np.argsort(np.argsort(L_null, kind="stable"), kind="stable")) / B
+        rank_T = (B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B
+        p = (1 + np.count_nonzero(np.minimum(rank_L, rank_T) <= min(p_omnibus, p_step))) / (B + 1)
+        c, before, after = where[best]
+        step = {"statistic": T, "p_value": float(p_step), "channel": CHANNELS[c],
+                "between": [int(fit.used[before]), int(fit.used[after])],
+                "labels": [fit.labels[before], fit.labels[after]],
+                "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])),
+                "size": float(sizes[best])}
     per_channel = {}
     for c, name in enumerate(CHANNELS):
         sel = g.channel_of_row == c

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from plansim.diagnose.procedure import absorbed
+from plansim.diagnose.procedure import absorbed, levels
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 from plansim.report.fit import OUTPUT_UNITS, _g, _kind
@@ -52,9 +52,10 @@ def diagnose_report(d) -> str:
     lines = ["plansim diagnose — closing the loop (docs/closing-the-loop.md)", ""]
     lof = d.lack_of_fit
     lines.append(f"Lack of fit of the base model (segment means, simulated null): statistic {_g(lof.statistic, 5)}, "
-                 f"p = {_p(lof.p_value)} -> {'FLAGGED' if lof.flagged else 'not flagged'} at alpha/2 = {d.alpha / 2:g}")
+                 f"p = {_p(lof.p_value)} -> {'FLAGGED' if lof.flagged else 'not flagged'} at "
+                 f"{levels(d.alpha)['lack_of_fit']:g} (alpha = {d.alpha:g} for the whole diagnosis)")
     if d.selected:
-        lines.append(f"Found (closed testing, family-wise alpha = {d.alpha:g}):")
+        lines.append(f"Found (closed testing, family-wise level {levels(d.alpha)['selections']:g}):")
         for effect in d.selected:
             size = d.sizes[effect]
             parts = ", ".join(f"{c} = {v:.4g} ± {u:.2g}" for c, v, u in zip(size["components"], size["value"],
