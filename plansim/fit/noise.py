@@ -35,6 +35,7 @@ data carry no noise at all (a simulated ``ideal`` recording).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -547,12 +548,24 @@ def turning_design(n: int, rate: float, sample_rate: float) -> np.ndarray:
     return np.column_stack(columns)
 
 
+@functools.lru_cache(maxsize=64)
+def _turning_basis(n: int, rate: float, sample_rate: float) -> np.ndarray:
+    """An orthonormal basis (n, rank) of :func:`turning_design`'s columns (SVD, rank to 1e-10 of the largest
+    singular value), kept for the null draws of the same segment (``plansim diagnose``'s within tests fit
+    thousands of draws of one turning segment)."""
+    u, s, _ = np.linalg.svd(turning_design(n, rate, sample_rate), full_matrices=False)
+    basis = u[:, s > 1e-10 * s.max()]
+    basis.setflags(write=False)
+    return basis
+
+
 def turning_residuals(values: np.ndarray, rate: float, sample_rate: float) -> np.ndarray:
-    """A turning segment's samples (n, …) less their least-squares fit by :func:`turning_design` (n > its columns)."""
+    """A turning segment's samples (n, …) less their least-squares fit by :func:`turning_design` (n > its columns):
+    the projection onto the orthogonal complement of the design's columns."""
     values = np.asarray(values, dtype=float)
-    design = turning_design(values.shape[0], rate, sample_rate)
-    coefficients, *_ = np.linalg.lstsq(design, values.reshape(values.shape[0], -1), rcond=None)
-    return values - (design @ coefficients).reshape(values.shape)
+    basis = _turning_basis(values.shape[0], float(rate), float(sample_rate))
+    flat = values.reshape(values.shape[0], -1)
+    return (flat - basis @ (basis.T @ flat)).reshape(values.shape)
 
 
 def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tuple[np.ndarray, int]:
