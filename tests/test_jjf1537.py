@@ -159,7 +159,7 @@ def test_second_order_sensor_gives_its_response_within_the_mc_uncertainty_and_th
 
     The MC mean of each K_i, Δφ_i and of the bandwidth is within 5 s/√T of the noise-free procedure's value
     (T = 200 trials, s the MC standard deviation: the estimators are unbiased to first order in the noise, so a
-    correct simulation fails one of these 21 checks with probability < 21 × 5.7e-7); the noise-free values
+    correct simulation fails one of these 20 checks with probability < 20 × 5.7e-7 = 1.1e-5); the noise-free values
     differ from the analytic |H(f_i)| only by the reference S_0 read at the lowest frequency, which is checked
     in closed form. The MC standard deviations match the GUM's u within 4/√(2(T − 1)) = 0.20 relative (4 times
     the relative standard error of a standard deviation from T normal samples)."""
