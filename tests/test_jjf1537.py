@@ -215,3 +215,14 @@ def test_cli_text_and_bad_input(capsys):
 def test_settings_equal_after_round_trip():
     s = Jjf1537Experiment(damping=0.5)
     assert dataclasses.replace(s, overrides=("x",)) == s
+
+
+def test_cli_says_when_the_bandwidth_is_outside_the_band(capsys):
+    assert cli.main(["run", "jjf1537", "--trials", "2", "--quiet", "--set", "model=flat", "--set",
+                     "record_time=0.25 s", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)  # inf and nan are null: strict JSON
+    assert doc["truth"]["bandwidth"] is None and doc["monte_carlo"]["bandwidth_found"] == 0
+    assert cli.main(["run", "jjf1537", "--trials", "2", "--quiet", "--set", "natural_frequency=200 Hz", "--set",
+                     "record_time=0.25 s"]) == 0
+    assert "not found in any trial: the response does not fall through -3.01 dB between 13.75 and 110 Hz" in \
+        capsys.readouterr().out

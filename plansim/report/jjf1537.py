@@ -16,9 +16,9 @@ def _list(x) -> list:
 
 
 def _number(x) -> float | None:
-    """*x* as a float, None for nan (JSON has no nan)."""
+    """*x* as a float, None for nan or ±inf (JSON has neither; the flat sensor's bandwidth is inf)."""
     x = float(x)
-    return None if math.isnan(x) else x
+    return x if math.isfinite(x) else None
 
 
 def jjf1537_json(result, elapsed: float, version: str) -> dict:
@@ -78,12 +78,19 @@ def jjf1537_text(result, elapsed: float) -> str:
             f"{result.gum['ratio'][i]:8.2e}   {math.degrees(result.truth_phase[i]):17.4f}   "
             f"{math.degrees(summary['phase_bias'][i]):+10.2e}   {math.degrees(summary['phase_std'][i]):10.2e}   "
             f"{math.degrees(result.gum['phase'][i]):11.2e}")
+    if summary["bandwidth_found"] == 0:
+        bandwidth = (f"-3 dB bandwidth: truth {result.truth_bandwidth:.4f} Hz; not found in any trial: the response "
+                     f"does not fall through -3.01 dB between {sch.frequencies[0]:g} and {sch.frequencies[-1]:g} Hz "
+                     "(the bandwidth lies outside the measured band; --set expected_bandwidth=... or grid=jjf1537)")
+    else:
+        bandwidth = (
+            f"-3 dB bandwidth: truth {result.truth_bandwidth:.4f} Hz; procedure without noise "
+            f"{result.noise_free_bandwidth:.4f} Hz; MC mean {summary['bandwidth_mean']:.4f} Hz "
+            f"(bias {summary['bandwidth_bias']:+.4f} Hz), s {summary['bandwidth_std']:.4f} Hz, GUM u "
+            f"{result.gum['bandwidth']:.4f} Hz; found in {summary['bandwidth_found']}/{result.trials} trials")
     lines += [
         "",
-        f"-3 dB bandwidth: truth {result.truth_bandwidth:.4f} Hz; procedure without noise "
-        f"{result.noise_free_bandwidth:.4f} Hz; MC mean {summary['bandwidth_mean']:.4f} Hz "
-        f"(bias {summary['bandwidth_bias']:+.4f} Hz), s {summary['bandwidth_std']:.4f} Hz, GUM u "
-        f"{result.gum['bandwidth']:.4f} Hz; found in {summary['bandwidth_found']}/{result.trials} trials",
+        bandwidth,
         "K = S_i/S_0 with S_0 read at the lowest frequency (JJF 1537 eq. (9)); bias against the analytic |H|, "
         "arg H",
     ]
