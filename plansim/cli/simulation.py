@@ -8,13 +8,17 @@ import time
 
 from plansim.cli.common import COMMANDS, add_set_option
 from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, VALIDATE_REFUSAL, run_jjf1535
-from plansim.cli.vibration import EXPERIMENTS, run_vibration
+from plansim.cli.jjf1537 import DYNAMIC_TESTS, run_jjf1537_command
+from plansim.cli.vibration import EXPERIMENTS as VIBRATION_EXPERIMENTS
+from plansim.cli.vibration import run_vibration
 from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
 from plansim.report.progress import end_progress_line
 
 #: ``plansim run --chunk-size``'s default
 DEFAULT_CHUNK_SIZE = 4096
+#: the built-in experiments (``plansim run NAME [--set KEY=VALUE]``), listed last by ``plansim scenarios``
+EXPERIMENTS = {**DYNAMIC_TESTS, **VIBRATION_EXPERIMENTS}
 
 
 def _cmd_run(args) -> int:
@@ -29,7 +33,9 @@ def _cmd_run(args) -> int:
 
     if args.scenario in PROCEDURES:  # a built-in procedure run on a unit scenario, not a scenario file
         return run_jjf1535(args, DEFAULT_CHUNK_SIZE)
-    if args.scenario in EXPERIMENTS:  # a built-in experiment with its own settings (--set), not a scenario file
+    if args.scenario in DYNAMIC_TESTS:  # a built-in dynamic test, a Monte Carlo with its own settings (--set)
+        return run_jjf1537_command(args, DEFAULT_CHUNK_SIZE)
+    if args.scenario in VIBRATION_EXPERIMENTS:  # a built-in experiment with its own settings (--set)
         return run_vibration(args, DEFAULT_CHUNK_SIZE)
     if args.unit is not None:
         raise ValueError(f"--unit {args.unit!r}: only with a procedure ({', '.join(PROCEDURES)}: plansim run "
@@ -212,20 +218,21 @@ def add_commands(sub) -> None:
                        description="Monte Carlo of a scenario's calibration, compared with JJF 2003 Appendix A; "
                                    "'plansim run jjf1535 [--unit SCENARIO]': the JJF 1535-2015 procedure on a unit "
                                    "scenario, compared with its Appendix A; 'plansim run vibration_g2': the vibration "
-                                   "paper's g² experiment (docs/dynamic.md)")
+                                   "paper's g² experiment; 'plansim run jjf1537': the JJF 1537-2015 "
+                                   "angular vibration test, a Monte Carlo (docs/dynamic.md)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003; or the "
-                        "procedure jjf1535, or the experiment vibration_g2")
+                        "procedure jjf1535, the experiment vibration_g2, or the dynamic test jjf1537")
     p.add_argument("--unit", default=None, metavar="SCENARIO",
                    help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
                         f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
     p.add_argument("--trials", type=int, default=None,
-                   help="number of simulated calibrations (default: the scenario's; jjf1535: 1000)")
+                   help="number of simulated calibrations (default: the scenario's; jjf1535: 1000; jjf1537: 500)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's, or the unit's)")
     p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
     p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg); "
-                   "vibration_g2: the PSDs and the compensated output")
+                   "vibration_g2: the PSDs and the compensated output; jjf1537: the Bode diagram")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
     p.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
                    help="trials per kernel call (results do not depend on it; memory grows with it)")

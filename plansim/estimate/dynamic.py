@@ -347,3 +347,53 @@ def bandwidth_3db(frequencies, ratios, level: float = HALF_POWER) -> float:
         return float(f[0])
     f0, f1, K0, K1 = f[k - 1], f[k], K[k - 1], K[k]
     return float(f0 + (K0 - lev) * (f1 - f0) / (K0 - K1))
+
+
+@dataclass(frozen=True)
+class SineFits:
+    """:func:`sine_fit` of many records on one time axis: arrays of the records' shape (``amplitude``,
+    ``phase``, ``offset``, ``residual_rms``), the frequency and N."""
+
+    frequency: float
+    amplitude: np.ndarray
+    phase: np.ndarray
+    offset: np.ndarray
+    residual_rms: np.ndarray
+    samples: int
+
+
+def sine_fits(t, records, frequency: float) -> SineFits:
+    """:func:`sine_fit` of every record of *records* (..., N) sampled at the same times *t* (N,), at once.
+
+    The design matrix D = [cos ωt, sin ωt, 1] is the same for every record, so one least-squares solve with
+    the records as right-hand sides gives each record's (a, b, C), hence E, φ, C, as :func:`sine_fit`
+    computes them one by one (the same equations, JJF 1537-2015 eq. (6); their covariance is not formed
+    here). For the Monte Carlo of :mod:`plansim.simulate.jjf1537`, where n repeats × the trials share t.
+
+    Raises
+    ------
+    ValueError
+        As :func:`sine_fit` (lengths, finiteness, ordering, f ≤ 0, rank below 3).
+    """
+    t = checked_array("t", t, ndim=1, minimum=4)
+    y = np.asarray(records, dtype=float)
+    if y.ndim < 1 or y.shape[-1] != t.size:
+        raise ValueError(f"records: expected shape (..., {t.size}) for {t.size} sample times, got {y.shape}")
+    if not np.all(np.isfinite(y)):
+        raise ValueError("records: expected finite values, got nan or inf")
+    if not np.all(np.diff(t) > 0):
+        raise ValueError("t: expected strictly increasing times")
+    f = positive_number("frequency", frequency, "Hz")
+    omega_t = 2.0 * math.pi * f * t
+    design = np.column_stack((np.cos(omega_t), np.sin(omega_t), np.ones_like(t)))
+    rhs = y.reshape(-1, t.size).T
+    solution, _, rank, _ = scipy.linalg.lstsq(design, rhs, cond=RANK_TOLERANCE)
+    if rank < 3:
+        raise ValueError(f"frequency: at {f!r} Hz the columns cos ωt, sin ωt and 1 are linearly dependent at the "
+                         f"sample times t (rank {rank}); the sine fit needs samples at distinct phases")
+    residuals = rhs - design @ solution
+    a, b, c = solution
+    shape = y.shape[:-1]
+    return SineFits(frequency=f, amplitude=np.hypot(a, b).reshape(shape),
+                    phase=np.asarray(wrap_phase(np.arctan2(-b, a))).reshape(shape), offset=c.reshape(shape),
+                    residual_rms=np.sqrt(np.mean(residuals * residuals, axis=0)).reshape(shape), samples=t.size)

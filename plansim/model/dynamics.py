@@ -1,4 +1,4 @@
-"""Analytic frequency responses of a sensor: the second-order low-pass and its −3 dB bandwidth.
+"""Analytic frequency responses of a sensor: the second-order low-pass, JJF 1537's two resonances, the −3 dB bandwidth.
 
 A rate gyro whose sense path behaves as one second-order system (one resonance of natural frequency
 f_n = ω_n/2π and damping ratio ζ) has the transfer function
@@ -19,13 +19,16 @@ and |H| = 1/√2 (−3.01 dB, half power) at
 so f_3dB = f_n for ζ = 1/√2 (the Butterworth response, |H| = 1/√(1 + x⁴)). Frequencies are in Hz
 (f = ω/2π) throughout, like the table frequencies f_i of JJF 1537 7.2.1.
 
-Nothing here is simulated yet: these are the truth the estimators of :mod:`plansim.estimate.dynamic`
-are tested against.
+JJF 1537-2015 eq. (3)'s two-resonance form is :func:`two_resonance_response`, and :class:`SensorDynamics`
+holds one of the three models (flat, one resonance, two) with its H(s) as polynomials for the simulator
+(:mod:`plansim.simulate.jjf1537` discretises them) and its bandwidth. These are the truth the estimators of
+:mod:`plansim.estimate.dynamic` are tested against.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -110,3 +113,93 @@ def second_order_bandwidth(natural_frequency: float, damping: float) -> float:
     f_n = positive_number("natural_frequency", natural_frequency)
     b = 1.0 - 2.0 * positive_number("damping", damping) ** 2
     return f_n * math.sqrt(b + math.sqrt(b * b + 1.0))
+
+
+def two_resonance_response(frequencies, sense_frequency: float, sense_damping: float, drive_frequency: float,
+                           drive_damping: float) -> np.ndarray:
+    """H(j2πf) of JJF 1537-2015 eq. (3)'s form: the product of the drive- and the sense-mode resonances.
+
+    JJF 1537-2015 5 (and JJF 1535-2015 eq. (3)) model the vibratory gyro as two coupled second-order
+    systems, the drive mode (mass M_d, damping D_d, stiffness K_d) and the sense mode (M_s, D_s, K_s), the
+    Coriolis force 2M_sΩẋ_d coupling the rate Ω into the sense mode; the rate-to-output transfer function is
+    the product of the two resonances. Normalised to H(0) = 1 (the static gain is the scale factor's),
+
+        H(s) = ω_d²/(s² + 2ζ_d ω_d s + ω_d²) · ω_s²/(s² + 2ζ_s ω_s s + ω_s²),
+
+    ω_d = 2πf_d, ω_s = 2πf_s, ζ = D/(2√(MK)) of each mode. The product of two
+    :func:`second_order_response`; complex, the shape of *frequencies* (Hz).
+    """
+    return (second_order_response(frequencies, sense_frequency, sense_damping)
+            * second_order_response(frequencies, drive_frequency, drive_damping))
+
+
+#: the sensor models of :class:`SensorDynamics`
+SENSOR_MODELS = ("flat", "second_order", "two_resonance")
+
+
+@dataclass(frozen=True)
+class SensorDynamics:
+    """The gyro's rate-to-output dynamics, normalised to H(0) = 1 (the static gain is the scale factor's).
+
+    ``model``: ``"flat"`` (H = 1, an ideal sensor), ``"second_order"`` (:func:`second_order_response` with
+    ``natural_frequency`` f_n and ``damping`` ζ) or ``"two_resonance"`` (JJF 1537-2015 eq. (3),
+    :func:`two_resonance_response`: the sense mode f_n, ζ times the drive mode ``drive_frequency``,
+    ``drive_damping``). Frequencies in Hz, dampings dimensionless.
+    """
+
+    model: str = "second_order"
+    natural_frequency: float = 100.0
+    damping: float = 0.6
+    drive_frequency: float = 400.0
+    drive_damping: float = 0.7
+
+    def __post_init__(self):
+        if self.model not in SENSOR_MODELS:
+            raise ValueError(f"model: expected one of {', '.join(SENSOR_MODELS)}, got {self.model!r}")
+        for name, unit in (("natural_frequency", "Hz"), ("damping", ""), ("drive_frequency", "Hz"),
+                           ("drive_damping", "")):
+            object.__setattr__(self, name, positive_number(name, getattr(self, name), unit))
+
+    def response(self, frequencies) -> np.ndarray:
+        """H(j2πf), complex, at *frequencies* (Hz)."""
+        if self.model == "flat":
+            return np.ones(np.shape(_frequencies(frequencies)), dtype=complex)
+        out = second_order_response(frequencies, self.natural_frequency, self.damping)
+        if self.model == "two_resonance":
+            out = out * second_order_response(frequencies, self.drive_frequency, self.drive_damping)
+        return out
+
+    def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
+        """H(s) = B(s)/A(s) as coefficient arrays in descending powers of s (s in rad/s)."""
+        b, a = np.array([1.0]), np.array([1.0])
+        if self.model == "flat":
+            return b, a
+        modes = [(self.natural_frequency, self.damping)]
+        if self.model == "two_resonance":
+            modes.append((self.drive_frequency, self.drive_damping))
+        for f_n, zeta in modes:
+            w = 2.0 * math.pi * f_n
+            b = np.polymul(b, [w * w])
+            a = np.polymul(a, [1.0, 2.0 * zeta * w, w * w])
+        return b, a
+
+    def bandwidth(self) -> float:
+        """The first frequency where |H| falls through 1/√2 (−3.01 dB), Hz; inf for the flat sensor.
+
+        :func:`second_order_bandwidth` in closed form; for the two resonances the first downward crossing on
+        a grid of 1/2000 of the lower resonance, refined by Brent's method to 1e-12 relative.
+        """
+        if self.model == "flat":
+            return math.inf
+        if self.model == "second_order":
+            return second_order_bandwidth(self.natural_frequency, self.damping)
+        level = 1.0 / math.sqrt(2.0)
+        step = min(self.natural_frequency, self.drive_frequency) / 2000.0
+        grid = np.arange(1, 200001) * step  # up to 100 × the lower resonance: |H| < 1e-4 there
+        below = np.flatnonzero(np.abs(self.response(grid)) <= level)
+        k = int(below[0])
+        lo, hi = (grid[k - 1] if k > 0 else 0.0), grid[k]
+        import scipy.optimize
+
+        return float(scipy.optimize.brentq(lambda f: abs(self.response(f)) - level, lo, hi, xtol=1e-300,
+                                           rtol=1e-12))

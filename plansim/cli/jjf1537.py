@@ -1,0 +1,66 @@
+"""``plansim run jjf1537``: JJF 1537-2015's amplitude/phase-frequency test on an angular vibration table,
+simulated as a Monte Carlo and reduced (docs/dynamic.md).
+
+Like ``vibration_g2`` it is built in, not a scenario file: its settings are
+:class:`plansim.simulate.jjf1537.Jjf1537Experiment`, changed with ``--set KEY=VALUE``
+(:data:`plansim.simulate.jjf1537.FIELDS`).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+#: the built-in dynamic tests (``plansim run NAME``), with a description
+DYNAMIC_TESTS = {
+    "jjf1537": "JJF 1537-2015 7.2.1 on an angular vibration table: sine fits at >= 7 frequencies x 7 repeats, "
+               "amplitude/phase response and -3 dB bandwidth, Monte Carlo bias and scatter against the truth and "
+               "the GUM",
+}
+
+
+def run_jjf1537_command(args, default_chunk_size: int) -> int:
+    """``plansim run jjf1537``: every check first, then the Monte Carlo and the report."""
+    from plansim.io.files import OutputSet, check_output_path
+    from plansim.io.recording import plansim_version
+    from plansim.report.jjf1537 import bode_figure, jjf1537_json, jjf1537_text
+    from plansim.report.plot import FIGURE_SUFFIXES
+    from plansim.report.progress import stderr_progress
+    from plansim.simulate.jjf1537 import DEFAULT_SEED, DEFAULT_TRIALS, Jjf1537Experiment, run_jjf1537, with_overrides
+
+    for option, value in (("--out", args.out), ("--unit", args.unit)):
+        if value is not None:
+            raise ValueError(f"{option} {value!r}: not available with the test jjf1537 (its settings change with "
+                             "--set KEY=VALUE)")
+    if args.path != "auto":
+        raise ValueError(f"--path {args.path}: not available with the test jjf1537 (it has one simulation path of "
+                         "its own, plansim/simulate/jjf1537.py)")
+    if args.chunk_size != default_chunk_size:
+        raise ValueError(f"--chunk-size {args.chunk_size}: not available with the test jjf1537 (the results do "
+                         "not depend on its chunks)")
+    trials = DEFAULT_TRIALS if args.trials is None else args.trials
+    if trials < 2:
+        raise ValueError(f"--trials {trials}: must be >= 2 (the Monte Carlo's scatter needs two trials)")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    settings = with_overrides(Jjf1537Experiment(), args.set)
+    seed = DEFAULT_SEED if args.seed is None else args.seed
+
+    with OutputSet() as outputs:
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        progress = None if args.quiet else stderr_progress("plansim run jjf1537")
+        start = time.perf_counter()
+        result = run_jjf1537(settings, trials=trials, seed=seed, progress=progress)
+        elapsed = time.perf_counter() - start
+        if plot is not None:
+            bode_figure(result, plot, format=args.plot.rsplit(".", 1)[-1])
+        outputs.commit()
+    if args.json:
+        print(json.dumps(jjf1537_json(result, elapsed, plansim_version()), indent=2))
+    else:
+        print(jjf1537_text(result, elapsed))
+        if args.plot:
+            print(f"\nwrote figure: {args.plot}")
+    return 0

@@ -1,0 +1,163 @@
+"""``plansim run jjf1537``'s report: the text table, the JSON object (SI) and the Bode figure (docs/dynamic.md)."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from plansim.report.plot import figure_format, pyplot, save
+from plansim.units import DEG
+
+
+def _list(x) -> list:
+    return [float(v) for v in np.ravel(x)]
+
+
+def _number(x) -> float | None:
+    """*x* as a float, None for nan or ±inf (JSON has neither; the flat sensor's bandwidth is inf)."""
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def jjf1537_json(result, elapsed: float, version: str) -> dict:
+    """The result as one JSON-able object, SI units (Hz, rad, rad/s); ratios dimensionless; nan as null."""
+    s, sch, summary = result.settings, result.schedule, result.summary()
+    return {
+        "experiment": "jjf1537", "seed": result.seed, "trials": result.trials, "overrides": list(s.overrides),
+        "plansim_version": version, "elapsed_s": elapsed,
+        "units": "SI: Hz, rad, rad/s, s; ratios K_i = S_i/S_0 dimensionless",
+        "settings": {
+            "model": s.model, "natural_frequency": s.natural_frequency, "damping": s.damping,
+            "drive_frequency": s.drive_frequency, "drive_damping": s.drive_damping, "gyro_range": s.gyro_range,
+            "amplitude": sch.amplitude, "repeats": sch.repeats, "sample_rate": sch.sample_rate,
+            "record_samples": [int(v) for v in sch.samples()], "expected_bandwidth": sch.expected_bandwidth,
+            "grid": s.grid, "gyro_arw": s.gyro_arw, "quantisation": s.quantisation, "scale_factor": s.scale_factor,
+            "bias": s.bias, "noise_sigma": s.noise_sigma,
+        },
+        "frequencies": _list(sch.frequencies),
+        "truth": {"ratio": _list(result.truth_ratio), "phase": _list(result.truth_phase),
+                  "bandwidth": _number(result.truth_bandwidth)},
+        "noise_free": {"ratio": _list(result.noise_free_ratio), "bandwidth": _number(result.noise_free_bandwidth)},
+        "monte_carlo": {
+            "ratio_mean": _list(summary["ratio_mean"]), "ratio_std": _list(summary["ratio_std"]),
+            "ratio_bias": _list(summary["ratio_bias"]), "phase_mean": _list(summary["phase_mean"]),
+            "phase_std": _list(summary["phase_std"]), "phase_bias": _list(summary["phase_bias"]),
+            "bandwidth_mean": _number(summary["bandwidth_mean"]), "bandwidth_std": _number(summary["bandwidth_std"]),
+            "bandwidth_bias": _number(summary["bandwidth_bias"]), "bandwidth_found": summary["bandwidth_found"],
+        },
+        "gum": {"ratio": _list(result.gum["ratio"]), "phase": _list(result.gum["phase"]),
+                "bandwidth": _number(result.gum["bandwidth"]), "amplitude": _list(result.gum["amplitude"])},
+        "type_a_mean": {"ratio": _list(result.type_a["ratio"]), "phase": _list(result.type_a["phase"])},
+    }
+
+
+def jjf1537_text(result, elapsed: float) -> str:
+    """The text report: per frequency the truth, the MC mean, bias and scatter against the GUM; the bandwidth."""
+    s, sch, summary = result.settings, result.schedule, result.summary()
+    dyn = result.settings.dynamics()
+    model = {"flat": "flat (ideal)",
+             "second_order": f"second-order f_n {dyn.natural_frequency:g} Hz, zeta {dyn.damping:g}",
+             "two_resonance": f"two resonances (JJF 1537 eq. (3)): sense {dyn.natural_frequency:g} Hz, zeta "
+                              f"{dyn.damping:g}; drive {dyn.drive_frequency:g} Hz, zeta {dyn.drive_damping:g}"}[s.model]
+    lines = [
+        f"plansim run jjf1537: seed {result.seed}, {result.trials} trials, {elapsed:.1f} s",
+        f"sensor: {model}; range {s.gyro_range / DEG:g} deg/s, ARW {s.gyro_arw / DEG * 60:g} deg/sqrt(h), "
+        f"step {s.quantisation / DEG:.4g} deg/s",
+        f"table: {sch.amplitude / DEG:g} deg/s amplitude, {sch.frequencies.size} frequencies ({s.grid} grid), "
+        f"n = {sch.repeats}, {sch.sample_rate:g} Hz, {sch.samples().min()}-{sch.samples().max()} samples per record",
+        "",
+        "  f (Hz)   |H| truth   K noise-free   K MC mean   bias K      s(K) MC    u(K) GUM   "
+        "phase truth (deg)   bias (deg)   s MC (deg)   u GUM (deg)",
+    ]
+    for i, f in enumerate(sch.frequencies):
+        lines.append(
+            f"{f:8.3f}   {result.truth_ratio[i]:9.6f}   {result.noise_free_ratio[i]:12.6f}   "
+            f"{summary['ratio_mean'][i]:9.6f}   {summary['ratio_bias'][i]:+9.2e}   {summary['ratio_std'][i]:8.2e}   "
+            f"{result.gum['ratio'][i]:8.2e}   {math.degrees(result.truth_phase[i]):17.4f}   "
+            f"{math.degrees(summary['phase_bias'][i]):+10.2e}   {math.degrees(summary['phase_std'][i]):10.2e}   "
+            f"{math.degrees(result.gum['phase'][i]):11.2e}")
+    if summary["bandwidth_found"] == 0:
+        bandwidth = (f"-3 dB bandwidth: truth {result.truth_bandwidth:.4f} Hz; not found in any trial: the response "
+                     f"does not fall through -3.01 dB between {sch.frequencies[0]:g} and {sch.frequencies[-1]:g} Hz "
+                     "(the bandwidth lies outside the measured band; --set expected_bandwidth=... or grid=jjf1537)")
+    else:
+        bandwidth = (
+            f"-3 dB bandwidth: truth {result.truth_bandwidth:.4f} Hz; procedure without noise "
+            f"{result.noise_free_bandwidth:.4f} Hz; MC mean {summary['bandwidth_mean']:.4f} Hz "
+            f"(bias {summary['bandwidth_bias']:+.4f} Hz), s {summary['bandwidth_std']:.4f} Hz, GUM u "
+            f"{result.gum['bandwidth']:.4f} Hz; found in {summary['bandwidth_found']}/{result.trials} trials")
+    lines += [
+        "",
+        bandwidth,
+        "K = S_i/S_0 with S_0 read at the lowest frequency (JJF 1537 eq. (9)); bias against the analytic |H|, "
+        "arg H",
+    ]
+    return "\n".join(lines)
+
+
+def bode_figure(result, path: str | os.PathLike, format: str | None = None) -> None:
+    """The Bode diagram of the test.
+
+    Left: gain (dB) and phase (deg) against frequency on a log axis, the analytic truth as a line, the MC
+    mean of the estimates with ± one MC standard deviation as bars, the −3.01 dB line, the true bandwidth
+    and the estimated one (MC mean ± s, shaded). Right: the same estimates minus the truth, where the bars can
+    be seen (they are ~1e-4 of the gain), with the noise-free procedure's error (the method's bias) and
+    ± the GUM standard uncertainty around it.
+    """
+    fmt = figure_format(path, format)
+    plt = pyplot()
+    sch, summary = result.schedule, result.summary()
+    f = sch.frequencies
+    dyn = result.settings.dynamics()
+    grid = np.geomspace(f[0] / 2.0, f[-1] * 2.0, 400)
+    H = dyn.response(grid)
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
+    (gain, gain_err), (phase, phase_err) = axes
+    gain.semilogx(grid, 20.0 * np.log10(np.abs(H)), "k-", lw=1, label="truth |H| (analytic)")
+    mean = summary["ratio_mean"]
+    db_err = 20.0 / math.log(10.0) * summary["ratio_std"] / mean
+    gain.errorbar(f, 20.0 * np.log10(mean), yerr=db_err, fmt="o", color="tab:blue", ms=4, capsize=3,
+                  label=f"estimate K_i, MC mean ± s ({result.trials} trials)")
+    gain.axhline(-10.0 * math.log10(2.0), color="tab:red", ls="--", lw=1, label="−3.01 dB")
+    if math.isfinite(result.truth_bandwidth):
+        for ax in (gain, phase):
+            ax.axvline(result.truth_bandwidth, color="k", ls=":", lw=1)
+        gain.plot([], [], "k:", lw=1, label=f"true bandwidth {result.truth_bandwidth:.3f} Hz")
+    if math.isfinite(summary["bandwidth_mean"]):
+        gain.axvspan(summary["bandwidth_mean"] - summary["bandwidth_std"],
+                     summary["bandwidth_mean"] + summary["bandwidth_std"], color="tab:blue", alpha=0.3,
+                     label=f"estimated {summary['bandwidth_mean']:.3f} ± {summary['bandwidth_std']:.3f} Hz")
+    gain.set_ylabel("gain 20 log10 K (dB)")
+    gain.set_title("JJF 1537-2015: amplitude and phase response")
+    phase.semilogx(grid, np.degrees(np.unwrap(np.angle(H))), "k-", lw=1, label="truth arg H (analytic)")
+    # on the truth's unwrapped branch (a two-resonance response passes −180° within the band)
+    phase_mean = np.unwrap(result.truth_phase) + summary["phase_bias"]
+    phase.errorbar(f, np.degrees(phase_mean), yerr=np.degrees(summary["phase_std"]), fmt="o",
+                   color="tab:blue", ms=4, capsize=3, label="estimate Δφ_i, MC mean ± s")
+    phase.set_xlabel("frequency (Hz)")
+    phase.set_ylabel("phase (deg)")
+
+    method = result.noise_free_ratio - result.truth_ratio
+    gain_err.fill_between(f, 1e6 * (method - result.gum["ratio"]), 1e6 * (method + result.gum["ratio"]),
+                          color="tab:orange", alpha=0.3, label="noise-free procedure ± u GUM")
+    gain_err.plot(f, 1e6 * method, "-", color="tab:orange", lw=1)
+    gain_err.errorbar(f, 1e6 * summary["ratio_bias"], yerr=1e6 * summary["ratio_std"], fmt="o", color="tab:blue",
+                      ms=4, capsize=3, label="MC mean ± s")
+    gain_err.axhline(0.0, color="k", lw=0.5)
+    gain_err.set_ylabel("K_i − |H(f_i)| (ppm)")
+    gain_err.set_title("estimates minus the analytic truth")
+    phase_err.fill_between(f, -np.degrees(result.gum["phase"]) * 1e3, np.degrees(result.gum["phase"]) * 1e3,
+                           color="tab:orange", alpha=0.3, label="± u GUM")
+    phase_err.errorbar(f, 1e3 * np.degrees(summary["phase_bias"]), yerr=1e3 * np.degrees(summary["phase_std"]),
+                       fmt="o", color="tab:blue", ms=4, capsize=3, label="MC mean ± s")
+    phase_err.axhline(0.0, color="k", lw=0.5)
+    phase_err.set_ylabel("Δφ_i − arg H(f_i) (mdeg)")
+    phase_err.set_xlabel("frequency (Hz)")
+    for ax in axes.ravel():
+        ax.set_xscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, loc="lower left")
+    fig.tight_layout()
+    save(fig, path, fmt, dpi=90)

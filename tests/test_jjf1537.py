@@ -1,0 +1,228 @@
+"""JJF 1537-2015's angular vibration test simulated (docs/dynamic.md, "The JJF 1537 procedure simulated"): the IIR
+kernel, the discretisation, the schedule, chunking and seeds, the zero-noise identity, the Monte Carlo against the
+analytic response and the GUM, and ``plansim run jjf1537``."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+import scipy.signal
+
+from plansim import cli
+from plansim.estimate.dynamic import sine_fit, sine_fits
+from plansim.kernels.dynamics import iir_filter
+from plansim.model.dynamics import SensorDynamics, second_order_bandwidth, second_order_response
+from plansim.schedule.jjf1537 import Jjf1537Schedule, jjf1535_frequencies
+from plansim.simulate.jjf1537 import (
+    Jjf1537Experiment,
+    discretise,
+    run_in_samples,
+    run_jjf1537,
+    simulate_records,
+    with_overrides,
+)
+from plansim.units import DEG
+
+#: a short test: 7 frequencies x 7 repeats of 0.25 s at 4 kHz
+SHORT = dict(grid="jjf1537", band_low=20.0, band_high=140.0, frequency_count=7, record_time=0.25)
+
+
+def _coefficients(model="second_order", frequency=60.0):
+    dyn = SensorDynamics(model, 100.0, 0.4, 300.0, 0.5)
+    return discretise(dyn, frequency, 4000.0)
+
+
+@pytest.mark.parametrize("model", ["second_order", "two_resonance"])
+def test_kernel_filter_matches_lfilter_and_chunks_bit_for_bit(model):
+    b, a = _coefficients(model)
+    x = np.random.default_rng(3).standard_normal(5000)
+    expected = scipy.signal.lfilter(b, a, x)
+    out = np.empty_like(x)
+    iir_filter(b, a, x, np.zeros(len(a) - 1), out)
+    np.testing.assert_allclose(out, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    chunked = np.empty_like(x)
+    state = np.zeros(len(a) - 1)
+    for start in range(0, x.size, 777):  # the state carried across chunks
+        iir_filter(b, a, x[start:start + 777], state, chunked[start:start + 777])
+    assert np.array_equal(chunked, out)
+
+
+@pytest.mark.parametrize("model", ["second_order", "two_resonance"])
+@pytest.mark.parametrize("frequency", [13.75, 101.0, 400.0])
+def test_prewarped_bilinear_is_exact_at_the_table_frequency(model, frequency):
+    dyn = SensorDynamics(model, 100.0, 0.4, 300.0, 0.5)
+    b, a = discretise(dyn, frequency, 4000.0)
+    _, h = scipy.signal.freqz(b, a, worN=[frequency], fs=4000.0)
+    assert abs(h[0] - dyn.response(frequency)) < 1e-12
+    _, h0 = scipy.signal.freqz(b, a, worN=[0.0], fs=4000.0)  # and the DC gain
+    assert abs(h0[0] - 1.0) < 1e-12
+
+
+def test_two_resonance_is_the_product_and_its_bandwidth_is_on_the_level():
+    dyn = SensorDynamics("two_resonance", 100.0, 0.7, 400.0, 0.7)
+    f = np.array([0.0, 50.0, 100.0, 250.0])
+    np.testing.assert_allclose(dyn.response(f), second_order_response(f, 100.0, 0.7)
+                               * second_order_response(f, 400.0, 0.7), rtol=1e-15)
+    bw = dyn.bandwidth()
+    assert abs(abs(dyn.response(bw)) - 2**-0.5) < 1e-12
+    assert bw < second_order_bandwidth(100.0, 0.7)  # the drive mode only takes away
+    second = SensorDynamics("second_order", 100.0, 0.6)
+    assert second.bandwidth() == second_order_bandwidth(100.0, 0.6)
+
+
+def test_jjf1535_grid_has_eight_points_and_two_inserted():
+    f = jjf1535_frequencies(100.0)
+    np.testing.assert_allclose(f, sorted([*(np.arange(1, 9) * 13.75), (96.25 + 100) / 2, (100 + 110) / 2]))
+
+
+def test_schedule_refuses_what_jjf1537_does_not_allow():
+    ok = dict(frequencies=np.arange(1, 8) * 10.0, amplitude=1.0, gyro_range=5.0)
+    Jjf1537Schedule(**ok)
+    with pytest.raises(ValueError, match=r"frequencies: expected at least 7"):
+        Jjf1537Schedule(**{**ok, "frequencies": [10, 20, 30, 40, 50, 60]})
+    with pytest.raises(ValueError, match=r"repeats: expected an integer >= 7"):
+        Jjf1537Schedule(**ok, repeats=6)
+    with pytest.raises(ValueError, match=r"amplitude: expected 10-30 % of the range"):
+        Jjf1537Schedule(**{**ok, "amplitude": 2.0})
+    with pytest.raises(ValueError, match=r"sample_rate: expected > 20 x the expected bandwidth 100 Hz"):
+        Jjf1537Schedule(**ok, sample_rate=2000.0)
+    with pytest.raises(ValueError, match=r"model: expected one of flat, second_order, two_resonance, got 'third'"):
+        Jjf1537Experiment(model="third")
+    with pytest.raises(ValueError, match=r"--set 'damping=x'"):
+        with_overrides(Jjf1537Experiment(), ["damping=x"])
+    with pytest.raises(ValueError, match=r"KEY one of model"):
+        with_overrides(Jjf1537Experiment(), ["nope=1"])
+
+
+def test_overrides_read_units():
+    s = with_overrides(Jjf1537Experiment(), ["natural_frequency=0.12 kHz", "gyro_range=500 deg/s", "damping=0.5"])
+    assert (s.natural_frequency, s.damping) == (120.0, 0.5)
+    assert s.gyro_range == pytest.approx(500 * DEG)
+    assert s.overrides == ("natural_frequency=0.12 kHz", "gyro_range=500 deg/s", "damping=0.5")
+
+
+def test_batched_sine_fits_equal_one_by_one():
+    t = np.arange(1000) / 4000.0
+    y = np.random.default_rng(5).standard_normal((2, 3, t.size)) + np.cos(2 * np.pi * 37.0 * t + 0.3)
+    fits = sine_fits(t, y, 37.0)
+    for idx in np.ndindex(2, 3):
+        one = sine_fit(t, y[idx], 37.0)
+        assert fits.amplitude[idx] == pytest.approx(one.amplitude, rel=1e-12)
+        assert fits.phase[idx] == pytest.approx(one.phase, abs=1e-12)
+        assert fits.offset[idx] == pytest.approx(one.offset, abs=1e-12)
+        assert fits.residual_rms[idx] == pytest.approx(one.residual_rms, rel=1e-12)
+
+
+@pytest.mark.parametrize("model", ["second_order", "two_resonance"])
+def test_records_do_not_depend_on_the_chunking(model):
+    s = Jjf1537Experiment(model=model, **SHORT)
+    whole = simulate_records(s, 11, 3, [0, 1, 2])
+    for chunk in (1, 97, 777):  # chunks in time, across the run-in's end
+        assert np.array_equal(simulate_records(s, 11, 3, [0, 1, 2], chunk=chunk), whole)
+    assert np.array_equal(simulate_records(s, 11, 3, [2]), whole[2:])  # and in trials
+    assert not np.array_equal(simulate_records(s, 12, 3, [0, 1, 2]), whole)
+    assert run_in_samples(discretise(s.dynamics(), 20.0, 4000.0)[1]) > 0
+
+
+def test_same_seed_same_numbers_whatever_the_trial_chunks():
+    s = Jjf1537Experiment(**SHORT)
+    one = run_jjf1537(s, trials=5, seed=3, chunk_trials=2)
+    two = run_jjf1537(s, trials=5, seed=3, chunk_trials=5)
+    assert np.array_equal(one.ratios, two.ratios) and np.array_equal(one.phases, two.phases)
+    assert np.array_equal(one.bandwidths, two.bandwidths)
+    assert not np.array_equal(run_jjf1537(s, trials=5, seed=4).ratios, one.ratios)
+
+
+@pytest.mark.parametrize("model", ["flat", "second_order", "two_resonance"])
+def test_zero_noise_identity(model):
+    """No noise and no quantisation: a flat sensor gives K_i = 1 and Δφ_i = 0, and any sensor the noise-free
+    procedure's K_i = |H(f_i)/H(f_1)| and Δφ_i = arg H(f_i), to 1e-9 (the prewarped discretisation is exact at
+    the table frequency; the run-in leaves < 1e-13 of the start-up transient)."""
+    s = Jjf1537Experiment(model=model, gyro_arw=0.0, quantisation=0.0, bias=0.3, scale_factor=1.01, **SHORT)
+    r = run_jjf1537(s, trials=2, seed=1)
+    np.testing.assert_allclose(r.ratios, np.broadcast_to(r.noise_free_ratio, r.ratios.shape), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(r.phases, np.broadcast_to(r.truth_phase, r.phases.shape), rtol=0, atol=1e-9)
+    if model == "flat":
+        np.testing.assert_allclose(r.ratios, 1.0, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(r.phases, 0.0, rtol=0, atol=1e-9)
+        assert np.all(np.isnan(r.bandwidths))  # never falls: above the band
+    else:
+        np.testing.assert_allclose(r.bandwidths, r.noise_free_bandwidth, rtol=0, atol=1e-9)
+
+
+def test_second_order_sensor_gives_its_response_within_the_mc_uncertainty_and_the_gum():
+    """The default second-order sensor (f_n 100 Hz, ζ 0.7) with its noise and quantiser, 200 trials, seed 21.
+
+    The MC mean of each K_i, Δφ_i and of the bandwidth is within 5 s/√T of the noise-free procedure's value
+    (T = 200 trials, s the MC standard deviation: the estimators are unbiased to first order in the noise, so a
+    correct simulation fails one of these 20 checks with probability < 20 × 5.7e-7 = 1.1e-5); the noise-free values
+    differ from the analytic |H(f_i)| only by the reference S_0 read at the lowest frequency, which is checked
+    in closed form. The MC standard deviations match the GUM's u within 4/√(2(T − 1)) = 0.20 relative (4 times
+    the relative standard error of a standard deviation from T normal samples)."""
+    trials = 200
+    r = run_jjf1537(Jjf1537Experiment(), trials=trials, seed=21)
+    s = r.summary()
+    np.testing.assert_allclose(r.noise_free_ratio, r.truth_ratio / r.truth_ratio[0], rtol=1e-15)
+    se = 5.0 / math.sqrt(trials)
+    assert np.all(np.abs(s["ratio_mean"] - r.noise_free_ratio)[1:] <= se * s["ratio_std"][1:])
+    assert np.all(np.abs(s["phase_bias"]) <= se * s["phase_std"])
+    assert s["bandwidth_found"] == trials
+    assert abs(s["bandwidth_mean"] - r.noise_free_bandwidth) <= se * s["bandwidth_std"]
+    assert abs(r.truth_bandwidth - second_order_bandwidth(100.0, 0.7)) == 0.0
+    tolerance = 4.0 / math.sqrt(2 * (trials - 1))
+    np.testing.assert_allclose(s["ratio_std"][1:] / r.gum["ratio"][1:], 1.0, atol=tolerance)
+    np.testing.assert_allclose(s["phase_std"] / r.gum["phase"], 1.0, atol=tolerance)
+    assert s["bandwidth_std"] / r.gum["bandwidth"] == pytest.approx(1.0, abs=tolerance)
+
+
+def test_cli_json_and_plot(capsys, tmp_path):
+    plot = tmp_path / "bode.png"
+    code = cli.main(["run", "jjf1537", "--trials", "3", "--seed", "5", "--json", "--quiet", "--plot", str(plot),
+                     "--set", "record_time=0.25 s"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert err == ""  # --quiet: no progress line
+    doc = json.loads(out)
+    assert set(doc) == {"experiment", "seed", "trials", "overrides", "plansim_version", "elapsed_s", "units",
+                        "settings", "frequencies", "truth", "noise_free", "monte_carlo", "gum", "type_a_mean"}
+    assert (doc["experiment"], doc["seed"], doc["trials"]) == ("jjf1537", 5, 3)
+    assert doc["overrides"] == ["record_time=0.25 s"]
+    assert len(doc["frequencies"]) == len(doc["monte_carlo"]["ratio_mean"]) == len(doc["gum"]["ratio"]) == 10
+    assert doc["truth"]["bandwidth"] == pytest.approx(second_order_bandwidth(100.0, 0.7))
+    assert doc["monte_carlo"]["bandwidth_found"] == 3
+    assert plot.stat().st_size > 10_000
+
+
+def test_cli_text_and_bad_input(capsys):
+    assert cli.main(["run", "jjf1537", "--trials", "2", "--set", "record_time=0.25 s"]) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith("plansim run jjf1537: seed 1537, 2 trials") and "-3 dB bandwidth: truth" in out
+    assert "2/2 trials" in err  # the progress line
+    assert cli.main(["run", "jjf1537", "--set", "repeats=5"]) == 2
+    assert "repeats: expected an integer >= 7" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1537", "--set", "amplitude_fraction=0.05"]) == 2
+    assert "amplitude_fraction: expected 0.1 to 0.3" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1537", "--trials", "1"]) == 2
+    assert "--trials 1: must be >= 2" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1537", "--out", "x.nc"]) == 2
+    assert "--out 'x.nc': not available with the test jjf1537" in capsys.readouterr().err
+
+
+def test_settings_equal_after_round_trip():
+    s = Jjf1537Experiment(damping=0.5)
+    assert dataclasses.replace(s, overrides=("x",)) == s
+
+
+def test_cli_says_when_the_bandwidth_is_outside_the_band(capsys):
+    assert cli.main(["run", "jjf1537", "--trials", "2", "--quiet", "--set", "model=flat", "--set",
+                     "record_time=0.25 s", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)  # inf and nan are null: strict JSON
+    assert doc["truth"]["bandwidth"] is None and doc["monte_carlo"]["bandwidth_found"] == 0
+    assert cli.main(["run", "jjf1537", "--trials", "2", "--quiet", "--set", "natural_frequency=200 Hz", "--set",
+                     "record_time=0.25 s"]) == 0
+    assert "not found in any trial: the response does not fall through -3.01 dB between 13.75 and 110 Hz" in \
+        capsys.readouterr().out
