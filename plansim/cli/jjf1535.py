@@ -119,21 +119,14 @@ def validate_jjf1535_command(args) -> int:
         The options of ``plansim validate`` (``--unit``, ``--seed``, ``--json``, ``--digits``,
         ``--trials-per-block``, ``--max-trials``, ``--path``, ``--summary``, ``--quiet``; not ``--claims``).
     """
-    from plansim.report.progress import end_progress_line, mark_progress_line
-    from plansim.report.validation import format_jjf1535_report, jjf1535_json, stderr_block_progress
+    from plansim.report.progress import end_progress_line
+    from plansim.report.validation import format_jjf1535_report, jjf1535_json, validate_progress
     from plansim.uncertainty.jjf1535_validation import validate_jjf1535
 
     if args.claims:
         raise ValueError(VALIDATE_CLAIMS_REFUSAL)
     unit = _load_unit(args)
-    progress = None
-    if not (args.quiet or args.json):
-        block_progress = stderr_block_progress(f"plansim validate jjf1535 --unit {unit.name}")
-
-        def progress(*state) -> None:  # the block progress line is open until the report starts
-            block_progress(*state)
-            mark_progress_line(True)
-
+    progress = validate_progress(f"plansim validate jjf1535 --unit {unit.name}", args.quiet or args.json)
     report = validate_jjf1535(unit, digits=args.digits, trials_per_block=args.trials_per_block,
                               max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
     end_progress_line()

@@ -142,8 +142,7 @@ def _cmd_record(args) -> int:
 def _cmd_validate(args) -> int:
     from plansim.io.claims import load_claims
     from plansim.io.scenario_file import load_scenario
-    from plansim.report.progress import mark_progress_line
-    from plansim.report.validation import format_report, stderr_block_progress, validation_json
+    from plansim.report.validation import format_report, validate_progress, validation_json
     from plansim.runner import validate
 
     for option, value, minimum in (("--trials-per-block", args.trials_per_block, 2),
@@ -159,14 +158,7 @@ def _cmd_validate(args) -> int:
                          f"jjf1535 --unit SCENARIO); the scenario {args.scenario!r} is its own unit")
     scenario = load_scenario(args.scenario, args.set)
     claims = load_claims(args.claims, scenario) if args.claims else None
-    progress = None
-    if not (args.quiet or args.json):
-        block_progress = stderr_block_progress(f"plansim validate {scenario.name}")
-
-        def progress(*state) -> None:  # the block progress line is open until the report starts
-            block_progress(*state)
-            mark_progress_line(True)
-
+    progress = validate_progress(f"plansim validate {scenario.name}", args.quiet or args.json)
     report = validate(scenario, claims, digits=args.digits, trials_per_block=args.trials_per_block,
                       max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
     end_progress_line()

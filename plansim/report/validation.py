@@ -14,12 +14,14 @@ import time
 import numpy as np
 
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, parameter
+from plansim.report.progress import mark_progress_line
 from plansim.uncertainty.budget import ParameterBudget
 from plansim.uncertainty.jjf1535_validation import Jjf1535ValidationReport
 from plansim.uncertainty.metrology.coverage import COVERAGE_Z
 from plansim.uncertainty.validation import ValidationReport
 
-__all__ = ["format_jjf1535_report", "format_report", "jjf1535_json", "stderr_block_progress", "validation_json"]
+__all__ = ["format_jjf1535_report", "format_report", "jjf1535_json", "stderr_block_progress", "validate_progress",
+           "validation_json"]
 
 
 def validation_json(report: ValidationReport) -> dict:
@@ -35,9 +37,7 @@ def validation_json(report: ValidationReport) -> dict:
         "scenario": report.scenario,
         "description": report.description,
         "claims": report.claims_source,
-        "mcm": {"trials": mc.trials, "blocks": mc.blocks, "trials_per_block": mc.trials_per_block,
-                "seed": mc.seed, "digits": report.digits, "tolerance_fraction": report.tolerance_fraction,
-                "converged": mc.converged, "path": mc.path},
+        "mcm": _mcm_json(mc, report.digits, report.tolerance_fraction, mc.path),
         "parameters": [p.as_dict() for p in report.parameters],
         "appendix_a": [c.as_dict() for c in report.appendix_items],
         "joint_Kg": report.joint.as_dict(),
@@ -45,6 +45,12 @@ def validation_json(report: ValidationReport) -> dict:
                         "gum": np.round(gum_corr, 6).tolist()},
         "gum_budgets": [b.as_dict() for b in report.gum.budgets],
     })
+
+
+def _mcm_json(mc, digits: int, tolerance_fraction: float, path: str) -> dict:
+    """The ``mcm`` object of both validations' JSON: the adaptive Monte Carlo's size, seed, tolerance and path."""
+    return {"trials": mc.trials, "blocks": mc.blocks, "trials_per_block": mc.trials_per_block, "seed": mc.seed,
+            "digits": digits, "tolerance_fraction": tolerance_fraction, "converged": mc.converged, "path": path}
 
 
 def jjf1535_json(report: Jjf1535ValidationReport) -> dict:
@@ -61,9 +67,7 @@ def jjf1535_json(report: Jjf1535ValidationReport) -> dict:
         "procedure": "jjf1535",
         "unit_scenario": report.unit_scenario,
         "description": report.description,
-        "mcm": {"trials": mc.trials, "blocks": mc.blocks, "trials_per_block": mc.trials_per_block,
-                "seed": mc.seed, "digits": report.digits, "tolerance_fraction": report.tolerance_fraction,
-                "converged": mc.converged, "path": report.path},
+        "mcm": _mcm_json(mc, report.digits, report.tolerance_fraction, report.path),
         "items": [c.as_dict() for c in report.items],
         "gum_budgets": [report.gum.item(c.item) for c in report.items],
         "not_propagated": report.not_propagated,
@@ -289,6 +293,20 @@ def format_report(report: ValidationReport, details: bool = True) -> str:
                            f"{a.plansim_u[2]:.3g} → u_c {a.plansim_uc:.3g}, U95 {a.plansim_U95:.3g}")
     return "\n".join(out)
 
+
+
+def validate_progress(label: str, quiet: bool):
+    """``plansim validate``'s progress: None if *quiet*, else :func:`stderr_block_progress` (*label*) marking the
+    progress line open until the report starts (:func:`plansim.report.progress.mark_progress_line`)."""
+    if quiet:
+        return None
+    block_progress = stderr_block_progress(label)
+
+    def progress(*state) -> None:
+        block_progress(*state)
+        mark_progress_line(True)
+
+    return progress
 
 
 def stderr_block_progress(label: str):
