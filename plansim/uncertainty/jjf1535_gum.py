@@ -143,9 +143,27 @@ def reduction_jacobian(means, procedure: Jjf1535Procedure, gravity: float, items
 
 
 def truth_jacobian(world: Scenario, procedure: Jjf1535Procedure, items=GUM_ITEMS) -> np.ndarray:
-    """(P, 39): ``∂(true value of each item)/∂(unit parameter)`` at the nominal unit, by central differences of
-    :func:`~plansim.uncertainty.jjf1535_monte_carlo.truth_of` with a step of each parameter's spread (0 where the
-    unit has no spread: no line reads it)."""
+    """(P, 39): ``∂(true value of each item)/∂(unit parameter)`` at the nominal unit.
+
+    Central differences of :func:`~plansim.uncertainty.jjf1535_monte_carlo.truth_of` (the mapping of
+    :func:`~plansim.estimate.jjf1535_items.true_items`: K = Kg_ii·(1 + κ·ΔT) of eq. (5), B0 = (Bg_i + β·ΔT)/K of
+    eq. (15)–(17), G_ia/K of 7.2.12) with a step of each parameter's spread; 0 where the unit has no spread (no
+    budget line reads it).
+
+    Parameters
+    ----------
+    world : Scenario
+        The JJF 1535 world (:func:`~plansim.uncertainty.jjf1535_monte_carlo.jjf1535_scenario`): its
+        ``truth_nominal``, ``truth_spread`` and effects.
+    procedure : Jjf1535Procedure
+    items : sequence of str
+        Items of :data:`GUM_ITEMS`.
+
+    Returns
+    -------
+    (P, 39) ndarray
+        The rows in the order of *items*, the columns of :data:`plansim.model.parameters.PARAMETER_NAMES`.
+    """
     nominal = np.asarray(world.truth_nominal, dtype=float)
     spread = np.asarray(world.truth_spread, dtype=float)
     out = np.zeros((len(items), nominal.size))

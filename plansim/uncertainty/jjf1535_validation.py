@@ -49,9 +49,30 @@ __all__ = ["Jjf1535ItemValidation", "Jjf1535ValidationReport", "scatter_toleranc
 
 
 def scatter_tolerance(trials: int, excess_kurtosis: float, z: float = COVERAGE_Z) -> float:
-    """``z·sqrt((2 + κ)/(4M))``: *z* standard errors of the ratio s/σ of a sample standard deviation over *trials*
-    = M values with excess kurtosis κ (``z/sqrt(2M)`` for normal values; the large-M variance of s²,
-    ``σ⁴(2/(M − 1) + κ/M)``, halved by the square root)."""
+    """``z·sqrt((2 + κ)/(4M))``: *z* standard errors of the ratio s/σ of a sample standard deviation.
+
+    For M values with excess kurtosis κ the large-M variance of s² is ``σ⁴(2/(M − 1) + κ/M)``; the square root
+    halves the relative standard error, ``sqrt((2 + κ)/(4M))`` (``1/sqrt(2M)`` for normal values).
+
+    Parameters
+    ----------
+    trials : int
+        M, >= 2.
+    excess_kurtosis : float
+        κ of the values, >= −2.
+    z : float
+        Standard errors allowed (default :data:`~plansim.uncertainty.metrology.COVERAGE_Z`, 3).
+
+    Returns
+    -------
+    float
+        The half-width of the band about 1 in which MCM u / GUM u_c agrees.
+
+    Raises
+    ------
+    ValueError
+        *trials* not a whole number >= 2, or κ not finite or below −2.
+    """
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 2:
         raise ValueError(f"trials = {trials!r}: expected a whole number >= 2")
     kappa = float(excess_kurtosis)
