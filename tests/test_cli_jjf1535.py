@@ -162,12 +162,44 @@ def test_unit_is_refused_with_a_scenario_file(capsys, monkeypatch):
     assert code == 2 and out == "" and "--unit 'ideal'" in err and "only with a procedure" in err
 
 
-def test_validate_jjf1535_says_what_it_would_need_and_exits_2(capsys):
-    code = cli.main(["validate", "jjf1535"])
+def test_validate_jjf1535_refuses_claims_saying_what_is_not_built_and_exits_2(capsys, monkeypatch):
+    import plansim.uncertainty.jjf1535_validation as validation
+
+    monkeypatch.setattr(validation, "validate_jjf1535", lambda *a, **k: pytest.fail("the validation started"))
+    code = cli.main(["validate", "jjf1535", "--claims", "claims.toml"])
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
-    assert err.startswith("plansim: error: validate jjf1535: not available")
-    assert "GUM" in err and "plansim run jjf1535" in err
+    assert err.startswith("plansim: error: --claims: not available with the procedure jjf1535")
+    assert "JJF 1535 items are not built" in err and "plansim run jjf1535" in err
+    code = cli.main(["validate", "jjf2003", "--unit", "ideal"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and "--unit 'ideal'" in err and "only with a procedure" in err
+
+
+def test_validate_jjf1535_compares_the_gum_with_the_monte_carlo_and_exits_0(capsys):
+    """Two blocks of 50 trials (the shape of the report, not its statistics: tests/test_jjf1535_gum.py)."""
+    from plansim.uncertainty.jjf1535_gum import GUM_ITEMS, NOT_PROPAGATED
+
+    code = cli.main(["validate", "jjf1535", "--unit", "ideal", "--seed", "3", "--trials-per-block", "50",
+                     "--max-trials", "100", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["procedure"] == "jjf1535" and d["unit_scenario"] == "ideal"
+    assert d["mcm"]["trials"] == 100 and d["mcm"]["seed"] == 3 and d["mcm"]["blocks"] == 2
+    assert [c["item"] for c in d["items"]] == list(GUM_ITEMS)
+    for c in d["items"]:
+        assert c["gum_u"] > 0 and c["mcm_u"] > 0 and c["u_ratio"] == pytest.approx(c["mcm_u"] / c["gum_u"])
+        assert {"delta", "d_low", "d_high", "validated", "u_ratio_tolerance", "scatter_agrees", "coverage_gum",
+                "coverage_verdict", "gum_U95", "mcm_low", "mcm_high"} <= set(c)
+    assert [b["item"] for b in d["gum_budgets"]] == list(GUM_ITEMS)
+    assert d["not_propagated"] == NOT_PROPAGATED
+    code = cli.main(["validate", "jjf1535", "--unit", "ideal", "--seed", "3", "--trials-per-block", "50",
+                     "--max-trials", "100", "--quiet", "--summary"])
+    out, err = capsys.readouterr()
+    assert code == 0 and err == "", err
+    assert out.startswith("plansim validate jjf1535 — unit scenario 'ideal'")
+    assert "GUM framework validated for" in out and "Not propagated" in out and "== scale_factor" not in out
 
 
 def test_scenarios_lists_jjf1535_as_a_procedure_not_a_scenario_file(capsys):

@@ -1,4 +1,5 @@
-"""``plansim run jjf1535``: the JJF 1535-2015 Monte Carlo on a unit scenario; ``plansim validate jjf1535`` refused.
+"""``plansim run jjf1535``: the JJF 1535-2015 Monte Carlo on a unit scenario; ``plansim validate jjf1535``: the GUM of
+its items against an adaptive Monte Carlo (:mod:`plansim.uncertainty.jjf1535_validation`).
 
 ``jjf1535`` is a built-in *procedure*, not a scenario file: a scenario file describes JJF 2003 procedures only, so
 the JJF 1535 session replaces a loaded unit scenario's schedule, turntable and acquisition
@@ -18,13 +19,12 @@ PROCEDURES = {
 #: the unit scenario of ``plansim run jjf1535`` without ``--unit``
 DEFAULT_UNIT = "jjf2003"
 
-#: why ``plansim validate jjf1535`` is refused (exit status 2)
-VALIDATE_REFUSAL = (
-    "validate jjf1535: not available. 'plansim validate' checks a GUM budget propagated through the schedule's "
-    "reduction against an adaptive Monte Carlo (JCGM 101) for the 39 JJF 2003 parameters; for JJF 1535 it would "
-    "need the GUM of the JJF 1535 items (the sensitivity of each to the segment means and the table's errors), "
-    "which is not built. The Appendix A budgets of JJF 1535 against the Monte Carlo (the coverage of K and B0) "
-    "are in 'plansim run jjf1535 [--unit SCENARIO]'")
+#: what ``plansim validate jjf1535`` still refuses (exit status 2): a claims file names JJF 2003 parameters and items
+VALIDATE_CLAIMS_REFUSAL = (
+    "--claims: not available with the procedure jjf1535. A claims file states the uncertainty of JJF 2003 "
+    "parameters ([parameters.NAME]) or JJF 2003 Appendix A items ([items.\"A.x\"]); claims on JJF 1535 items are "
+    "not built. 'plansim validate jjf1535' checks the GUM of the items against the Monte Carlo; JJF 1535's own "
+    "Appendix A budgets (K and B0) against the Monte Carlo are in 'plansim run jjf1535 [--unit SCENARIO]'")
 
 
 def _load_unit(args):
@@ -108,3 +108,33 @@ def _version() -> str:
     from plansim.io.recording import plansim_version
 
     return plansim_version()
+
+
+def validate_jjf1535_command(args) -> int:
+    """``plansim validate jjf1535``: every check first, then the GUM and the adaptive Monte Carlo, then the report.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of ``plansim validate`` (``--unit``, ``--seed``, ``--json``, ``--digits``,
+        ``--trials-per-block``, ``--max-trials``, ``--path``, ``--summary``, ``--quiet``; not ``--claims``).
+    """
+    from plansim.report.progress import end_progress_line
+    from plansim.report.validation import format_jjf1535_report, jjf1535_json, validate_progress
+    from plansim.uncertainty.jjf1535_validation import validate_jjf1535
+
+    if args.claims:
+        raise ValueError(VALIDATE_CLAIMS_REFUSAL)
+    unit = _load_unit(args)
+    progress = validate_progress(f"plansim validate jjf1535 --unit {unit.name}", args.quiet or args.json)
+    report = validate_jjf1535(unit, digits=args.digits, trials_per_block=args.trials_per_block,
+                              max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
+    end_progress_line()
+    if args.json:
+        print(json.dumps({**jjf1535_json(report), "overrides": list(unit.overrides),
+                          "plansim_version": _version()}, indent=2))
+    else:
+        if unit.overrides:
+            print(f"Overrides (--set): {'; '.join(unit.overrides)}")
+        print(format_jjf1535_report(report, details=not args.summary))
+    return 0

@@ -7,7 +7,7 @@ import os
 import time
 
 from plansim.cli.common import COMMANDS, add_set_option
-from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, VALIDATE_REFUSAL, run_jjf1535
+from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, run_jjf1535, validate_jjf1535_command
 from plansim.cli.jjf1537 import DYNAMIC_TESTS, run_jjf1537_command
 from plansim.cli.vibration import EXPERIMENTS as VIBRATION_EXPERIMENTS
 from plansim.cli.vibration import run_vibration
@@ -148,28 +148,23 @@ def _cmd_record(args) -> int:
 def _cmd_validate(args) -> int:
     from plansim.io.claims import load_claims
     from plansim.io.scenario_file import load_scenario
-    from plansim.report.progress import mark_progress_line
-    from plansim.report.validation import format_report, stderr_block_progress, validation_json
+    from plansim.report.validation import format_report, validate_progress, validation_json
     from plansim.runner import validate
 
-    if args.scenario in PROCEDURES:
-        raise ValueError(VALIDATE_REFUSAL)
-    scenario = load_scenario(args.scenario, args.set)
-    claims = load_claims(args.claims, scenario) if args.claims else None
     for option, value, minimum in (("--trials-per-block", args.trials_per_block, 2),
                                    ("--max-trials", args.max_trials, 1), ("--digits", args.digits, 1)):
         if value < minimum:
             raise ValueError(f"{option} {value}: must be >= {minimum}")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
-    progress = None
-    if not (args.quiet or args.json):
-        block_progress = stderr_block_progress(f"plansim validate {scenario.name}")
-
-        def progress(*state) -> None:  # the block progress line is open until the report starts
-            block_progress(*state)
-            mark_progress_line(True)
-
+    if args.scenario in PROCEDURES:  # a built-in procedure validated on a unit scenario
+        return validate_jjf1535_command(args)
+    if args.unit is not None:
+        raise ValueError(f"--unit {args.unit!r}: only with a procedure ({', '.join(PROCEDURES)}: plansim validate "
+                         f"jjf1535 --unit SCENARIO); the scenario {args.scenario!r} is its own unit")
+    scenario = load_scenario(args.scenario, args.set)
+    claims = load_claims(args.claims, scenario) if args.claims else None
+    progress = validate_progress(f"plansim validate {scenario.name}", args.quiet or args.json)
     report = validate(scenario, claims, digits=args.digits, trials_per_block=args.trials_per_block,
                       max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
     end_progress_line()
@@ -191,7 +186,11 @@ def _add_validate_command(sub) -> None:
         description="GUM budget from the schedule, validated by adaptive Monte Carlo (JCGM 101/102); "
                     "checks a claimed budget (default: JJF 2003 Appendix A)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
-                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003; or the "
+                        "procedure jjf1535 (the GUM of its items against the Monte Carlo)")
+    p.add_argument("--unit", default=None, metavar="SCENARIO",
+                   help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
+                        f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
     p.add_argument("--claims", default=None,
                    help="TOML file of claimed expanded uncertainties ([items.\"A.2\"] U = ...; [parameters.Bgx] "

@@ -14,10 +14,14 @@ import time
 import numpy as np
 
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, parameter
+from plansim.report.progress import mark_progress_line
 from plansim.uncertainty.budget import ParameterBudget
+from plansim.uncertainty.jjf1535_validation import Jjf1535ValidationReport
+from plansim.uncertainty.metrology.coverage import COVERAGE_Z
 from plansim.uncertainty.validation import ValidationReport
 
-__all__ = ["format_report", "stderr_block_progress", "validation_json"]
+__all__ = ["format_jjf1535_report", "format_report", "jjf1535_json", "stderr_block_progress", "validate_progress",
+           "validation_json"]
 
 
 def validation_json(report: ValidationReport) -> dict:
@@ -33,9 +37,7 @@ def validation_json(report: ValidationReport) -> dict:
         "scenario": report.scenario,
         "description": report.description,
         "claims": report.claims_source,
-        "mcm": {"trials": mc.trials, "blocks": mc.blocks, "trials_per_block": mc.trials_per_block,
-                "seed": mc.seed, "digits": report.digits, "tolerance_fraction": report.tolerance_fraction,
-                "converged": mc.converged, "path": mc.path},
+        "mcm": _mcm_json(mc, report.digits, report.tolerance_fraction, mc.path),
         "parameters": [p.as_dict() for p in report.parameters],
         "appendix_a": [c.as_dict() for c in report.appendix_items],
         "joint_Kg": report.joint.as_dict(),
@@ -43,6 +45,78 @@ def validation_json(report: ValidationReport) -> dict:
                         "gum": np.round(gum_corr, 6).tolist()},
         "gum_budgets": [b.as_dict() for b in report.gum.budgets],
     })
+
+
+def _mcm_json(mc, digits: int, tolerance_fraction: float, path: str) -> dict:
+    """The ``mcm`` object of both validations' JSON: the adaptive Monte Carlo's size, seed, tolerance and path."""
+    return {"trials": mc.trials, "blocks": mc.blocks, "trials_per_block": mc.trials_per_block, "seed": mc.seed,
+            "digits": digits, "tolerance_fraction": tolerance_fraction, "converged": mc.converged, "path": path}
+
+
+def jjf1535_json(report: Jjf1535ValidationReport) -> dict:
+    """``plansim validate jjf1535 --json``: the report as one strict-JSON dictionary, SI.
+
+    Keys: ``procedure`` ("jjf1535"), ``unit_scenario``, ``description``, ``mcm`` (as :func:`validation_json`),
+    ``items`` (per item: the GUM y, u_c, ν_eff, k, U95; the MCM y, u, 95 % interval; JCGM 101 8's δ, d_low, d_high,
+    validated; ``u_ratio`` = MCM u / GUM u_c, its tolerance and ``scatter_agrees``; the coverage of the truth by
+    the GUM U95 and its verdict), ``gum_budgets`` (each item's inputs, ``u_i`` SI) and ``not_propagated`` (the
+    items with a true value whose GUM is not built, and why).
+    """
+    mc = report.mcm
+    return _json_ready({
+        "procedure": "jjf1535",
+        "unit_scenario": report.unit_scenario,
+        "description": report.description,
+        "mcm": _mcm_json(mc, report.digits, report.tolerance_fraction, report.path),
+        "items": [c.as_dict() for c in report.items],
+        "gum_budgets": [report.gum.item(c.item) for c in report.items],
+        "not_propagated": report.not_propagated,
+    })
+
+
+def format_jjf1535_report(report: Jjf1535ValidationReport, details: bool = True) -> str:
+    """The text report of ``plansim validate jjf1535``: per item GUM against MCM in the item's JJF 1535 unit,
+    then (with *details*) each item's budget, then the items whose GUM is not built."""
+    mc = report.mcm
+    out = [
+        f"plansim validate jjf1535 — unit scenario {report.unit_scenario!r}: {report.description}",
+        f"GUM (JCGM 100) of the JJF 1535-2015 items from the procedure's reduction; adaptive Monte Carlo "
+        f"(JCGM 101 7.9.4): {mc.blocks} blocks × {mc.trials_per_block} = {mc.trials} trials ({report.path} path, "
+        f"seed {mc.seed}), n_dig = {report.digits}, run to {report.tolerance_fraction:g}·δ of the GUM u_c "
+        "(JCGM 101 8.2): " + ("reached" if mc.converged else "NOT reached (max trials)"),
+        "Output quantity: the error E = reported − true of each item, in its JJF 1535 unit (JSON: SI).",
+        "",
+        "Summary (JCGM 101 8: validated if d_low and d_high ≤ δ; u ratio = MCM u / GUM u_c, agrees if within "
+        f"{COVERAGE_Z:g} standard errors of 1; coverage = fraction of trials with |E| ≤ GUM U95)",
+        f"{'item':16s} {'unit':>10s} {'mean error':>11s} {'std error':>10s} {'GUM y':>10s} {'GUM u_c':>10s} "
+        f"{'ν_eff':>7s} {'GUM U95':>10s} {'MCM low':>11s} {'MCM high':>11s} {'δ':>8s} {'d_low':>8s} "
+        f"{'d_high':>8s} {'valid':>5s} {'u ratio':>13s} {'cov GUM':>7s}  verdict",
+    ]
+    for c in report.items:
+        f = c.unit_si
+        out.append(
+            f"{c.item:16s} {c.unit:>10s} {c.mcm_y / f:>11.4g} {c.mcm_u / f:>10.4g} {c.gum_y / f:>10.4g} "
+            f"{c.gum_u / f:>10.4g} {_fmt(c.gum_dof, 2):>7s} {c.gum_U95 / f:>10.4g} {c.mcm_low / f:>11.4g} "
+            f"{c.mcm_high / f:>11.4g} {c.delta / f:>8.2g} {c.d_low / f:>8.2g} {c.d_high / f:>8.2g} "
+            f"{'yes' if c.validated else 'NO':>5s} {c.u_ratio:>6.3f}±{c.u_ratio_tolerance:<6.3f} "
+            f"{c.coverage_gum:>7.1%}  {c.coverage_verdict}")
+    failed = [c.item for c in report.items if not c.validated]
+    disagree = [c.item for c in report.items if not c.scatter_agrees]
+    out.append(f"GUM framework validated for {len(report.items) - len(failed)} of {len(report.items)} items"
+               + (f"; not for {', '.join(failed)}" if failed else "")
+               + "; the GUM u_c agrees with the Monte Carlo's scatter for "
+               + ("every item" if not disagree else f"all but {', '.join(disagree)}"))
+    for c in report.items if details else ():
+        budget = report.gum.item(c.item)
+        f = c.unit_si
+        out += ["", f"== {c.item} (JJF 1535 {c.clause}) [{c.unit}]: u_c = {_fmt(c.gum_u / f)}, "
+                    f"MCM u = {_fmt(c.mcm_u / f)}; inputs (u_i(y) in {c.unit}, share of u_c²):"]
+        for line in budget["inputs"]:
+            out.append(f"  {line['name'][:30]:30s} {line['type']:2s} {_fmt(line['u_i'] / f, 3):>10s} "
+                       f"{(line['u_i'] / c.gum_u) ** 2:>6.1%}")
+    out += ["", "Not propagated (a true value, but no GUM built for it):"]
+    out += [f"  {item}: {why}" for item, why in report.not_propagated.items()]
+    return "\n".join(out)
 
 
 def _json_ready(value):
@@ -219,6 +293,20 @@ def format_report(report: ValidationReport, details: bool = True) -> str:
                            f"{a.plansim_u[2]:.3g} → u_c {a.plansim_uc:.3g}, U95 {a.plansim_U95:.3g}")
     return "\n".join(out)
 
+
+
+def validate_progress(label: str, quiet: bool):
+    """``plansim validate``'s progress: None if *quiet*, else :func:`stderr_block_progress` (*label*) marking the
+    progress line open until the report starts (:func:`plansim.report.progress.mark_progress_line`)."""
+    if quiet:
+        return None
+    block_progress = stderr_block_progress(label)
+
+    def progress(*state) -> None:
+        block_progress(*state)
+        mark_progress_line(True)
+
+    return progress
 
 
 def stderr_block_progress(label: str):

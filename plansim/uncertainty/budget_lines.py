@@ -17,7 +17,6 @@ import numpy as np
 
 from plansim.config import ErrorDistribution, Scenario
 from plansim.kernels.layout import ACCEL_CHANNELS, GYRO_CHANNELS, N_CHANNELS, NOISE_WHITE
-from plansim.model.parameters import N_PARAMETERS
 from plansim.simulate.arguments import kernel_arguments
 from plansim.uncertainty.drift import drift_covariance
 from plansim.uncertainty.quantisation import quantisation_covariance, quantisation_variance
@@ -81,7 +80,7 @@ def _through_reduction(matrix: np.ndarray, d_means: np.ndarray, exact_zeros: boo
     """
     if exact_zeros:
         return np.einsum("psc,ksc->pk", matrix, d_means)
-    return matrix.reshape(N_PARAMETERS, -1) @ d_means.reshape(len(d_means), matrix[0].size).T
+    return matrix.reshape(len(matrix), -1) @ d_means.reshape(len(d_means), matrix[0].size).T
 
 
 def _gram(d_means: np.ndarray) -> np.ndarray:
@@ -98,15 +97,18 @@ def _largest_second_order(matrix: np.ndarray, second: np.ndarray, u: np.ndarray)
     return np.max(0.5 * np.abs(np.einsum("psc,ksc->pk", matrix, second)) * u[None, :] ** 2, axis=1)
 
 
-def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation: bool, describe: bool = True
-                ) -> tuple[list[Line], np.ndarray]:
-    """Every budget line of *scenario*, for all 39 parameters at once, and the expected segment means.
+def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation: bool, describe: bool = True,
+                truth_jacobian: np.ndarray | None = None) -> tuple[list[Line], np.ndarray]:
+    """Every budget line of *scenario*, for all 39 parameters (or the P outputs of *matrix*) at once, and the
+    expected segment means.
 
     Parameters
     ----------
     scenario : Scenario
     matrix : (39, S, 6) ndarray
-        The reduction's matrix (:func:`plansim.uncertainty.sensitivities.estimator_matrix`).
+        The reduction's matrix (:func:`plansim.uncertainty.sensitivities.estimator_matrix`); or, with
+        *truth_jacobian*, the (P, S, 6) linearised reduction of P other outputs (the JJF 1535 items,
+        :mod:`plansim.uncertainty.jjf1535_gum`).
     quantisation_correlation : bool
         Correlate the quantisation errors of the segments of a channel
         (:func:`plansim.uncertainty.quantisation.quantisation_covariance`), or keep Appendix A's
@@ -117,6 +119,9 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         exact zeros where the reduction cancels a component (:func:`_through_reduction`). ``False``
         leaves them out (``None``; the distribution without the regime; columns the same to
         rounding): the prediction (:func:`plansim.uncertainty.gum.gum_uncertainties`) needs none of them.
+    truth_jacobian : (P, 39) ndarray, optional
+        ``∂(true value of output p)/∂(parameter)`` of the unit, for the unit-to-unit spread line's
+        ``∂E/∂Y = R·∂m̄/∂Y − ∂t/∂Y``; default the identity (output p is parameter p).
 
     Returns
     -------
@@ -129,6 +134,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         (:func:`plansim.uncertainty.systematic.expected_error`).
     """
     lines: list[Line] = []
+    n_out = len(matrix)  # outputs: the 39 parameters, or the rows of another reduction
     segments = scenario.schedule.segments
     n_seg = len(segments)
     arguments = kernel_arguments(scenario)
@@ -180,7 +186,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         # below 64 ulp of the mean the deviation is rounding, not a start-angle effect
         deviation[np.abs(deviation) <= 64 * np.finfo(float).eps * np.abs(centre)[None]] = 0.0
         d = np.einsum("psc,jsc->sjp", matrix[:, rotating, :], deviation[:, rotating, :])  # (R, J, 39) per angle
-        d = d.reshape(-1, N_PARAMETERS)
+        d = d.reshape(-1, n_out)
         cov = d.T @ d / PHASE_NODES  # Σ over the rotating segments of the variance over the angle
         # the variance over the angle of each rotating segment's mean, per channel (the angle last: the
         # same pairwise sum as the mean of each segment and channel alone)
@@ -202,11 +208,14 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         if with_offsets:
             offsets += _gram(d_means)
         columns = _through_reduction(matrix, d_means, True) if describe else columns_all[:, n_table:].copy()
-        columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
+        if truth_jacobian is None:
+            columns[idx, np.arange(idx.size)] -= spread[idx]  # E = Ŷ − Y
+        else:
+            columns -= truth_jacobian[:, idx] * spread[idx]  # E = Ŷ − Y(truth)
         lines.append(Line(
             name="unit-to-unit spread", category="unit", evaluation="B", distribution="normal (mimu.truth_spread)",
             u=spread[idx], input_unit="SI of each parameter", columns=columns, mixed_units=True,
-            note="∂E/∂Y = R·∂m/∂Y − 1: the error's dependence on the true value",
+            note="∂E/∂Y = R·∂m/∂Y − ∂Y/∂truth: the error's dependence on the true value",
             second_order=_largest_second_order(matrix, second_all[n_table:], spread[idx]) if describe else None))
 
     # white noise of the segment means (type A, ν = n − 1)
@@ -214,7 +223,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
         u = noise[channels, NOISE_WHITE][None, :] / np.sqrt(durations)[:, None]  # (S, 3)
         if not np.any(u > 0):
             continue
-        columns = (matrix[:, :, channels] * u[None]).reshape(N_PARAMETERS, -1)  # component (s, channel), s-major
+        columns = (matrix[:, :, channels] * u[None]).reshape(n_out, -1)  # component (s, channel), s-major
         dof = np.repeat(samples - 1.0, len(channels))
         dof = np.where(dof > 0, dof, np.inf)
         unit = "rad/s" if label.endswith("gyros") else "m/s^2"
@@ -227,7 +236,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     drift = drift_covariance(scenario, arguments)
     offsets += drift
     for label, channels in (("drift, gyros", _GYROS), ("drift, accelerometers", _ACCELS)):
-        cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
+        cov = np.zeros((n_out, n_out))
         for c in channels:
             if np.any(drift[c] != 0):
                 cov += matrix[:, :, c] @ drift[c] @ matrix[:, :, c].T
@@ -259,7 +268,7 @@ def model_lines(scenario: Scenario, matrix: np.ndarray, quantisation_correlation
     if a.bits:
         for label, channels, step in (("quantisation, gyros", _GYROS, a.gyro_step),
                                       ("quantisation, accelerometers", _ACCELS, a.accel_step)):
-            cov = np.zeros((N_PARAMETERS, N_PARAMETERS))
+            cov = np.zeros((n_out, n_out))
             sigmas = np.array([np.sqrt(noise[c, NOISE_WHITE] ** 2 / dts + jitter[:, c] ** 2) for c in channels])
             if quantisation_correlation:  # the three channels of the kind at once
                 # the pairs no estimate reads (a segment the matrix does not read) only meet its zeros

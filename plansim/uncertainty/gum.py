@@ -167,13 +167,13 @@ def _propagate(scenario: Scenario, coverage_probability: float, quantisation_cor
 
 
 def _effective_dof(lines: list[Line], variances: list[np.ndarray], uc: np.ndarray) -> np.ndarray:
-    """ν_eff (39,) by the Welch–Satterthwaite formula (JCGM 100 G.4.1, eq. (G.2b)).
+    """ν_eff (39,) (or one per output of the lines) by the Welch–Satterthwaite formula (JCGM 100 G.4.1, eq. (G.2b)).
 
     Over every independent component with a finite ν of the lines that count for a parameter (a
     contribution above :data:`NEGLIGIBLE`·u_c): each column of a line with per-component ν, or the
     whole line with its ``line_dof``; ``inf`` where no such component is left or u_c is 0.
     """
-    denominator = np.zeros(N_PARAMETERS)
+    denominator = np.zeros(uc.shape)
     for line, variance in zip(lines, variances):
         if line.columns is not None and line.dof is not None:
             contribution = np.sqrt(variance)
@@ -187,7 +187,7 @@ def _effective_dof(lines: list[Line], variances: list[np.ndarray], uc: np.ndarra
         counts = (contribution > NEGLIGIBLE * uc) & (contribution != 0.0)  # below: the differences' numerical noise
         denominator += np.where(counts, terms, 0.0)
     finite = (denominator > 0) & (uc > 0)
-    return np.divide(uc**4, denominator, out=np.full(N_PARAMETERS, math.inf), where=finite)
+    return np.divide(uc**4, denominator, out=np.full(uc.shape, math.inf), where=finite)
 
 
 def gum_uncertainties(scenario: Scenario, coverage_probability: float = DEFAULT_COVERAGE_PROBABILITY,
