@@ -462,13 +462,42 @@ def vibration_shock_truth(settings: Jjf1537Experiment) -> dict:
 
 
 def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
-    """The GUM standard uncertainty of the three changes of mean (output unit): σ√(1/N₁ + 1/N₂) with
-    σ² = σ_w² + q²/12 (the white noise's and the quantiser's), N the two records' samples; the vibration
-    record's mean is its sine fit's C, var(C) = σ²/N over whole cycles."""
+    """The GUM (JCGM 100, first order) standard uncertainties of the 7.2.4–7.2.7 figures, by item.
+
+    The three changes of mean (output unit): σ√(1/N₁ + 1/N₂) with σ² = σ_w² + q²/12 (the white noise's and the
+    quantiser's), N the two records' samples; the vibration record's mean is its sine fit's C, var(C) = σ²/N
+    over whole cycles.
+
+    The amplitude nonlinearity γ = |S_k* − S̄|/S̄ (k* where |S_k − S̄| is largest), evaluated at the noise-free
+    S_k: with d_j = S_j − S̄ and s* the sign of d_k*,
+
+        ∂γ/∂S_j = s* [(δ_jk* − 1/M)/S̄ − d_k*/(M S̄²)],        u(S_j) = √(2σ²/(nN))/A_j
+
+    (var(E) = 2σ²/N per record, n records), summed in quadrature. nan when γ is not differentiable there: a
+    linear sensor (every d_j = 0) or two amplitudes tied for the maximum. It holds while the noise does not
+    move the maximum to another amplitude (the runner-up several u below).
+    """
     sch = settings.vibration_shock_schedule()
     sigma = math.sqrt(settings.noise_sigma**2 + settings.quantisation**2 / 12.0)
     rest = sch.rest_samples()
-    return {"vibration_output_change": sigma * math.sqrt(1.0 / sch.samples(sch.vibration_time) + 1.0 / rest),
+    gain = float(abs(settings.dynamics().response(sch.frequency)))
+    _, fundamental = static_nonlinearity_harmonics(sch.amplitudes * gain, 0.0,
+                                                   settings.odd_nonlinearity / settings.gyro_range**2)
+    S = np.abs(settings.scale_factor * fundamental) / sch.amplitudes
+    M, mean = S.size, S.mean()
+    d = S - mean
+    order = np.argsort(-np.abs(d))
+    u_nonlinearity = math.nan
+    scale = np.max(np.abs(S))
+    if abs(d[order[0]]) > 1e-9 * scale and abs(d[order[0]]) - abs(d[order[1]]) > 1e-9 * scale:
+        k = int(order[0])
+        grad = -np.full(M, 1.0 / M) / mean - d[k] / (M * mean**2)
+        grad[k] += 1.0 / mean
+        grad *= math.copysign(1.0, d[k])
+        u_S = math.sqrt(2.0 * sigma**2 / (sch.repeats * sch.samples(sch.record_time))) / sch.amplitudes
+        u_nonlinearity = float(np.sqrt(np.sum((grad * u_S) ** 2)))
+    return {"amplitude_nonlinearity": u_nonlinearity,
+            "vibration_output_change": sigma * math.sqrt(1.0 / sch.samples(sch.vibration_time) + 1.0 / rest),
             "bias_change_vibration": sigma * math.sqrt(2.0 / rest), "bias_change_shock": sigma * math.sqrt(2.0 / rest)}
 
 
@@ -533,7 +562,7 @@ class VibrationShockResult:
     """The Monte Carlo of JJF 1537-2015 7.2.4–7.2.7 (output unit; the nonlinearity dimensionless).
 
     ``truth``, ``gum``: by item (:data:`ITEMS`), :func:`vibration_shock_truth` and
-    :func:`vibration_shock_gum` (no GUM for the nonlinearity: a maximum of absolute values);
+    :func:`vibration_shock_gum` (the nonlinearity's nan for a linear sensor: a maximum of absolute values);
     ``estimates``, ``type_a``: (trials,) per item, the figure and its Type A u per trial.
     """
 
