@@ -367,8 +367,8 @@ def test_items_monte_carlo_against_the_truth_and_the_coverage_of_their_uncertain
       maximum |S_k − ⟨S⟩| is at 90 °/s (|A² − ⟨A²⟩| = 4050 (°/s)²), its runner-up at 30 °/s (3150) is
       (1 − 3150/4050) γ ≈ 750 ppm below it, 2.4 times the standard deviation of the difference of the two
       deviations (u(S) ≈ 300 ppm at 30 °/s with 0.25 s records), so the maximum stays at 90 °/s, where the
-      estimator is smooth and unbiased to first order, in all but about 1 % of the trials. A correct simulation fails one of these 4 checks with
-      probability < 4 × 5.7e-7.
+      estimator is smooth and unbiased to first order, in all but about 1 % of the trials. A correct
+      simulation fails one of these 4 checks with probability < 4 × 5.7e-7.
     - The MC standard deviations equal the GUM's within 4/√(2(T − 1)) = 0.16 relative (4 relative standard
       errors of a standard deviation from T normal samples): the changes' σ√(1/N₁ + 1/N₂), the nonlinearity's
       first-order u at 90 °/s (``vibration_shock_gum``).
