@@ -222,6 +222,12 @@ def test_cli_text_and_bad_input(capsys):
     assert "repeats: expected an integer >= 7" in capsys.readouterr().err
     assert cli.main(["run", "jjf1537", "--set", "amplitude_fraction=0.05"]) == 2
     assert "amplitude_fraction: expected 0.1 to 0.3" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1537", "--set", "linearity_points=2"]) == 2
+    assert "linearity_points: expected an integer >= 3, got 2" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1537", "--set", "vibration_frequency=3 kHz"]) == 2
+    assert "vibration_frequency: expected < half the sample rate 4000 Hz, got 3000.0" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1537", "--set", "shock_bias_shift=1 m"]) == 2
+    assert "--set 'shock_bias_shift=1 m'" in capsys.readouterr().err
     assert cli.main(["run", "jjf1537", "--trials", "1"]) == 2
     assert "--trials 1: must be >= 2" in capsys.readouterr().err
     assert cli.main(["run", "jjf1537", "--out", "x.nc"]) == 2
