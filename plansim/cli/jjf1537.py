@@ -1,5 +1,6 @@
-"""``plansim run jjf1537``: JJF 1537-2015's amplitude/phase-frequency test on an angular vibration table,
-simulated as a Monte Carlo and reduced (docs/dynamic.md).
+"""``plansim run jjf1537``: JJF 1537-2015's amplitude/phase-frequency test on an angular vibration table, and its
+items 7.2.4–7.2.7 (amplitude nonlinearity, output change under vibration, bias change across vibration and
+shock), simulated as a Monte Carlo and reduced (docs/dynamic.md).
 
 Like ``vibration_g2`` it is built in, not a scenario file: its settings are
 :class:`plansim.simulate.jjf1537.Jjf1537Experiment`, changed with ``--set KEY=VALUE``
@@ -15,7 +16,8 @@ import time
 DYNAMIC_TESTS = {
     "jjf1537": "JJF 1537-2015 7.2.1 on an angular vibration table: sine fits at >= 7 frequencies x 7 repeats, "
                "amplitude/phase response and -3 dB bandwidth, Monte Carlo bias and scatter against the truth and "
-               "the GUM",
+               "the GUM; 7.2.4-7.2.7 at one frequency: amplitude nonlinearity, output change in vibration, bias "
+               "change across vibration and shock",
 }
 
 

@@ -22,7 +22,13 @@ clause                          quantity                                        
 JJF 1537 7.2.1 eq. (6)          E_ij, φ_ij, C_ij of one record                      :func:`sine_fit`
 JJF 1537 7.2.1 eq. (7)–(9)      Ē_i, S_i, K_i; the phase response (7.2.3)           :func:`frequency_response`
 JJF 1535 3.7, 7.2.15.2          the −3 dB bandwidth                                 :func:`bandwidth_3db`
+JJF 1537 7.2.4 (title only)     the amplitude nonlinearity                          :func:`amplitude_nonlinearity`
+JJF 1537 7.2.5–7.2.7 (titles)   a change of the mean output, with its Type A u      :func:`mean_change`
 ==============================  ==================================================  ===========================
+
+The copy of JJF 1537-2015 this follows breaks off after eq. (9): 7.2.4–7.2.7 are known by their titles in
+its Table 3 only (amplitude nonlinearity; output change under vibration; bias change before/after vibration;
+before/after shock), and the two estimators for them are plansim's reading, stated in their docstrings.
 
 References
 ----------
@@ -397,3 +403,52 @@ def sine_fits(t, records, frequency: float) -> SineFits:
     return SineFits(frequency=f, amplitude=np.hypot(a, b).reshape(shape),
                     phase=np.asarray(wrap_phase(np.arctan2(-b, a))).reshape(shape), offset=c.reshape(shape),
                     residual_rms=np.sqrt(np.mean(residuals * residuals, axis=0)).reshape(shape), samples=t.size)
+
+
+def amplitude_nonlinearity(input_amplitudes, mean_amplitudes) -> float:
+    """The amplitude nonlinearity at one frequency (JJF 1537-2015 7.2.4, Table 3 item 4), dimensionless.
+
+    At M ≥ 3 table amplitudes A_k the sensitivities S_k = Ē_k/A_k (eq. (7)–(8), Ē_k the mean fitted
+    amplitude of the n records at A_k) are compared with their mean S̄ = (1/M) Σ_k S_k:
+
+        γ = max_k |S_k − S̄| / |S̄|.
+
+    The copy of JJF 1537 used here gives 7.2.4 by its title only; this is plansim's reading, the largest
+    relative deviation of the sensitivity from its mean over the amplitudes (as the scale-factor
+    nonlinearity of JJF 1535 eq. (6) is the largest deviation from the fitted line, relative). A linear
+    sensor gives 0 whatever its scale factor and dynamics.
+    """
+    A = checked_array("input_amplitudes", input_amplitudes, ndim=1, minimum=3)
+    E = checked_array("mean_amplitudes", mean_amplitudes, ndim=1, minimum=3)
+    if A.shape != E.shape:
+        raise ValueError(f"input_amplitudes and mean_amplitudes: expected the same length, got {A.size} and "
+                         f"{E.size}")
+    if np.any(A <= 0):
+        raise ValueError(f"input_amplitudes: expected values > 0 rad/s, got {A.tolist()}")
+    S = E / A
+    mean = S.mean()
+    if not mean != 0:
+        raise ValueError(f"mean_amplitudes: the mean sensitivity is 0 (got {E.tolist()})")
+    return float(np.max(np.abs(S - mean)) / abs(mean))
+
+
+def mean_change(before, after) -> tuple[np.ndarray, np.ndarray]:
+    """The change of the mean output from the record(s) *before* to *after* (last axis: samples), with its
+    Type A standard uncertainty (JJF 1537-2015 7.2.6–7.2.7, Table 3 items 6–7, by their titles).
+
+        Δ = ȳ_after − ȳ_before,        u(Δ) = √(s²_after/N_after + s²_before/N_before),
+
+    s² the sample variances (ddof 1): the two records' means are independent and their noise white. The
+    bias change across vibration or shock is Δ/S in rate units (S the scale factor). Arrays of the leading
+    shape (floats for one record each).
+    """
+    b = checked_array("before", before, minimum=2)
+    a = checked_array("after", after, minimum=2)
+    for name, x in (("before", b), ("after", a)):
+        if x.ndim == 0 or x.shape[-1] < 2:
+            raise ValueError(f"{name}: expected at least 2 samples along the last axis, got shape {x.shape}")
+    if b.shape[:-1] != a.shape[:-1]:
+        raise ValueError(f"before and after: expected the same leading shape, got {b.shape} and {a.shape}")
+    change = a.mean(axis=-1) - b.mean(axis=-1)
+    u = np.sqrt(a.var(axis=-1, ddof=1) / a.shape[-1] + b.var(axis=-1, ddof=1) / b.shape[-1])
+    return change, u

@@ -58,16 +58,18 @@ def iir_filter(b, a, x, state, out):
 
 @jit
 def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias, sigma, step, output_range,
-                 key, streams, block, white, out):
+                 key, streams, block, white, out, even=0.0, odd=0.0):
     """Gyro records on an angular vibration table: out[r, k] for record r and sample index first + k.
 
     The table's rate about the sensitive axis is ω_r(t) = A cos(Ω t + φ_r) at t = i·Δt for the sample index
     i = first + k (i < 0: the run-in before the record, whose output is filtered and then discarded). The
     gyro's output is
 
-        y = Q(S · (H ω)[i] + B + σ w_r[i]),
+        y = Q(S · g((H ω)[i]) + B + σ w_r[i]),        g(v) = v + c₂ v² + c₃ v³,
 
-    H the filter (b, a) continuing from ``states[r]``, S the scale factor, B the bias, w_r the standard
+    H the filter (b, a) continuing from ``states[r]``, g the static amplitude nonlinearity after the dynamics
+    (c₂ = *even*, c₃ = *odd*, in (rad/s)⁻¹ and (rad/s)⁻²; both 0 by default: the linear sensor), S the scale
+    factor, B the bias, w_r the standard
     normal sequence of stream ``streams[r]`` (drawn block by block, :func:`plansim.kernels.vibration.white_blocks`,
     so w_r[i] depends only on (key, stream, i)), and Q the saturation at ± *output_range* and the quantiser of
     step *step* (:func:`plansim.kernels.quantiser.quantise`; step 0: none). Samples with i < 0 are written as
@@ -90,6 +92,8 @@ def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias,
         The sample index of out[:, 0] (negative in the run-in).
     scale, bias, sigma, step, output_range : float
         S (output unit per rad/s), B and σ (output unit), the quantisation step (0: none) and the range.
+    even, odd : float
+        c₂, c₃ of g (above), 0 for a linear sensor.
     key : ndarray of uint64, (4,)
         The root key (:func:`plansim.kernels.random.root_key`).
     streams : ndarray of int64, (R,)
@@ -116,5 +120,7 @@ def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias,
             if i < 0:
                 out[r, k] = math.nan
             else:
+                if even != 0.0 or odd != 0.0:
+                    v = v + v * v * (even + odd * v)
                 y = scale * v + bias + sigma * white[k - skip]
                 out[r, k] = quantise(y, output_range, step, inverse_step, output_range)

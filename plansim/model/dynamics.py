@@ -133,6 +133,25 @@ def two_resonance_response(frequencies, sense_frequency: float, sense_damping: f
             * second_order_response(frequencies, drive_frequency, drive_damping))
 
 
+def static_nonlinearity_harmonics(amplitude, even: float, odd: float) -> tuple[np.ndarray, np.ndarray]:
+    """The mean and the fundamental of g(v) = v + c₂v² + c₃v³ for v = a cos θ over whole cycles.
+
+    The sensor's optional amplitude nonlinearity (:func:`plansim.kernels.dynamics.sine_records`) acts on
+    the rate after the dynamics, v = a cos θ with a = A|H(j2πf)|. From cos²θ = (1 + cos 2θ)/2 and
+    cos³θ = (3 cos θ + cos 3θ)/4,
+
+        g(a cos θ) = c₂a²/2 + (a + 3c₃a³/4) cos θ + (c₂a²/2) cos 2θ + (c₃a³/4) cos 3θ,
+
+    so over whole cycles the mean is c₂a²/2 (the rectification, JJF 1537-2015 7.2.5's output change under
+    vibration) and the fundamental's amplitude, which the sine fit of eq. (6) reads, is a + 3c₃a³/4 (the even
+    term adds none: the amplitude nonlinearity of 7.2.4 comes from the odd term). Returns (mean,
+    fundamental) in rad/s, arrays of *amplitude*'s shape (rad/s); c₂ in (rad/s)⁻¹, c₃ in (rad/s)⁻².
+    """
+    a = np.asarray(amplitude, dtype=float)
+    c2, c3 = one_number("even", even), one_number("odd", odd)
+    return 0.5 * c2 * a * a, a + 0.75 * c3 * a**3
+
+
 #: the sensor models of :class:`SensorDynamics`
 SENSOR_MODELS = ("flat", "second_order", "two_resonance")
 

@@ -34,7 +34,9 @@ def jjf1537_json(result, elapsed: float, version: str) -> dict:
             "amplitude": sch.amplitude, "repeats": sch.repeats, "sample_rate": sch.sample_rate,
             "record_samples": [int(v) for v in sch.samples()], "expected_bandwidth": sch.expected_bandwidth,
             "grid": s.grid, "gyro_arw": s.gyro_arw, "quantisation": s.quantisation, "scale_factor": s.scale_factor,
-            "bias": s.bias, "noise_sigma": s.noise_sigma,
+            "bias": s.bias, "noise_sigma": s.noise_sigma, "odd_nonlinearity": s.odd_nonlinearity,
+            "even_nonlinearity": s.even_nonlinearity, "vibration_bias_shift": s.vibration_bias_shift,
+            "shock_bias_shift": s.shock_bias_shift,
         },
         "frequencies": _list(sch.frequencies),
         "truth": {"ratio": _list(result.truth_ratio), "phase": _list(result.truth_phase),
@@ -50,6 +52,21 @@ def jjf1537_json(result, elapsed: float, version: str) -> dict:
         "gum": {"ratio": _list(result.gum["ratio"]), "phase": _list(result.gum["phase"]),
                 "bandwidth": _number(result.gum["bandwidth"]), "amplitude": _list(result.gum["amplitude"])},
         "type_a_mean": {"ratio": _list(result.type_a["ratio"]), "phase": _list(result.type_a["phase"])},
+        "vibration_shock": _vibration_shock_json(result.vibration_shock),
+    }
+
+
+def _vibration_shock_json(items) -> dict | None:
+    """JJF 1537 7.2.4–7.2.7: the schedule and, per item, the truth and the MC figures (nan as null)."""
+    if items is None:
+        return None
+    sch = items.schedule
+    return {
+        "frequency": sch.frequency, "amplitudes": _list(sch.amplitudes), "vibration_amplitude": sch.amplitude,
+        "record_samples": sch.samples(sch.record_time), "vibration_samples": sch.samples(sch.vibration_time),
+        "rest_samples": sch.rest_samples(), "shock_waveform_simulated": False,
+        "items": {name: {key: _number(value) for key, value in figures.items()}
+                  for name, figures in items.summary().items()},
     }
 
 
@@ -94,7 +111,44 @@ def jjf1537_text(result, elapsed: float) -> str:
         "K = S_i/S_0 with S_0 read at the lowest frequency (JJF 1537 eq. (9)); bias against the analytic |H|, "
         "arg H",
     ]
+    if result.vibration_shock is not None:
+        lines += ["", *_vibration_shock_text(result)]
     return "\n".join(lines)
+
+
+#: the report's label of each 7.2.4–7.2.7 figure
+_ITEM_LABELS = {"amplitude_nonlinearity": "7.2.4 amplitude nonlinearity (ppm)",
+                "vibration_output_change": "7.2.5 output change in vibration (deg/h)",
+                "bias_change_vibration": "7.2.6 bias change, vibration (deg/h)",
+                "bias_change_shock": "7.2.7 bias change, shock (deg/h)"}
+
+
+def _vibration_shock_text(result) -> list[str]:
+    """The 7.2.4–7.2.7 table: per item the truth, the MC mean, bias and s, the mean Type A u, the GUM u and the
+    coverage of ± 2 u_A; the nonlinearity in ppm, the changes in deg/h of output (S = 1: of rate)."""
+    items, s = result.vibration_shock, result.settings
+    sch = items.schedule
+    amplitudes = ", ".join(f"{a / DEG:g}" for a in sch.amplitudes)
+    lines = [
+        f"JJF 1537 7.2.4-7.2.7 at {sch.frequency:g} Hz: amplitudes {amplitudes} deg/s, n = {sch.repeats} x "
+        f"{sch.samples(sch.record_time)} samples; vibration {sch.amplitude / DEG:g} deg/s, "
+        f"{sch.samples(sch.vibration_time)} samples; 3 records at rest of {sch.rest_samples()} samples",
+        f"sensor: odd nonlinearity c3 {s.odd_nonlinearity:g}, even c2 {s.even_nonlinearity:g} (g(v) = v + c2 v^2/R "
+        f"+ c3 v^3/R^2); bias shift after vibration {s.vibration_bias_shift / DEG * 3600:g} deg/h, after the "
+        f"shock {s.shock_bias_shift / DEG * 3600:g} deg/h (the shock waveform is not simulated)",
+        "",
+        "  item                                       truth        MC mean      bias         s MC       "
+        "mean u_A     u GUM      |err| <= 2u_A",
+    ]
+    for name, fig in items.summary().items():
+        unit = 1e6 if name == "amplitude_nonlinearity" else 3600.0 / DEG
+        cover = "" if math.isnan(fig["coverage"]) else f"{100 * fig['coverage']:.1f} %"
+        u_a = "" if math.isnan(fig["type_a_mean"]) else f"{unit * fig['type_a_mean']:9.4g}"
+        gum = "" if math.isnan(fig["gum"]) else f"{unit * fig['gum']:9.4g}"
+        row = (f"  {_ITEM_LABELS[name]:<41}  {unit * fig['truth']:+10.4g}   {unit * fig['mean']:+10.4g}   "
+               f"{unit * fig['bias']:+10.3g}   {unit * fig['std']:9.4g}   {u_a:>9}   {gum:>9}   {cover:>8}")
+        lines.append(row.rstrip())
+    return lines
 
 
 def bode_figure(result, path: str | os.PathLike, format: str | None = None) -> None:

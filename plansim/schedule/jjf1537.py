@@ -9,7 +9,11 @@ JJF 1537-2015 7.2.1 (docs/dynamic.md, *The JJF 1537 procedure simulated*):
 JJF 1535-2015 7.2.15.1 b) places its frequencies differently: 8 points evenly up to the expected bandwidth
 f_e + 10 Hz, and one more halfway between f_e and each of its two neighbours on that grid
 (:func:`jjf1535_frequencies`). Either grid is a :class:`Jjf1537Schedule`'s ``frequencies``.
-Frequencies in Hz, rates in rad/s, times in s.
+
+JJF 1537-2015 7.2.4–7.2.7 (amplitude nonlinearity, output change under vibration, bias change before/after
+vibration and shock; the copy used here has their titles only, Table 3) are :class:`VibrationShockSchedule`:
+M amplitudes across the 10–30 % of 7.2.1.1 at one frequency, one vibration record and three records at
+rest (before vibration, after it, after the shock). Frequencies in Hz, rates in rad/s, times in s.
 """
 
 from __future__ import annotations
@@ -28,6 +32,13 @@ MIN_REPEATS = 7
 AMPLITUDE_FRACTION = (0.10, 0.30)
 #: JJF 1537-2015 7.2.1.2 b): the sample rate exceeds this multiple of the bandwidth
 RATE_PER_BANDWIDTH = 20.0
+
+
+def checked_repeats(repeats) -> int:
+    """*repeats* as an int, or a ``ValueError`` unless it is an integer ≥ :data:`MIN_REPEATS` (7.2.1.2 c))."""
+    if isinstance(repeats, bool) or not isinstance(repeats, (int, np.integer)) or repeats < MIN_REPEATS:
+        raise ValueError(f"repeats: expected an integer >= {MIN_REPEATS} (JJF 1537-2015 7.2.1.2 c)), got {repeats!r}")
+    return int(repeats)
 
 
 def jjf1535_frequencies(expected_bandwidth: float, margin: float = 10.0) -> np.ndarray:
@@ -111,11 +122,7 @@ class Jjf1537Schedule:
             raise ValueError(f"amplitude: expected 10-30 % of the range {self.gyro_range!r} rad/s (JJF 1537-2015 "
                              f"7.2.1.1), i.e. {lo * self.gyro_range:.6g} to {hi * self.gyro_range:.6g} rad/s, "
                              f"got {self.amplitude!r}")
-        if isinstance(self.repeats, bool) or not isinstance(self.repeats, (int, np.integer)) \
-                or self.repeats < MIN_REPEATS:
-            raise ValueError(f"repeats: expected an integer >= {MIN_REPEATS} (JJF 1537-2015 7.2.1.2 c)), "
-                             f"got {self.repeats!r}")
-        object.__setattr__(self, "repeats", int(self.repeats))
+        object.__setattr__(self, "repeats", checked_repeats(self.repeats))
         if not self.sample_rate > RATE_PER_BANDWIDTH * self.expected_bandwidth:
             raise ValueError(f"sample_rate: expected > {RATE_PER_BANDWIDTH:g} x the expected bandwidth "
                              f"{self.expected_bandwidth:g} Hz = {RATE_PER_BANDWIDTH * self.expected_bandwidth:g} Hz "
@@ -149,3 +156,90 @@ def amplitude_in_range(fraction: float, gyro_range: float) -> float:
         raise ValueError(f"amplitude_fraction: expected {lo:g} to {hi:g} of the range (JJF 1537-2015 7.2.1.1), "
                          f"got {fraction!r}")
     return x * positive_number("gyro_range", gyro_range, "rad/s")
+
+
+#: the default number of amplitudes of the amplitude-nonlinearity test (JJF 1537-2015 7.2.4)
+LINEARITY_POINTS = 5
+
+
+def linearity_amplitudes(gyro_range: float, count: int = LINEARITY_POINTS) -> np.ndarray:
+    """*count* (≥ 3) amplitudes evenly across 10–30 % of *gyro_range* (rad/s), ends included: the amplitude
+    range of JJF 1537-2015 7.2.1.1, read as the range of 7.2.4's amplitudes too."""
+    R = positive_number("gyro_range", gyro_range, "rad/s")
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 3:
+        raise ValueError(f"linearity_points: expected an integer >= 3, got {count!r}")
+    lo, hi = AMPLITUDE_FRACTION
+    return np.linspace(lo * R, hi * R, int(count))
+
+
+@dataclass(frozen=True)
+class VibrationShockSchedule:
+    """JJF 1537-2015 7.2.4–7.2.7 as data: one table frequency, the records at rest and under vibration.
+
+    Per test: at ``frequency`` f, n = ``repeats`` records of whole cycles near ``record_time`` at each of the
+    ``amplitudes`` A_k (7.2.4); then at rest for ``rest_time`` (before vibration), under vibration at the
+    amplitude ``amplitude`` for ``vibration_time`` (7.2.5), at rest again (after vibration, 7.2.6), the shock
+    (not simulated as a waveform), at rest (after the shock, 7.2.7).
+
+    Attributes
+    ----------
+    frequency : float
+        f, Hz, below f_s/2.
+    amplitudes : ndarray
+        A_k, rad/s, ≥ 3 distinct, each 10–30 % of ``gyro_range``.
+    amplitude : float
+        The vibration's rate amplitude, rad/s, 10–30 % of ``gyro_range``.
+    gyro_range, sample_rate : float
+        rad/s, Hz.
+    repeats : int
+        n ≥ :data:`MIN_REPEATS` records per amplitude.
+    record_time, vibration_time, rest_time : float
+        s; the first two rounded down to whole cycles (at least one), N = round(c f_s/f) samples: exactly whole
+        cycles when c f_s/f is an integer (20 Hz at 4 kHz), as the closed forms of the tests assume.
+    """
+
+    frequency: float
+    amplitudes: np.ndarray
+    amplitude: float
+    gyro_range: float
+    repeats: int = MIN_REPEATS
+    sample_rate: float = 4000.0
+    record_time: float = 1.0
+    vibration_time: float = 5.0
+    rest_time: float = 5.0
+
+    def __post_init__(self):
+        for name, unit in (("frequency", "Hz"), ("amplitude", "rad/s"), ("gyro_range", "rad/s"),
+                           ("sample_rate", "Hz"), ("record_time", "s"), ("vibration_time", "s"),
+                           ("rest_time", "s")):
+            object.__setattr__(self, name, positive_number(name, getattr(self, name), unit))
+        try:
+            A = np.array(self.amplitudes, dtype=float).ravel()
+        except (TypeError, ValueError) as exc:
+            raise TypeError(f"amplitudes: expected numbers (rad/s), got {self.amplitudes!r}") from exc
+        lo, hi = (x * self.gyro_range for x in AMPLITUDE_FRACTION)
+        inside = np.all((A >= lo * (1 - 1e-12)) & (A <= hi * (1 + 1e-12)))
+        if A.size < 3 or np.unique(A).size != A.size or not inside:
+            raise ValueError(f"amplitudes: expected at least 3 distinct values within 10-30 % of the range, "
+                             f"{lo:.6g} to {hi:.6g} rad/s (JJF 1537-2015 7.2.1.1, 7.2.4), got {A.tolist()}")
+        A.flags.writeable = False
+        object.__setattr__(self, "amplitudes", A)
+        if not lo * (1 - 1e-12) <= self.amplitude <= hi * (1 + 1e-12):
+            raise ValueError(f"amplitude: expected 10-30 % of the range, {lo:.6g} to {hi:.6g} rad/s, got "
+                             f"{self.amplitude!r}")
+        object.__setattr__(self, "repeats", checked_repeats(self.repeats))
+        if not self.sample_rate > 2.0 * self.frequency:
+            raise ValueError(f"vibration_frequency: expected < half the sample rate {self.sample_rate:g} Hz, got "
+                             f"{self.frequency!r}")
+        if min(self.samples(self.record_time), self.rest_samples()) < 4:
+            raise ValueError(f"record_time, rest_time: {self.record_time!r} s and {self.rest_time!r} s give "
+                             "fewer than 4 samples; allowed: longer records")
+
+    def samples(self, duration: float) -> int:
+        """N = round(c f_s/f) for c = max(1, ⌊duration · f⌋) whole cycles."""
+        cycles = max(1, math.floor(duration * self.frequency * (1 + 1e-12)))
+        return int(round(cycles * self.sample_rate / self.frequency))
+
+    def rest_samples(self) -> int:
+        """round(rest_time · f_s): the samples of one record at rest."""
+        return int(round(self.rest_time * self.sample_rate))

@@ -35,6 +35,16 @@ frequency, the phase response, the −3 dB bandwidth interpolated (JJF 1535-2015
 the bias and standard deviation of each against the analytic truth, and the GUM (JCGM 100) of the same
 estimators from the sine fit's closed-form variance.
 
+**Items 7.2.4–7.2.7** (:func:`run_vibration_shock`; :func:`run_jjf1537` runs them in the same trials). The
+sensor may have a static amplitude nonlinearity after its dynamics, g(v) = v + c₂v²/R + c₃v³/R² (R the range;
+``even_nonlinearity`` c₂, ``odd_nonlinearity`` c₃, both 0 by default: a model choice, the copy of JJF 1537
+naming no model), and its bias may step by ``vibration_bias_shift`` after the vibration and by
+``shock_bias_shift`` after the shock (0 by default). At one frequency (``vibration_frequency``) each trial
+records n repeats at each of M amplitudes across 10–30 % of the range (7.2.4), then at rest, under vibration at
+the 7.2.1 amplitude (7.2.5), at rest, the shock (its waveform not simulated: only the bias step it leaves), at
+rest (7.2.6, 7.2.7); :func:`reduce_vibration_shock` reduces them and :func:`vibration_shock_truth` gives the
+figures in closed form.
+
 **Reproducibility.** Every noise sample is a function of (seed, record, sample index) and the filter state
 is carried from chunk to chunk: the numbers do not depend on the chunking, in time or in trials.
 """
@@ -48,11 +58,27 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.signal
 
-from plansim.estimate.dynamic import HALF_POWER, bandwidth_3db, frequency_response, sine_fits, wrap_phase
+from plansim.estimate.dynamic import (
+    HALF_POWER,
+    amplitude_nonlinearity,
+    bandwidth_3db,
+    frequency_response,
+    mean_change,
+    sine_fits,
+    wrap_phase,
+)
 from plansim.kernels.dynamics import sine_records
 from plansim.kernels.random import root_key
-from plansim.model.dynamics import SENSOR_MODELS, SensorDynamics, one_number
-from plansim.schedule.jjf1537 import Jjf1537Schedule, amplitude_in_range, jjf1535_frequencies, jjf1537_frequencies
+from plansim.model.dynamics import SENSOR_MODELS, SensorDynamics, one_number, static_nonlinearity_harmonics
+from plansim.schedule.jjf1537 import (
+    LINEARITY_POINTS,
+    Jjf1537Schedule,
+    VibrationShockSchedule,
+    amplitude_in_range,
+    jjf1535_frequencies,
+    jjf1537_frequencies,
+    linearity_amplitudes,
+)
 from plansim.units import DEG, parse_quantity
 
 #: white numbers per block of a record's noise (fixed: the numbers never depend on the chunking)
@@ -86,10 +112,19 @@ FIELDS = {
     "quantisation": ("angular_rate", "the output's step, e.g. '0.00916 deg/s'; 0: none"),
     "scale_factor": ("dimensionless", "S, output (rad/s) per input rad/s"),
     "bias": ("angular_rate", "the output's bias, e.g. '0.1 deg/s'"),
+    "odd_nonlinearity": ("dimensionless", "c3 of g(v) = v + c2 v^2/R + c3 v^3/R^2 (R the range): the gain's "
+                                          "relative excess at the full range; 0: linear (default)"),
+    "even_nonlinearity": ("dimensionless", "c2 of g(v) (above): the rectification; 0: none (default)"),
+    "vibration_frequency": ("frequency", "7.2.4-7.2.7: the table frequency, e.g. '20 Hz'"),
+    "linearity_points": ("count", "7.2.4: amplitudes evenly across 10-30 % of the range, >= 3"),
+    "vibration_time": ("time", "7.2.5: the record under vibration (whole cycles), e.g. '5 s'"),
+    "rest_time": ("time", "7.2.6-7.2.7: each record at rest, e.g. '5 s'"),
+    "vibration_bias_shift": ("angular_rate", "7.2.6: the output's bias change the vibration leaves; 0: none"),
+    "shock_bias_shift": ("angular_rate", "7.2.7: the output's bias change the shock leaves; 0: none"),
 }
 _CHOICES = {"model": SENSOR_MODELS, "grid": ("jjf1535", "jjf1537")}
 _MAY_BE_ZERO = ("gyro_arw", "quantisation")
-_ANY_SIGN = ("bias",)
+_ANY_SIGN = ("bias", "odd_nonlinearity", "even_nonlinearity", "vibration_bias_shift", "shock_bias_shift")
 
 
 @dataclass(frozen=True)
@@ -121,6 +156,14 @@ class Jjf1537Experiment:
     quantisation: float = 600.0 * DEG / 2**16     # rad/s
     scale_factor: float = 1.0
     bias: float = 0.1 * DEG                       # rad/s
+    odd_nonlinearity: float = 0.0
+    even_nonlinearity: float = 0.0
+    vibration_frequency: float = 20.0
+    linearity_points: int = LINEARITY_POINTS
+    vibration_time: float = 5.0
+    rest_time: float = 5.0
+    vibration_bias_shift: float = 0.0             # output unit (rad/s)
+    shock_bias_shift: float = 0.0                 # output unit (rad/s)
     overrides: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
@@ -143,6 +186,7 @@ class Jjf1537Experiment:
         amplitude_in_range(self.amplitude_fraction, self.gyro_range)
         self.dynamics()
         self.schedule()
+        self.vibration_shock_schedule()
 
     def dynamics(self) -> SensorDynamics:
         """The sensor's truth (:class:`plansim.model.dynamics.SensorDynamics`)."""
@@ -160,6 +204,15 @@ class Jjf1537Experiment:
                                amplitude=amplitude_in_range(self.amplitude_fraction, self.gyro_range),
                                gyro_range=self.gyro_range, repeats=self.repeats, sample_rate=self.sample_rate,
                                record_time=self.record_time, expected_bandwidth=self.expected_bandwidth)
+
+    def vibration_shock_schedule(self) -> VibrationShockSchedule:
+        """JJF 1537-2015 7.2.4–7.2.7's records (:class:`plansim.schedule.jjf1537.VibrationShockSchedule`): the
+        vibration at ``amplitude_fraction`` of the range, ``linearity_points`` amplitudes over 10–30 %."""
+        return VibrationShockSchedule(
+            frequency=self.vibration_frequency, amplitudes=linearity_amplitudes(self.gyro_range, self.linearity_points),
+            amplitude=amplitude_in_range(self.amplitude_fraction, self.gyro_range), gyro_range=self.gyro_range,
+            repeats=self.repeats, sample_rate=self.sample_rate, record_time=self.record_time,
+            vibration_time=self.vibration_time, rest_time=self.rest_time)
 
     @property
     def noise_sigma(self) -> float:
@@ -236,28 +289,44 @@ def simulate_records(settings: Jjf1537Experiment, seed: int, index: int, trials,
     schedule = settings.schedule()
     trials = np.asarray(trials, dtype=np.int64).ravel()
     m, n = schedule.frequencies.size, schedule.repeats
-    f = float(schedule.frequencies[index])
-    N = int(schedule.samples()[index])
-    b, a = discretise(settings.dynamics(), f, schedule.sample_rate)
-    lead = run_in_samples(a)
     if phases is None:
         phases = np.stack([table_phases(seed, t, (m, n))[index] for t in trials])
-    rows = trials.size * n
     streams = ((trials[:, None] * m + index) * n + np.arange(n)[None, :]).ravel().astype(np.int64)
+    out = table_records(settings, seed, float(schedule.frequencies[index]), schedule.amplitude,
+                        np.ascontiguousarray(phases).ravel(), int(schedule.samples()[index]), streams, chunk=chunk)
+    return out.reshape(trials.size, n, -1)
+
+
+def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, amplitude: float, phases, samples: int,
+                  streams, chunk: int | None = None, bias_shift: float = 0.0) -> np.ndarray:
+    """One record per stream (R,) of *samples* samples: the table at *frequency* (Hz) and rate *amplitude*
+    (rad/s; 0: at rest) with the phases *phases* (R,), through the sensor of *settings* after its run-in
+    (:func:`plansim.kernels.dynamics.sine_records`), the output bias B + *bias_shift* (output unit, as B).
+    (R, samples), output unit; *chunk* as :func:`simulate_records` (the numbers do not depend on it)."""
+    streams = np.ascontiguousarray(streams, dtype=np.int64).ravel()
+    if amplitude == 0.0:  # at rest: the dynamics pass nothing
+        b, a, lead = np.ones(1), np.ones(1), 0
+    else:
+        b, a = discretise(settings.dynamics(), frequency, settings.sample_rate)
+        lead = run_in_samples(a)
+    rows = streams.size
     states = np.zeros((rows, len(a) - 1))
-    out = np.empty((rows, lead + N))
-    step = lead + N if chunk is None else int(chunk)
+    out = np.empty((rows, lead + samples))
+    step = lead + samples if chunk is None else int(chunk)
     if step < 1:
         raise ValueError(f"chunk: expected an integer >= 1, got {chunk!r}")
     white = np.empty(step + 1)
     key = root_key(seed)
-    for start in range(0, lead + N, step):
-        stop = min(start + step, lead + N)
-        sine_records(b, a, states, schedule.amplitude, 2.0 * math.pi * f, np.ascontiguousarray(phases).ravel(),
-                     schedule.interval, start - lead, settings.scale_factor, settings.bias, settings.noise_sigma,
-                     settings.quantisation, settings.gyro_range * settings.scale_factor, key, streams, WHITE_BLOCK,
-                     white, out[:, start:stop])
-    return out[:, lead:].reshape(trials.size, n, N)
+    R = settings.gyro_range
+    even, odd = settings.even_nonlinearity / R, settings.odd_nonlinearity / R**2
+    for start in range(0, lead + samples, step):
+        stop = min(start + step, lead + samples)
+        sine_records(b, a, states, amplitude, 2.0 * math.pi * frequency,
+                     np.ascontiguousarray(phases, dtype=float).ravel(), 1.0 / settings.sample_rate, start - lead,
+                     settings.scale_factor, settings.bias + bias_shift,
+                     settings.noise_sigma, settings.quantisation, R * settings.scale_factor, key, streams,
+                     WHITE_BLOCK, white, out[:, start:stop], even, odd)
+    return out[:, lead:]
 
 
 @dataclass(frozen=True)
@@ -286,6 +355,7 @@ class Jjf1537Result:
     bandwidths: np.ndarray
     gum: dict
     type_a: dict
+    vibration_shock: VibrationShockResult | None = None
 
     def summary(self) -> dict:
         """MC mean, standard deviation and bias against the analytic truth of the ratios, the phases (rad) and
@@ -352,6 +422,208 @@ def gum_uncertainties(settings: Jjf1537Experiment, response: np.ndarray, level: 
     return {"ratio": u_K, "phase": u_phase, "bandwidth": u_bw, "amplitude": u_E, "sigma": math.sqrt(sigma2)}
 
 
+#: the noise streams of the 7.2.4–7.2.7 records start here (the 7.2.1 records use 0 … trials·m·n − 1)
+ITEM_STREAMS = 2**40
+#: the records at rest of 7.2.6–7.2.7: before the vibration, after it, after the shock
+REST_RECORDS = ("before_vibration", "after_vibration", "after_shock")
+#: the figures of 7.2.4–7.2.7, in the report's order
+ITEMS = ("amplitude_nonlinearity", "vibration_output_change", "bias_change_vibration", "bias_change_shock")
+#: the coverage factor of the intervals whose coverage the Monte Carlo counts
+COVERAGE_FACTOR = 2.0
+
+
+def item_phases(seed: int, trial: int, count: int) -> np.ndarray:
+    """The table phases of trial *trial*'s 7.2.4 and 7.2.5 records, uniform on [−π, π), from
+    ``default_rng([seed, trial, 1])`` (a generator apart from :func:`table_phases`')."""
+    return np.random.default_rng([int(seed), int(trial), 1]).uniform(-math.pi, math.pi, count)
+
+
+def vibration_shock_truth(settings: Jjf1537Experiment) -> dict:
+    """The figures of 7.2.4–7.2.7 of the simulated sensor, in closed form (docs/dynamic.md).
+
+    With a = A|H(j2πf)| the rate amplitude after the dynamics, g's fundamental a + 3c₃'a³/4 and mean c₂'a²/2
+    (:func:`plansim.model.dynamics.static_nonlinearity_harmonics`, c₂' = c₂/R, c₃' = c₃/R²): the amplitude
+    nonlinearity is :func:`plansim.estimate.dynamic.amplitude_nonlinearity` of the exact fundamentals,
+
+        γ = (3/4)|c₃'| |H|² max_k |A_k² − ⟨A²⟩| / |1 + (3/4) c₃' |H|² ⟨A²⟩|,
+
+    the output change under vibration S c₂'a²/2 (output unit), the bias changes the two shifts.
+    """
+    sch = settings.vibration_shock_schedule()
+    gain = float(abs(settings.dynamics().response(sch.frequency)))
+    R = settings.gyro_range
+    c2, c3 = settings.even_nonlinearity / R, settings.odd_nonlinearity / R**2
+    _, fundamental = static_nonlinearity_harmonics(sch.amplitudes * gain, c2, c3)
+    mean, _ = static_nonlinearity_harmonics(sch.amplitude * gain, c2, c3)
+    exact = np.abs(settings.scale_factor * fundamental)  # the Ē_k without noise
+    return {"amplitude_nonlinearity": amplitude_nonlinearity(sch.amplitudes, exact),
+            "vibration_output_change": float(settings.scale_factor * mean),
+            "bias_change_vibration": settings.vibration_bias_shift, "bias_change_shock": settings.shock_bias_shift}
+
+
+def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
+    """The GUM (JCGM 100, first order) standard uncertainties of the 7.2.4–7.2.7 figures, by item.
+
+    The three changes of mean (output unit): σ√(1/N₁ + 1/N₂) with σ² = σ_w² + q²/12 (the white noise's and the
+    quantiser's), N the two records' samples; the vibration record's mean is its sine fit's C, var(C) = σ²/N
+    over whole cycles.
+
+    The amplitude nonlinearity γ = |S_k* − S̄|/S̄ (k* where |S_k − S̄| is largest), evaluated at the noise-free
+    S_k: with d_j = S_j − S̄ and s* the sign of d_k*,
+
+        ∂γ/∂S_j = s* [(δ_jk* − 1/M)/S̄ − d_k*/(M S̄²)],        u(S_j) = √(2σ²/(nN))/A_j
+
+    (var(E) = 2σ²/N per record, n records), summed in quadrature. nan when γ is not differentiable there: a
+    linear sensor (every d_j = 0) or two amplitudes tied for the maximum. It holds while the noise does not
+    move the maximum to another amplitude (the runner-up several u below).
+    """
+    sch = settings.vibration_shock_schedule()
+    sigma = math.sqrt(settings.noise_sigma**2 + settings.quantisation**2 / 12.0)
+    rest = sch.rest_samples()
+    gain = float(abs(settings.dynamics().response(sch.frequency)))
+    _, fundamental = static_nonlinearity_harmonics(sch.amplitudes * gain, 0.0,
+                                                   settings.odd_nonlinearity / settings.gyro_range**2)
+    S = np.abs(settings.scale_factor * fundamental) / sch.amplitudes
+    M, mean = S.size, S.mean()
+    d = S - mean
+    order = np.argsort(-np.abs(d))
+    u_nonlinearity = math.nan
+    scale = np.max(np.abs(S))
+    if abs(d[order[0]]) > 1e-9 * scale and abs(d[order[0]]) - abs(d[order[1]]) > 1e-9 * scale:
+        k = int(order[0])
+        grad = -np.full(M, 1.0 / M) / mean - d[k] / (M * mean**2)
+        grad[k] += 1.0 / mean
+        grad *= math.copysign(1.0, d[k])
+        u_S = math.sqrt(2.0 * sigma**2 / (sch.repeats * sch.samples(sch.record_time))) / sch.amplitudes
+        u_nonlinearity = float(np.sqrt(np.sum((grad * u_S) ** 2)))
+    return {"amplitude_nonlinearity": u_nonlinearity,
+            "vibration_output_change": sigma * math.sqrt(1.0 / sch.samples(sch.vibration_time) + 1.0 / rest),
+            "bias_change_vibration": sigma * math.sqrt(2.0 / rest), "bias_change_shock": sigma * math.sqrt(2.0 / rest)}
+
+
+def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chunk: int | None = None) -> dict:
+    """The 7.2.4–7.2.7 records of the trials *trials* (T,), output unit: ``linearity`` (T, M, n, N) at the M
+    amplitudes, ``vibration`` (T, N_v), and ``rest`` (T, 3, N_r) before the vibration, after it (the bias
+    shifted by ``vibration_bias_shift``) and after the shock (shifted by both). The shock itself is not
+    simulated: its effect is the step of the bias. Every record has its own noise stream above
+    :data:`ITEM_STREAMS`; *chunk* as :func:`simulate_records`."""
+    sch = settings.vibration_shock_schedule()
+    trials = np.asarray(trials, dtype=np.int64).ravel()
+    M, n = sch.amplitudes.size, sch.repeats
+    per_trial = M * n + 1 + len(REST_RECORDS)  # streams per trial
+    base = ITEM_STREAMS + trials * per_trial
+    phases = np.stack([item_phases(seed, t, M * n + 1) for t in trials])  # (T, M n + 1)
+    N = sch.samples(sch.record_time)
+    linearity = np.empty((trials.size, M, n, N))
+    for k, A in enumerate(sch.amplitudes):
+        streams = (base[:, None] + k * n + np.arange(n)[None, :]).ravel()
+        linearity[:, k] = table_records(settings, seed, sch.frequency, float(A), phases[:, k * n:(k + 1) * n],
+                                        N, streams, chunk).reshape(trials.size, n, N)
+    vibration = table_records(settings, seed, sch.frequency, sch.amplitude, phases[:, -1],
+                              sch.samples(sch.vibration_time), base + M * n, chunk)
+    shifts = (0.0, settings.vibration_bias_shift, settings.vibration_bias_shift + settings.shock_bias_shift)
+    rest = np.stack([table_records(settings, seed, sch.frequency, 0.0, np.zeros(trials.size), sch.rest_samples(),
+                                   base + M * n + 1 + r, chunk, bias_shift=shift) for r, shift in enumerate(shifts)],
+                    axis=1)
+    return {"linearity": linearity, "vibration": vibration, "rest": rest}
+
+
+def reduce_vibration_shock(settings: Jjf1537Experiment, records: dict) -> tuple[dict, dict]:
+    """One trial's 7.2.4–7.2.7 records (:func:`simulate_vibration_shock`, without the trial axis) reduced:
+    (estimates, Type A standard uncertainties) by the name of :data:`ITEMS`.
+
+    - 7.2.4: the sine fit of eq. (6) of every record, Ē_k over its n repeats (eq. (7)), and
+      :func:`plansim.estimate.dynamic.amplitude_nonlinearity` of (A_k, Ē_k); no Type A here (nan).
+    - 7.2.5: the mean output under vibration, the sine fit's C (the record less its fitted sinusoid), less the
+      mean at rest before it, by :func:`plansim.estimate.dynamic.mean_change`.
+    - 7.2.6, 7.2.7: :func:`mean_change` from before to after the vibration, and from after the vibration
+      to after the shock.
+    """
+    sch = settings.vibration_shock_schedule()
+    dt = 1.0 / sch.sample_rate
+    lin = records["linearity"]
+    fits = sine_fits(np.arange(lin.shape[-1]) * dt, lin, sch.frequency)
+    nonlinearity = amplitude_nonlinearity(sch.amplitudes, fits.amplitude.mean(axis=-1))
+    vib = records["vibration"]
+    t = np.arange(vib.size) * dt
+    fit = sine_fits(t, vib, sch.frequency)
+    level = vib - fit.amplitude * np.cos(2.0 * math.pi * sch.frequency * t + fit.phase)
+    rest = records["rest"]
+    output_change, u_output = mean_change(rest[0], level)
+    bias_vibration, u_vibration = mean_change(rest[0], rest[1])
+    bias_shock, u_shock = mean_change(rest[1], rest[2])
+    values = (nonlinearity, output_change, bias_vibration, bias_shock)
+    uncertainties = (math.nan, u_output, u_vibration, u_shock)
+    return ({k: float(v) for k, v in zip(ITEMS, values)}, {k: float(u) for k, u in zip(ITEMS, uncertainties)})
+
+
+@dataclass(frozen=True)
+class VibrationShockResult:
+    """The Monte Carlo of JJF 1537-2015 7.2.4–7.2.7 (output unit; the nonlinearity dimensionless).
+
+    ``truth``, ``gum``: by item (:data:`ITEMS`), :func:`vibration_shock_truth` and
+    :func:`vibration_shock_gum` (the nonlinearity's nan for a linear sensor: a maximum of absolute values);
+    ``estimates``, ``type_a``: (trials,) per item, the figure and its Type A u per trial.
+    """
+
+    schedule: VibrationShockSchedule
+    truth: dict
+    gum: dict
+    estimates: dict
+    type_a: dict
+
+    def summary(self) -> dict:
+        """Per item: MC ``mean``, ``std`` (ddof 1), ``bias`` against the truth, ``type_a_mean``, ``gum``, and
+        ``coverage``, the fraction of trials where |estimate − truth| ≤ 2 u_A (nan where there is no u_A)."""
+        out = {}
+        for name in ITEMS:
+            x, u = self.estimates[name], self.type_a[name]
+            covered = np.abs(x - self.truth[name]) <= COVERAGE_FACTOR * u
+            out[name] = {
+                "truth": float(self.truth[name]), "mean": float(x.mean()),
+                "std": float(x.std(ddof=1)) if x.size > 1 else math.nan, "bias": float(x.mean() - self.truth[name]),
+                "type_a_mean": float(u.mean()), "gum": float(self.gum.get(name, math.nan)),
+                "coverage": float(covered.mean()) if np.all(np.isfinite(u)) else math.nan,
+            }
+        return out
+
+
+def run_vibration_shock(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT_TRIALS,
+                        seed: int = DEFAULT_SEED, chunk_trials: int = 32) -> VibrationShockResult:
+    """The Monte Carlo of JJF 1537-2015 7.2.4–7.2.7 alone (:func:`run_jjf1537` runs it with 7.2.1–7.2.3):
+    *trials* trials simulated (:func:`simulate_vibration_shock`) and reduced (:func:`reduce_vibration_shock`).
+    The numbers depend on (settings, seed, trial) only, not on *chunk_trials*."""
+    settings = Jjf1537Experiment() if settings is None else settings
+    _check_run(seed, trials, chunk_trials)
+    estimates = {k: np.empty(trials) for k in ITEMS}
+    type_a = {k: np.empty(trials) for k in ITEMS}
+    for first in range(0, trials, chunk_trials):
+        _vibration_shock_block(settings, seed, np.arange(first, min(first + chunk_trials, trials)), estimates, type_a)
+    return _vibration_shock_result(settings, estimates, type_a)
+
+
+def _vibration_shock_block(settings, seed, block, estimates, type_a) -> None:
+    records = simulate_vibration_shock(settings, seed, block)
+    for c, trial in enumerate(block):
+        values, u = reduce_vibration_shock(settings, {k: v[c] for k, v in records.items()})
+        for name in ITEMS:
+            estimates[name][trial], type_a[name][trial] = values[name], u[name]
+
+
+def _vibration_shock_result(settings, estimates, type_a) -> VibrationShockResult:
+    return VibrationShockResult(schedule=settings.vibration_shock_schedule(), truth=vibration_shock_truth(settings),
+                                gum=vibration_shock_gum(settings), estimates=estimates, type_a=type_a)
+
+
+def _check_run(seed, trials, chunk_trials) -> None:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
+    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
+        raise ValueError(f"trials: expected an integer >= 1, got {trials!r}")
+    if isinstance(chunk_trials, bool) or not isinstance(chunk_trials, (int, np.integer)) or chunk_trials < 1:
+        raise ValueError(f"chunk_trials: expected an integer >= 1, got {chunk_trials!r}")
+
+
 def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT_TRIALS, seed: int = DEFAULT_SEED,
                 chunk_trials: int = 32, progress=None) -> Jjf1537Result:
     """Simulate *trials* runs of the test and reduce each as JJF 1537-2015 7.2.1 does (module docstring).
@@ -360,19 +632,18 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
     called as progress(done, total) in trials.
     """
     settings = Jjf1537Experiment() if settings is None else settings
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ValueError(f"trials: expected an integer >= 1, got {trials!r}")
-    if isinstance(chunk_trials, bool) or not isinstance(chunk_trials, (int, np.integer)) or chunk_trials < 1:
-        raise ValueError(f"chunk_trials: expected an integer >= 1, got {chunk_trials!r}")
+    _check_run(seed, trials, chunk_trials)
     schedule = settings.schedule()
     dynamics = settings.dynamics()
     freqs = schedule.frequencies
     m, n = freqs.size, schedule.repeats
     H = dynamics.response(freqs)
     truth_ratio, truth_phase = np.abs(H), np.angle(H)
-    noise_free = truth_ratio / truth_ratio[0]
+    # the fundamental the sine fit reads: |H| A, or g's (a + 3c₃'a³/4) with the amplitude nonlinearity on
+    _, fundamental = static_nonlinearity_harmonics(schedule.amplitude * truth_ratio,
+                                                   settings.even_nonlinearity / settings.gyro_range,
+                                                   settings.odd_nonlinearity / settings.gyro_range**2)
+    noise_free = np.abs(fundamental) / abs(fundamental[0])
     try:
         noise_free_bw = bandwidth_3db(freqs, noise_free)
     except ValueError:
@@ -384,6 +655,8 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
     ratio_u = np.empty((trials, m))
     phase_u = np.empty((trials, m))
     A = schedule.amplitude
+    item_estimates = {k: np.empty(trials) for k in ITEMS}
+    item_type_a = {k: np.empty(trials) for k in ITEMS}
     for first in range(0, trials, chunk_trials):
         block = np.arange(first, min(first + chunk_trials, trials))
         table = np.stack([table_phases(seed, t, (m, n)) for t in block])  # (c, m, n)
@@ -407,6 +680,7 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
                 bandwidths[trial] = bandwidth_3db(freqs, response.ratios)
             except ValueError:
                 pass
+        _vibration_shock_block(settings, seed, block, item_estimates, item_type_a)  # 7.2.4–7.2.7
         if progress is not None:
             progress(int(block[-1]) + 1, trials)
     return Jjf1537Result(
@@ -415,4 +689,5 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
         noise_free_bandwidth=noise_free_bw, ratios=ratios, phases=phases, bandwidths=bandwidths,
         gum=gum_uncertainties(settings, truth_ratio),
         type_a={"ratio": ratio_u.mean(axis=0), "phase": phase_u.mean(axis=0)},
+        vibration_shock=_vibration_shock_result(settings, item_estimates, item_type_a),
     )
