@@ -28,6 +28,11 @@ def test_a_small_null_run_and_its_report(tmp_path, capsys):
     assert data["null"]["recordings"] == 1 and data["null"]["false_alarms"] in (0, 1)
     assert data["effects"] == [] and data["out_of_catalogue"] == []
     assert "binomial_99_upper_count" in data["null"]
+    # which family fired: a recording that raised an alarm fired at least one, one that did not fired none
+    fired = data["null"]["by_family"]
+    assert set(fired) == {"selection", "lack_of_fit", "unexplained_segment_level", "within_segment"}
+    assert (sum(fired.values()) > 0) == (data["null"]["false_alarms"] > 0)
+    assert sum(data["null"]["falsely_selected"].values()) >= fired["selection"]
     assert check_json(run_diagnose_check.__globals__["CheckReport"]("x", 0.05))["null"] == {}
     assert main(["diagnose-check", "--sizes", "2,x", "--quiet"]) == 2
     assert "--sizes '2,x'" in capsys.readouterr().err

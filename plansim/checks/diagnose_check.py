@@ -109,6 +109,15 @@ def _alarm(d) -> bool:
     return bool(d.selected) or bool(d.lack_of_fit.flagged) or bool(d.unexplained["flagged"])
 
 
+def _families(d) -> dict[str, bool]:
+    """Which family of tests fired on a diagnosis (a recording can fire several): a selection, the base model's
+    segment-level lack of fit, the final model's, a within-segment finding — so that a false-alarm rate above α
+    says which share of α (plansim.diagnose.procedure.SELECTION_SHARE …) runs hot."""
+    return {"selection": bool(d.selected), "lack_of_fit": bool(d.lack_of_fit.flagged),
+            "unexplained_segment_level": bool(d.lack_of_fit_after.flagged),
+            "within_segment": bool(d.within.any_flagged)}
+
+
 def _without_quantiser(scenario):
     """The scenario with its acquisition's quantiser off (bits = 0): the same trial's samples before it (the
     quantiser draws no random numbers, so everything else is the same)."""
@@ -177,6 +186,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
 
     # the null
     alarms, selections, z_before = 0, 0, []
+    by_family = {"selection": 0, "lack_of_fit": 0, "unexplained_segment_level": 0, "within_segment": 0}
+    falsely_selected: dict[str, int] = {}
     reference = None
     for i in range(null):
         s = case_seed(seed, "null", i)
@@ -187,11 +198,16 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         sample_rate = recording.schedule.segments[0].sample_rate
         selections += bool(d.selected)
         alarms += _alarm(d)
+        for family, fired in _families(d).items():
+            by_family[family] += fired
+        for effect in d.selected:
+            falsely_selected[effect] = falsely_selected.get(effect, 0) + 1
         z_before.append(z["before"])
         tick()
     report.null = {"recordings": null, "false_alarms": alarms, "rate": alarms / null,
                    "selections": selections, "selection_rate": selections / null,
                    "binomial_99_upper_count": int(binom.ppf(0.99, null, alpha)),
+                   "by_family": by_family, "falsely_selected": falsely_selected,
                    "rms_z": float(np.mean([v[0] for v in z_before])),
                    "coverage_95": float(np.mean([v[1] for v in z_before]))}
     if reference is None or per_effect == 0:

@@ -45,6 +45,9 @@ def _cmd_diagnose_check(args) -> int:
         n = data["null"]
         print(f"null: {n['false_alarms']} false alarms in {n['recordings']} recordings ({n['rate']:.3f}; selections "
               f"{n['selection_rate']:.3f}; binomial 99 % bound at alpha: {n['binomial_99_upper_count']})")
+        fired = ", ".join(f"{k} {v}" for k, v in n["by_family"].items())
+        wrong = ", ".join(f"{k} {v}" for k, v in n["falsely_selected"].items()) or "none"
+        print(f"  by family (a recording may fire several): {fired}; selected: {wrong}")
         for e in data["effects"]:
             k = "" if e["times_noise_equivalent"] is None else f" x{e['times_noise_equivalent']:g}"
             print(f"{e['effect']}[{e['component']}]{k}: detection {e['detection']:.2f}, attribution "
