@@ -797,3 +797,35 @@ def test_a_given_noise_estimate_gives_the_same_fit_and_a_wrong_one_is_refused():
     shorter = dataclasses.replace(noise, within_std=noise.within_std[:-1])
     with pytest.raises(ValueError, match="noise: estimated over"):
         fit_recording(recording, site, scenario.turntable, noise=shorter)
+
+
+def test_a_channel_that_reads_one_code_in_every_pose_takes_the_stated_step_not_exact_means():
+    """jjf2003 (12-bit accelerometers, noise 0.05 of a step): in the null recording of seed 3077148103 all three
+    accelerometers read one code in each of their 18 poses, on three levels (−g, 0, +g): neither the samples nor the
+    levels show the step. Read as exact, their means gave K_a,zz u = 1.4e-10 against an error of 7e-4 (found by
+    plansim diagnose-check: one recording's r.m.s. z of 8e5). With the lab's stated acquisition (plansim fit
+    --scenario) the step is the stated one and the uncertainty covers the error; without it, the fit says that the
+    means weigh as exact."""
+    from plansim.fit import scenario_fit_options
+
+    scenario = load_scenario("jjf2003")
+    recording = simulate_and_record(scenario, seed=3077148103, trial=0)
+    _, _, truth = simulate_recording(scenario, 3077148103, 0)
+    site = resolve_site(scenario=scenario)
+    options = scenario_fit_options(scenario)
+    assert options["stated_step"][3] == pytest.approx(scenario.acquisition.accel_step)
+    fit = fit_recording(recording, site, **options)
+    k = PARAMETER_NAMES.index("Kazz")
+    assert fit.noise.channels[5].quantisation_step == pytest.approx(scenario.acquisition.accel_step)
+    assert fit.joint.u[k] > 1e-5
+    assert abs(fit.joint.estimate[k] - truth[k]) < 3 * fit.joint.u[k]
+    assert any("stated step" in note for note in fit.noise.notes)
+    # the 'ideal' scenario (no quantiser stated, no noise): its levels sit on a grid of g·1e-4, yet its means stay
+    # exact — a step is never read off the levels alone
+    ideal = load_scenario("ideal")
+    exact = fit_recording(simulate_and_record(ideal, seed=1, trial=0), resolve_site(scenario=ideal),
+                          **scenario_fit_options(ideal))
+    assert all(ch.quantisation_step == 0.0 for ch in exact.noise.channels)
+    bare = fit_recording(recording, site, **{k: v for k, v in options.items() if k != "stated_step"})
+    assert bare.noise.channels[5].quantisation_step == 0.0
+    assert any("weigh as exact" in note for note in bare.noise.notes)

@@ -201,13 +201,13 @@ def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed: int = 0,
              null_draws: int = NULL_DRAWS, lever_arm=None, reference_gravity=None, omega_squared_sign: str = "model",
-             turntable_source: str = "", stated_white=None) -> Diagnosis:
+             turntable_source: str = "", stated_white=None, stated_step=None) -> Diagnosis:
     """Diagnose a recording (module docstring).
 
     Parameters
     ----------
     recording : plansim.io.recording.Recording
-    site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source, stated_white
+    site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source, stated_white, stated_step
         As :func:`plansim.fit.fit_recording`.
     alpha : float
         False-alarm rate of the whole diagnosis (0 < alpha < 1): on a recording the base model describes, the
@@ -237,9 +237,9 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         raise ValueError(f"null_draws = {null_draws!r}: must be a whole number >= 19 (p resolves to 1/(B + 1))")
     options = dict(site=site, turntable=turntable, turntable_source=turntable_source,
                    reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm,
-                   stated_white=stated_white)
+                   stated_white=stated_white, stated_step=stated_step)
     # the samples' noise depends on the samples alone: estimated once, shared by every refit below
-    options["noise"] = recording_noise(recording, stated_white)
+    options["noise"] = recording_noise(recording, stated_white, stated_step)
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the
     # null hypothesis — the base model — as a score test estimates its nuisance parameters; every fit below then
     # takes it as given. Estimated with the candidates in the model instead, it came out too small wherever a

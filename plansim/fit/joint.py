@@ -534,13 +534,13 @@ def _noise_segments(schedule) -> list[int]:
     return [k for k, s in enumerate(schedule.segments) if s.test != "move"]
 
 
-def recording_noise(recording, stated_white=None) -> NoiseEstimate:
+def recording_noise(recording, stated_white=None, stated_step=None) -> NoiseEstimate:
     """The noise of a recording's samples (:func:`plansim.fit.noise.estimate_noise` over every segment that is
     not a move), which :func:`fit_recording` takes as its ``noise`` so that refits of the same samples share it."""
     schedule = recording.schedule
     segments = _noise_segments(schedule)
     return estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in segments],
-                          [schedule.segments[k] for k in segments], stated_white)
+                          [schedule.segments[k] for k in segments], stated_white, stated_step)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)
@@ -548,7 +548,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
                   between_noise: BetweenSegmentNoise | None = None, stated_white=None,
-                  noise: NoiseEstimate | None = None) -> FitResult:
+                  noise: NoiseEstimate | None = None, stated_step=None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -581,6 +581,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         The sensor's stated white-noise densities (rad/s/√Hz for gx gy gz, m/s²/√Hz for ax ay az; NaN where not
         stated), as a scenario's ``[mimu.noise]`` gives them: the prior of the noise before a quantiser the noise
         does not dither, which the data show only weakly (:func:`plansim.fit.noise.quantised_noise_posterior`).
+    stated_step : (6,) array_like, optional
+        The acquisition's stated quantisation steps, SI (a scenario's ``[acquisition]``,
+        :func:`plansim.fit.noise.stated_steps`): used only for a channel whose step the data cannot show
+        (:func:`plansim.fit.noise.estimate_noise`).
     noise : NoiseEstimate, optional
         The noise of the recording's samples, as :func:`recording_noise` returns it for this recording and
         *stated_white*: given, it is not estimated again (it depends on the samples alone, and ``plansim
@@ -649,7 +653,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
 
     # noise: every segment that is not a move (any pose at rest shows the sensors' noise)
     noise_segments = _noise_segments(schedule)
-    all_noise = recording_noise(recording, stated_white) if noise is None else noise
+    all_noise = recording_noise(recording, stated_white, stated_step) if noise is None else noise
     if all_noise.within_std.shape[0] != len(noise_segments):
         raise ValueError(f"noise: estimated over {all_noise.within_std.shape[0]} segments, but this recording has "
                          f"{len(noise_segments)} that are not moves; pass recording_noise(recording) of this "

@@ -221,6 +221,14 @@ def quantisation_step(segments: list[np.ndarray]) -> float:
     return 0.0
 
 
+def _on_grid(gaps: np.ndarray, q: float) -> bool:
+    """Every one of *gaps* a whole multiple of *q* (to :data:`QUANTISATION_MATCH` relative, at most
+    :data:`QUANTISATION_OFF_GRID` of a step)."""
+    ratio = np.abs(np.asarray(gaps, dtype=float)) / q
+    allowance = np.minimum(QUANTISATION_MATCH * np.maximum(ratio, 1.0), QUANTISATION_OFF_GRID)
+    return bool(np.all(np.abs(ratio - np.rint(ratio)) <= allowance))
+
+
 #: harmonics of the quantiser's Fourier series kept (the dropped tail of Σ 1/k² is < 1/QUANTISATION_HARMONICS)
 QUANTISATION_HARMONICS = 2000
 
@@ -579,6 +587,13 @@ def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tup
     return np.sqrt(np.sum(residual**2, axis=0) / dof), dof
 
 
+def stated_steps(scenario) -> np.ndarray:
+    """(6,) the quantisation step a scenario's ``[acquisition]`` states for gx gy gz ax ay az, SI (2·full
+    scale/2^bits; 0 where it quantises nothing)."""
+    a = scenario.acquisition
+    return np.array([a.gyro_step] * 3 + [a.accel_step] * 3, dtype=float)
+
+
 def stated_white_noise(scenario) -> np.ndarray:
     """(6,) the white-noise densities a scenario states for gx gy gz ax ay az (its ``[mimu.noise]`` angle and
     velocity random walks: rad/s/√Hz, m/s²/√Hz), NaN where it states none (0): :func:`estimate_noise`'s
@@ -589,7 +604,7 @@ def stated_white_noise(scenario) -> np.ndarray:
     return np.where(stated > 0, stated, np.nan)
 
 
-def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=None) -> NoiseEstimate:
+def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=None, stated_step=None) -> NoiseEstimate:
     """The noise of each channel and the variance of each segment mean, from the samples alone.
 
     Parameters
@@ -602,11 +617,22 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
         The white-noise density each channel is stated to have (a data sheet's angle and velocity random walk:
         rad/s/√Hz, m/s²/√Hz; NaN where not stated). Used only where the data cannot show it: as the prior of
         the noise before a quantiser the noise does not dither (:func:`quantised_noise_posterior`).
+    stated_step : (6,) array_like, optional
+        The acquisition's stated quantisation step of each channel, SI (a lab's ADC: 2·full scale/2^bits; 0 or NaN
+        where not stated). Used only for a channel that does not vary within any static segment and whose step
+        no sibling channel shows, when its levels are whole multiples of it apart: read as exact
+        there, its segment means would make every parameter that depends on it look exact (jjf2003's 12-bit
+        accelerometers, σ 0.05 of a step: in one null recording of about 140, all three read one code in each of
+        their 18 poses, on three levels only, and K_a,zz came out with u = 1.4e-10 against an error of 7e-4).
 
     Returns
     -------
     NoiseEstimate
     """
+    stated_q = np.zeros(6) if stated_step is None else np.nan_to_num(np.asarray(stated_step, dtype=float), nan=0.0)
+    if stated_q.shape != (6,) or np.any(stated_q < 0):
+        raise ValueError(f"stated_step: expected 6 steps >= 0 (gx gy gz ax ay az, SI; 0 or NaN: not stated), got "
+                         f"{stated_step!r}")
     S = len(segments)
     if S != len(segment_samples):
         raise ValueError(f"segment_samples: {len(segment_samples)} segments, segments: {S}")
@@ -622,10 +648,11 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
     everything = np.concatenate(segment_samples, axis=0)
     rms = np.sqrt(np.mean(everything**2, axis=0))
     steps = [quantisation_step([segment_samples[k][:, c] for k in static]) for c in range(6)]
+    found = list(steps)  # the steps the data show within segments
     for c in range(6):  # a channel constant within every segment may share its sibling channels' quantiser
         if steps[c] == 0.0 and static and all(np.ptp(segment_samples[k][:, c]) == 0 for k in static):
             kind = range(0, 3) if c < 3 else range(3, 6)
-            for q in sorted({steps[j] for j in kind if steps[j] > 0}):
+            for q in sorted({found[j] for j in kind if found[j] > 0}):
                 levels = np.array([segment_samples[k][0, c] for k in static]) / q
                 if np.all(np.abs(levels - np.rint(levels)) <= QUANTISATION_MATCH * np.maximum(np.abs(levels), 1.0)):
                     steps[c] = q
@@ -634,8 +661,20 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                                  "by the same acquisition")
                     break
             else:
-                notes.append(f"{CHANNELS[c]} does not vary within any static segment: no noise (or noise far below "
-                             "its quantisation step, which it does not show); its segment means weigh as exact")
+                # the levels alone cannot tell a step: noise-free levels of a unit with round parameters sit on a
+                # grid too (the 'ideal' scenario's accelerometers: multiples of g·1e-4 to 1e-6 of their gaps)
+                levels = np.array([segment_samples[k][0, c] for k in static])
+                if stated_q[c] > 0 and _on_grid(levels - levels[0], stated_q[c]):
+                    steps[c] = stated_q[c]
+                    notes.append(f"{CHANNELS[c]} does not vary within any static segment, and its levels are whole "
+                                 f"multiples of the acquisition's stated step {stated_q[c]:.6g} apart: taken as "
+                                 "quantised with it, its noise far below it (each segment mean off by up to half a "
+                                 "step)")
+                else:
+                    notes.append(f"{CHANNELS[c]} does not vary within any static segment: no noise (or noise far "
+                                 "below a quantisation step it does not show); its segment means weigh as exact — "
+                                 "if the unit is quantised, state its acquisition (plansim fit --scenario), or "
+                                 "every parameter that depends on this channel looks exact")
     channels = []
     for c, name in enumerate(CHANNELS):
         step = steps[c]

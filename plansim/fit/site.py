@@ -183,12 +183,14 @@ def scenario_fit_options(scenario) -> dict:
       input, not absorbed by P;
     - ``stated_white``: the sensor's stated white noise (``[mimu.noise]``,
       :func:`plansim.fit.noise.stated_white_noise`), where any is stated — the prior of the noise an undithered
-      quantiser hides.
+      quantiser hides;
+    - ``stated_step``: the acquisition's quantisation steps (``[acquisition]``, :func:`plansim.fit.noise.stated_steps`)
+      where it quantises — for a channel that reads one code in every pose, whose step the data cannot show.
 
     *scenario* None gives no options (JJF 2003 Table 1 and the recording's attributes).
     """
     from plansim.config import Scenario
-    from plansim.fit.noise import stated_white_noise
+    from plansim.fit.noise import stated_steps, stated_white_noise
 
     if scenario is None:
         return {}
@@ -202,4 +204,7 @@ def scenario_fit_options(scenario) -> dict:
     stated = stated_white_noise(scenario)
     if np.any(np.isfinite(stated)):
         options["stated_white"] = stated
+    steps = stated_steps(scenario)
+    if np.any(steps > 0):
+        options["stated_step"] = steps
     return options
