@@ -51,7 +51,6 @@ is carried from chunk to chunk: the numbers do not depend on the chunking, in ti
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -79,7 +78,8 @@ from plansim.schedule.jjf1537 import (
     jjf1537_frequencies,
     linearity_amplitudes,
 )
-from plansim.units import DEG, parse_quantity
+from plansim.simulate.overrides import apply_overrides
+from plansim.units import DEG
 
 #: white numbers per block of a record's noise (fixed: the numbers never depend on the chunking)
 WHITE_BLOCK = 4096
@@ -221,35 +221,9 @@ class Jjf1537Experiment:
 
 
 def with_overrides(settings: Jjf1537Experiment, overrides) -> Jjf1537Experiment:
-    """*settings* with ``KEY=VALUE`` strings applied (quantities as '<number> <unit>', :mod:`plansim.units`);
-    an error names the key, the value and what is allowed."""
-    changes = {}
-    for item in overrides:
-        key, sep, text = str(item).partition("=")
-        key, text = key.strip(), text.strip().strip("'\"")
-        if not sep or key not in FIELDS:
-            raise ValueError(f"--set {item!r}: expected KEY=VALUE with KEY one of {', '.join(FIELDS)}")
-        kind = FIELDS[key][0]
-        if kind == "choice":
-            changes[key] = text
-        elif kind == "count":
-            try:
-                changes[key] = int(text)
-            except ValueError:
-                raise ValueError(f"--set {item!r}: {key} expects an integer") from None
-        else:
-            try:
-                changes[key] = parse_quantity(text if kind != "dimensionless" else _number_or_text(text), kind, key)
-            except ValueError as exc:
-                raise ValueError(f"--set {item!r}: {exc}") from None
-    return dataclasses.replace(settings, **changes, overrides=tuple(settings.overrides) + tuple(overrides))
-
-
-def _number_or_text(text: str):
-    try:
-        return float(text)
-    except ValueError:
-        return text
+    """*settings* with ``KEY=VALUE`` strings applied (quantities as '<number> <unit>', :mod:`plansim.units`;
+    :func:`plansim.simulate.overrides.apply_overrides`); an error names the key, the value and what is allowed."""
+    return apply_overrides(settings, overrides, {key: spec[0] for key, spec in FIELDS.items()})
 
 
 def discretise(dynamics: SensorDynamics, frequency: float, sample_rate: float) -> tuple[np.ndarray, np.ndarray]:

@@ -24,7 +24,6 @@ the dynamic model whose g² and g³ coefficients are fitted by least squares fro
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -55,7 +54,8 @@ from plansim.model.vibration import (
     shaped_samples,
     shaping_filter,
 )
-from plansim.units import DEG, HOUR, MICRO_G, STANDARD_GRAVITY, parse_quantity
+from plansim.simulate.overrides import apply_overrides
+from plansim.units import DEG, HOUR, MICRO_G, STANDARD_GRAVITY
 
 #: the streams of a record (:func:`plansim.model.vibration.shaped_samples`)
 STREAM_VIBRATION, STREAM_GYRO_NOISE, STREAM_ACCEL_NOISE, STREAM_CALIBRATION = 0, 3, 6, 9
@@ -211,27 +211,11 @@ class VibrationExperiment:
 
 def with_overrides(settings: VibrationExperiment, overrides) -> VibrationExperiment:
     """*settings* with ``KEY=VALUE`` strings applied: quantities as '<number> <unit>' (:mod:`plansim.units`),
-    counts as integers, ``profile`` and ``vibration_axes`` as words; an error names the key and what is allowed."""
-    changes = {}
-    for item in overrides:
-        key, sep, text = str(item).partition("=")
-        key, text = key.strip(), text.strip().strip("'\"")
-        if not sep or key not in FIELDS:
-            raise ValueError(f"--set {item!r}: expected KEY=VALUE with KEY one of {', '.join(FIELDS)}")
-        kind = FIELDS[key][0]
-        if kind in ("choice", "axes"):
-            changes[key] = text
-        elif kind == "count":
-            try:
-                changes[key] = int(text)
-            except ValueError:
-                raise ValueError(f"--set {item!r}: {key} expects an integer >= {FIELDS[key][1]}") from None
-        else:
-            try:  # a bare number is a dimensionless quantity with the unit ''
-                changes[key] = parse_quantity(text, kind, key)
-            except ValueError as exc:
-                raise ValueError(f"--set {item!r}: {exc}") from None
-    return dataclasses.replace(settings, **changes, overrides=tuple(settings.overrides) + tuple(overrides))
+    counts as integers, ``profile`` and ``vibration_axes`` as words
+    (:func:`plansim.simulate.overrides.apply_overrides`); an error names the key and what is allowed."""
+    return apply_overrides(settings, overrides, {key: spec[0] for key, spec in FIELDS.items()},
+                           words=("choice", "axes"),
+                           count_minimum={key: spec[1] for key, spec in FIELDS.items() if spec[0] == "count"})
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,63 @@
+"""``--set KEY=VALUE`` on a built-in experiment's settings (``plansim run jjf1537``, ``plansim run vibration_g2``).
+
+One parser for both: a key must be one of the experiment's fields; a quantity is read as '<number> <unit>'
+(:func:`plansim.units.parse_quantity`, a bare number for a dimensionless one); a count as a whole number; a word
+field as it is written (the settings' own checks then judge it). An error names the item, the key and what is
+allowed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from plansim.units import parse_quantity
+
+
+def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), count_minimum: dict | None = None):
+    """*settings* (a frozen dataclass with an ``overrides`` tuple) with ``KEY=VALUE`` strings applied.
+
+    Parameters
+    ----------
+    settings : dataclass
+        The experiment's settings.
+    overrides : iterable of str
+        ``KEY=VALUE`` items, as ``--set`` gives them.
+    kinds : dict
+        field -> unit kind (:data:`plansim.units.KINDS`), ``"count"``, or one of *words*.
+    words : tuple of str
+        The kinds taken as written (a choice of names, a set of axes).
+    count_minimum : dict, optional
+        field -> the smallest count allowed, for the error message.
+
+    Returns
+    -------
+    The settings with the changes and the items appended to ``overrides``.
+
+    Raises
+    ------
+    ValueError
+        An item that is not KEY=VALUE with a known key, a count that is not a whole number, or a quantity
+        :func:`plansim.units.parse_quantity` refuses.
+    """
+    changes = {}
+    for item in overrides:
+        key, sep, text = str(item).partition("=")
+        key, text = key.strip(), text.strip().strip("'\"")
+        if not sep or key not in kinds:
+            raise ValueError(f"--set {item!r}: expected KEY=VALUE with KEY one of {', '.join(kinds)}")
+        kind = kinds[key]
+        if kind in words:
+            changes[key] = text
+        elif kind == "count":
+            try:
+                changes[key] = int(text)
+            except ValueError:
+                least = (count_minimum or {}).get(key)
+                raise ValueError(f"--set {item!r}: {key} expects an integer"
+                                 + ("" if least is None else f" >= {least}")) from None
+        else:
+            try:  # a bare number is a dimensionless quantity with the unit ''
+                changes[key] = parse_quantity(text, kind, key)
+            except ValueError as exc:
+                raise ValueError(f"--set {item!r}: {exc}") from None
+    return dataclasses.replace(settings, **changes, overrides=tuple(settings.overrides) + tuple(overrides))
