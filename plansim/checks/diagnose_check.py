@@ -105,8 +105,8 @@ class CheckReport:
 
 def _alarm(d) -> bool:
     """The diagnosis says something is there: an effect selected, the base model's lack of fit, or anything
-    unexplained after the refit (segment level or within segments)."""
-    return bool(d.selected) or bool(d.lack_of_fit.flagged) or bool(d.unexplained["flagged"])
+    unexplained after the refit (segment level or within segments): any of :func:`_families`."""
+    return any(_families(d).values())
 
 
 def _families(d) -> dict[str, bool]:

@@ -249,7 +249,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     options["between_noise"] = before.between_noise
     # within segments: the shapes the means cannot show, against the recording's own noise (SELECTION_SHARE …: the
     # three families share α, so that the diagnosis as a whole reports anything on a null recording at rate ≤ α)
-    a_select, a_segment, a_within = alpha * SELECTION_SHARE, alpha * SEGMENT_LEVEL_SHARE, alpha * WITHIN_SHARE
+    level = levels(alpha)
+    a_select, a_segment, a_within = level["selections"], level["lack_of_fit"], level["within_segment"]
     segments = recording.schedule.segments
     within = within_segment_tests([recording.segment_samples(k) for k in range(len(segments))], segments,
                                   before.noise, alpha=a_within, seed=seed)

@@ -401,9 +401,9 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
     """
     from plansim.fit.joint import BETWEEN_CORRELATION_TIMES, time_correlation
 
-    WS = g.project(g.W @ columns)
-    norms = np.linalg.norm(WS, axis=0)
-    keep = norms > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(g.W @ columns, axis=0), 1e-300)
+    whitened = g.W @ columns
+    WS = g.project(whitened)
+    keep = np.linalg.norm(WS, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
     if not np.any(keep):
         return None
     WS, where = WS[:, keep], [w for w, k in zip(where, keep) if k]

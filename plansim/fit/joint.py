@@ -586,9 +586,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         :func:`plansim.fit.noise.stated_steps`): used only for a channel whose step the data cannot show
         (:func:`plansim.fit.noise.estimate_noise`).
     noise : NoiseEstimate, optional
-        The noise of the recording's samples, as :func:`recording_noise` returns it for this recording and
-        *stated_white*: given, it is not estimated again (it depends on the samples alone, and ``plansim
-        diagnose`` refits the same recording several times).
+        The noise of the recording's samples, as :func:`recording_noise` returns it for this recording,
+        *stated_white* and *stated_step*: given, it is not estimated again (it depends on the samples alone,
+        and ``plansim diagnose`` refits the same recording several times).
 
     Returns
     -------

@@ -211,20 +211,16 @@ def quantisation_step(segments: list[np.ndarray]) -> float:
     q = float(gaps.min())
     if q <= 0:
         return 0.0
-    ratio = gaps / q
-    # a gap may miss a whole multiple by rounding (relative QUANTISATION_MATCH), never by a sizeable part of the
-    # step: without that bound, a q far below the data's resolution (two continuous values 1e-19 apart) passes,
-    # because every ratio is then huge and so is its allowance
-    allowance = np.minimum(QUANTISATION_MATCH * np.maximum(ratio, 1.0), QUANTISATION_OFF_GRID)
-    if np.all(np.abs(ratio - np.rint(ratio)) <= allowance):
-        return q
-    return 0.0
+    return q if _on_grid(gaps, q) else 0.0
 
 
 def _on_grid(gaps: np.ndarray, q: float) -> bool:
     """Every one of *gaps* a whole multiple of *q* (to :data:`QUANTISATION_MATCH` relative, at most
     :data:`QUANTISATION_OFF_GRID` of a step)."""
     ratio = np.abs(np.asarray(gaps, dtype=float)) / q
+    # a gap may miss a whole multiple by rounding (relative QUANTISATION_MATCH), never by a sizeable part of the
+    # step: without that bound, a q far below the data's resolution (two continuous values 1e-19 apart) passes,
+    # because every ratio is then huge and so is its allowance
     allowance = np.minimum(QUANTISATION_MATCH * np.maximum(ratio, 1.0), QUANTISATION_OFF_GRID)
     return bool(np.all(np.abs(ratio - np.rint(ratio)) <= allowance))
 
@@ -652,9 +648,10 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
     for c in range(6):  # a channel constant within every segment may share its sibling channels' quantiser
         if steps[c] == 0.0 and static and all(np.ptp(segment_samples[k][:, c]) == 0 for k in static):
             kind = range(0, 3) if c < 3 else range(3, 6)
+            levels = np.array([segment_samples[k][0, c] for k in static])  # the one value of each static segment
             for q in sorted({found[j] for j in kind if found[j] > 0}):
-                levels = np.array([segment_samples[k][0, c] for k in static]) / q
-                if np.all(np.abs(levels - np.rint(levels)) <= QUANTISATION_MATCH * np.maximum(np.abs(levels), 1.0)):
+                codes = levels / q
+                if np.all(np.abs(codes - np.rint(codes)) <= QUANTISATION_MATCH * np.maximum(np.abs(codes), 1.0)):
                     steps[c] = q
                     notes.append(f"{CHANNELS[c]} does not vary within any static segment; its levels are whole "
                                  f"multiples of the step {q:.6g} found on its sibling channels: taken as quantised "
@@ -663,7 +660,6 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
             else:
                 # the levels alone cannot tell a step: noise-free levels of a unit with round parameters sit on a
                 # grid too (the 'ideal' scenario's accelerometers: multiples of g·1e-4 to 1e-6 of their gaps)
-                levels = np.array([segment_samples[k][0, c] for k in static])
                 if stated_q[c] > 0 and _on_grid(levels - levels[0], stated_q[c]):
                     steps[c] = stated_q[c]
                     notes.append(f"{CHANNELS[c]} does not vary within any static segment, and its levels are whole "
