@@ -87,3 +87,32 @@ def add_set_option(p) -> None:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario field, e.g. --set schedule.dwell=\"60 s\" --set schedule.positions=6 "
                         "(dotted key as in the scenario file; repeatable; checked as the file is)")
+
+
+def run_experiment(args, run, figure, as_json, as_text) -> int:
+    """The tail of ``plansim run`` for a built-in experiment (``jjf1537``, ``vibration_g2``), once its options are
+    checked: *run* () → result, timed; ``--plot`` written by *figure* (result, path, format) and committed with the
+    run or not at all (:class:`plansim.io.files.OutputSet`); then *as_json* (result, elapsed, version) printed as
+    JSON with ``--json``, else *as_text* (result, elapsed) and the figure's name."""
+    import json
+    import time
+
+    from plansim.io.files import OutputSet
+    from plansim.io.recording import plansim_version
+    from plansim.report.plot import FIGURE_SUFFIXES
+
+    with OutputSet() as outputs:
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        start = time.perf_counter()
+        result = run()
+        elapsed = time.perf_counter() - start
+        if plot is not None:
+            figure(result, plot, format=args.plot.rsplit(".", 1)[-1])
+        outputs.commit()
+    if args.json:
+        print(json.dumps(as_json(result, elapsed, plansim_version()), indent=2))
+    else:
+        print(as_text(result, elapsed))
+        if args.plot:
+            print(f"\nwrote figure: {args.plot}")
+    return 0

@@ -9,9 +9,6 @@ Like ``vibration_g2`` it is built in, not a scenario file: its settings are
 
 from __future__ import annotations
 
-import json
-import time
-
 #: the built-in dynamic tests (``plansim run NAME``), with a description
 DYNAMIC_TESTS = {
     "jjf1537": "JJF 1537-2015 7.2.1 on an angular vibration table: sine fits at >= 7 frequencies x 7 repeats, "
@@ -23,8 +20,8 @@ DYNAMIC_TESTS = {
 
 def run_jjf1537_command(args, default_chunk_size: int) -> int:
     """``plansim run jjf1537``: every check first, then the Monte Carlo and the report."""
-    from plansim.io.files import OutputSet, check_output_path
-    from plansim.io.recording import plansim_version
+    from plansim.cli.common import run_experiment
+    from plansim.io.files import check_output_path
     from plansim.report.jjf1537 import bode_figure, jjf1537_json, jjf1537_text
     from plansim.report.plot import FIGURE_SUFFIXES
     from plansim.report.progress import stderr_progress
@@ -50,19 +47,6 @@ def run_jjf1537_command(args, default_chunk_size: int) -> int:
     settings = with_overrides(Jjf1537Experiment(), args.set)
     seed = DEFAULT_SEED if args.seed is None else args.seed
 
-    with OutputSet() as outputs:
-        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
-        progress = None if args.quiet else stderr_progress("plansim run jjf1537")
-        start = time.perf_counter()
-        result = run_jjf1537(settings, trials=trials, seed=seed, progress=progress)
-        elapsed = time.perf_counter() - start
-        if plot is not None:
-            bode_figure(result, plot, format=args.plot.rsplit(".", 1)[-1])
-        outputs.commit()
-    if args.json:
-        print(json.dumps(jjf1537_json(result, elapsed, plansim_version()), indent=2))
-    else:
-        print(jjf1537_text(result, elapsed))
-        if args.plot:
-            print(f"\nwrote figure: {args.plot}")
-    return 0
+    progress = None if args.quiet else stderr_progress("plansim run jjf1537")
+    return run_experiment(args, lambda: run_jjf1537(settings, trials=trials, seed=seed, progress=progress),
+                          bode_figure, jjf1537_json, jjf1537_text)

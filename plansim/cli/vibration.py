@@ -7,9 +7,6 @@ Like ``jjf1535`` it is built in, not a scenario file: its settings are
 
 from __future__ import annotations
 
-import json
-import time
-
 #: the built-in experiments (``plansim run NAME``), with a description
 EXPERIMENTS = {
     "vibration_g2": "the vibration paper's experiment: 100 s still, 300 s random vibration (0.04 g^2/Hz, "
@@ -21,8 +18,8 @@ DEFAULT_SEED = 20200612
 
 def run_vibration(args, default_chunk_size: int) -> int:
     """``plansim run vibration_g2``: every check first, then the record, the reduction and the report."""
-    from plansim.io.files import OutputSet, check_output_path
-    from plansim.io.recording import plansim_version
+    from plansim.cli.common import run_experiment
+    from plansim.io.files import check_output_path
     from plansim.report.plot import FIGURE_SUFFIXES
     from plansim.report.vibration import vibration_figure, vibration_json, vibration_text
     from plansim.simulate.vibration import VibrationExperiment, run_vibration_experiment, with_overrides
@@ -44,18 +41,5 @@ def run_vibration(args, default_chunk_size: int) -> int:
     settings = with_overrides(VibrationExperiment(), args.set)
     seed = DEFAULT_SEED if args.seed is None else args.seed
 
-    with OutputSet() as outputs:
-        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
-        start = time.perf_counter()
-        result = run_vibration_experiment(settings, seed=seed)
-        elapsed = time.perf_counter() - start
-        if plot is not None:
-            vibration_figure(result, plot, format=args.plot.rsplit(".", 1)[-1])
-        outputs.commit()
-    if args.json:
-        print(json.dumps(vibration_json(result, elapsed, plansim_version()), indent=2))
-    else:
-        print(vibration_text(result, elapsed))
-        if args.plot:
-            print(f"\nwrote figure: {args.plot}")
-    return 0
+    return run_experiment(args, lambda: run_vibration_experiment(settings, seed=seed), vibration_figure,
+                          vibration_json, vibration_text)
