@@ -178,10 +178,14 @@ def test_bias_repeatability_is_eq_20_of_the_turn_on_draws(ideal_document):
 
 def test_effects_off_the_earlier_items_bit_for_bit():
     """No JJF 1535 effect set: the procedure's new segments come after all the others, so the earlier items'
-    random draws, and their values, are those of commit f784c7a (:data:`BEFORE`)."""
+    random draws, and their values, are those of commit f784c7a (:data:`BEFORE`).
+
+    Equal to 1e-9 relative, not bit for bit: a fresh install's numpy/scipy/BLAS build may sum the least squares
+    in another order (seen: the asymmetry differed by 6e-13 relative on a new machine), while another draw would
+    move every item by the noise, ~1e-3 relative or more."""
     result = jjf1535_run("jjf2003", trials=2, seed=20151)
     for item, values in BEFORE.items():
-        assert tuple(result.column(item).tolist()) == values, item
+        assert result.column(item).tolist() == pytest.approx(list(values), rel=1e-9, abs=1e-300), item
 
 
 def test_the_monte_carlo_adds_the_effects_and_reports_them(ideal_document):
