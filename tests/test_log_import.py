@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from plansim.cli import main
-from plansim.io.log_import import import_log, parse_scale, parse_units
+from plansim.io.log_import import MAX_PREAMBLE_LINES, import_log, parse_offset, parse_scale, parse_units
 from plansim.io.recording import nominal_time, read_recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.runner import simulate_and_record
@@ -366,6 +366,51 @@ def test_unit_and_scale_parsing():
     assert parse_scale("16.4,2048") == (16.4,) * 3 + (2048.0,) * 3
     with pytest.raises(ValueError, match="'x' for channel gx is not a number"):
         parse_scale("x,1")
+
+
+def test_a_logger_preamble_before_the_header_is_skipped_and_reported(tmp_path, capsys):
+    """A logger that writes its own settings before the header (as an MPU-6050 sketch writes "Fs,100"): the header
+    is the first line naming every column; the lines before it are skipped, kept in the segment table's notes and
+    printed — never read as samples. Samples and segments are those of the same log without the preamble."""
+    t, x = synthetic_log()
+    plain, with_preamble = tmp_path / "plain.csv", tmp_path / "log.csv"
+    write_synthetic(plain, None, x)
+    with_preamble.write_text("Fs,100\nLogging Type,0\nWaiting time,3\n" + plain.read_text())
+    a = import_log(plain, sample_rate=100.0)
+    b = import_log(with_preamble, sample_rate=100.0)
+    np.testing.assert_array_equal(a.recording.samples, b.recording.samples)
+    assert a.recording.schedule.segments == b.recording.schedule.segments
+    assert b.table.preamble == ("Fs,100", "Logging Type,0", "Waiting time,3") and b.table.header_line == 4
+    assert b.table.lines[0] == 5 and b.recording.schedule.notes["import"]["preamble"][0] == "Fs,100"
+    assert main(["import", str(with_preamble), "--out", str(tmp_path / "rec.nc"), "--sample-rate", "100"]) == 0
+    assert "before the header (line 4): 3 line(s) skipped, not read as data: Fs,100; Logging" in capsys.readouterr().out
+    # a header that names no column asked for within MAX_PREAMBLE_LINES lines is refused against the first line
+    far = tmp_path / "far.csv"
+    far.write_text("".join(f"setting {k},{k}\n" for k in range(MAX_PREAMBLE_LINES + 1)) + plain.read_text())
+    with pytest.raises(ValueError, match=r"column 'gx' is missing; the header \(line 1\) has setting 0, 0"):
+        import_log(far, sample_rate=100.0)
+
+
+def test_an_offset_in_counts_is_subtracted_before_the_scale(tmp_path, capsys):
+    """Raw counts of an unsigned converter (zero input reads 32768): --offset 32768 then --scale gives the same
+    samples as the signed counts; without --scale the offset is refused, naming the option."""
+    t, x = synthetic_log()
+    counts = np.round(x / np.r_[[math.radians(1.0) / 16.4] * 3, [9.80665 / 2048.0] * 3])
+    write_synthetic(tmp_path / "signed.csv", t, counts)
+    write_synthetic(tmp_path / "unsigned.csv", t, counts + 32768.0)
+    signed = import_log(tmp_path / "signed.csv", time_column="time", units="deg/s,g", scale="16.4,2048")
+    unsigned = import_log(tmp_path / "unsigned.csv", time_column="time", units="deg/s,g", scale="16.4,2048",
+                          offset="32768,32768")
+    np.testing.assert_allclose(unsigned.recording.samples, signed.recording.samples, rtol=0, atol=1e-12)
+    assert unsigned.recording.schedule.notes["import"]["zero_offset_counts"]["az"] == 32768.0
+    assert parse_offset("1,2,3,-4,5,6") == (1.0, 2.0, 3.0, -4.0, 5.0, 6.0) and parse_offset(None) is None
+    with pytest.raises(ValueError, match="--offset '32768,x': 'x' for channel ax is not a number"):
+        parse_offset("32768,x")
+    with pytest.raises(ValueError, match="--offset '32768,32768' needs --scale"):
+        import_log(tmp_path / "unsigned.csv", time_column="time", units="deg/s,g", offset="32768,32768")
+    # read as signed counts, the unsigned log is 16 g at rest: refused by the 1 g check, naming the scale
+    with pytest.raises(ValueError, match="at rest the accelerometers read"):
+        import_log(tmp_path / "unsigned.csv", time_column="time", units="deg/s,g", scale="16.4,2048")
 
 
 def test_simulated_recording_times_are_the_nominal_ones():

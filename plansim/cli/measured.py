@@ -23,7 +23,7 @@ def _cmd_import(args) -> int:
     columns = None if args.columns is None else tuple(name.strip() for name in args.columns.split(","))
     options = {name: getattr(args, name) for name in ("window", "min_static") if getattr(args, name) is not None}
     result = import_log(args.log, columns=columns, time_column=args.time, time_unit=args.time_unit,
-                        units=args.units, scale=args.scale, sample_rate=args.sample_rate,
+                        units=args.units, scale=args.scale, offset=args.offset, sample_rate=args.sample_rate,
                         temperature_column=args.temperature_column, temperature=args.temperature,
                         latitude=args.latitude, height=args.height, **options)
     write_recording(result.recording, args.out)  # whole or not at all
@@ -38,7 +38,8 @@ def _add_import_command(sub) -> None:
         description="Read a plain CSV log (six channels; a time column or a sample rate) and write a recording "
                     "whose segment table (static poses, rotations, moves) is found from the data, for you to "
                     "review (docs/measured-data.md)")
-    p.add_argument("log", help="the CSV log: a header line of column names, one row per sample")
+    p.add_argument("log", help="the CSV log: a header line of column names (lines of a logger's own before it are "
+                               "skipped and reported), one row per sample")
     p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
     p.add_argument("--time", default=None, metavar="COL", help="the time column (default: none; give --sample-rate)")
     p.add_argument("--time-unit", default="s", choices=("s", "ms", "us", "ns", "samples"),
@@ -51,6 +52,9 @@ def _add_import_command(sub) -> None:
                         "--scale, the unit the counts are per; default rad/s,m/s^2")
     p.add_argument("--scale", default=None,
                    help="counts per unit, gyro,accelerometer or one per channel (e.g. 16.4,2048 with --units deg/s,g)")
+    p.add_argument("--offset", default=None,
+                   help="counts at zero input, gyro,accelerometer or one per channel, subtracted before --scale "
+                        "divides (e.g. 32768,32768 for an unsigned 16-bit converter)")
     p.add_argument("--sample-rate", type=float, default=None, metavar="HZ",
                    help="sample rate; required without --time (default: from the time column)")
     p.add_argument("--temperature-column", default=None, metavar="COL", help="a temperature column in degC")

@@ -51,6 +51,9 @@ GRAVITY_TOLERANCE = 0.3
 JITTER_WARNING = 0.1
 #: a given sample rate that differs from the time column's by more than this fraction is a warning
 RATE_MISMATCH_WARNING = 0.01
+#: lines a logger may write before the header (its own metadata, such as "Fs,100"): the header is the first line
+#: that names every column asked for, searched this far; those before it are skipped and reported
+MAX_PREAMBLE_LINES = 50
 #: rows converted to numbers at a time while reading
 _BLOCK_ROWS = 65536
 #: the temperature assumed for each segment when the log has no temperature channel, degC
@@ -87,6 +90,10 @@ class LogTable:
     ignored: tuple[str, ...]
     first_line: int
     lines: np.ndarray = field(repr=False, default=None)  # the file line of every sample
+    #: lines before the header that are not comments and not the header: a logger's own metadata
+    #: ("Fs,100"), skipped and reported, never read as numbers (:data:`MAX_PREAMBLE_LINES` at most)
+    preamble: tuple[str, ...] = ()
+    header_line: int = 1  # the file line of the header (1-based)
 
 
 @dataclass(frozen=True)
@@ -100,6 +107,7 @@ class ImportResult:
     units: tuple[str, ...]
     scale: tuple[float, ...] | None
     warnings: tuple[LogWarning, ...]
+    offset: tuple[float, ...] | None = None  # counts at zero input (--offset), or None
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -133,23 +141,33 @@ def parse_units(text: str | None) -> tuple[str, ...]:
 
 def parse_scale(text: str | None) -> tuple[float, ...] | None:
     """Counts per unit from ``--scale``: two entries (gyros, accelerometers) or six; ``None``: not counts."""
+    return _per_channel(text, "--scale", "counts per gyro unit, counts per accelerometer unit", positive=True)
+
+
+def parse_offset(text: str | None) -> tuple[float, ...] | None:
+    """The counts read at zero input from ``--offset`` (an unsigned converter's mid-scale, e.g. 32768): two
+    entries (gyros, accelerometers) or six; ``None``: 0. Subtracted before ``--scale`` divides."""
+    return _per_channel(text, "--offset", "counts at zero input of the gyros, of the accelerometers", positive=False)
+
+
+def _per_channel(text: str | None, option: str, pair: str, positive: bool) -> tuple[float, ...] | None:
+    """Two entries (gyros, accelerometers) or six numbers of *option*; ``None`` when not given."""
     if text is None:
         return None
-    items = _split_list(text, "--scale")
+    items = _split_list(text, option)
     if len(items) == 2:
         items = [items[0]] * 3 + [items[1]] * 3
     if len(items) != 6:
-        raise ValueError(f"--scale {text!r}: {len(items)} entries; expected 2 (counts per gyro unit, counts per "
-                         "accelerometer unit) or 6 (one per channel)")
+        raise ValueError(f"{option} {text!r}: {len(items)} entries; expected 2 ({pair}) or 6 (one per channel)")
     values = []
     for k, item in enumerate(items):
         try:
             value = float(item)
         except ValueError:
-            raise ValueError(f"--scale {text!r}: {item!r} for channel {CHANNELS[k]} is not a number") from None
-        if not (value > 0 and math.isfinite(value)):
-            raise ValueError(f"--scale {text!r}: {item!r} for channel {CHANNELS[k]}; expected a positive number of "
-                             "counts per unit")
+            raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]} is not a number") from None
+        if not math.isfinite(value) or (positive and not value > 0):
+            allowed = "a positive number of counts per unit" if positive else "a finite number of counts"
+            raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]}; expected {allowed}")
         values.append(value)
     return tuple(values)
 
@@ -192,16 +210,32 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     with _text_file(target, where) as fh:
         header_line = 0
         header = None
+        first = None  # the first line that is not a comment: the header, unless a preamble precedes it
+        preamble: list[str] = []
         for line in fh:
             header_line += 1
             stripped = line.strip()
-            if stripped and not stripped.startswith("#"):
+            if not stripped or stripped.startswith("#"):
+                continue
+            if first is None:
+                first = (header_line, line)
+            if set(wanted) <= set(_names(line)):
                 header = line
                 break
+            preamble.append(stripped)
+            if len(preamble) > MAX_PREAMBLE_LINES:
+                break
+        if header is None and first is not None:
+            header_line, header = first  # no line names every column: report against the first one
+            preamble = []
         if header is None:
             raise ValueError(f"{where}: no header line; expected a line of column names, then one row per sample")
-        delimiter = max(DELIMITERS, key=lambda d: len(next(csv.reader([header], delimiter=d))))
-        header_names = [name.strip() for name in next(csv.reader([header], delimiter=delimiter))]
+        if preamble:  # lines were read past the header; read again from just after it
+            fh.seek(0)
+            for _ in range(header_line):
+                fh.readline()
+        delimiter = _delimiter(header)
+        header_names = _names(header)
         duplicates = sorted({name for name in header_names if header_names.count(name) > 1})
         if duplicates:
             raise ValueError(f"{where}: column {duplicates[0]!r} appears more than once in the header "
@@ -258,7 +292,17 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     time = data[:, 6] if time_column is not None else None
     temperature = data[:, -1] if temperature_column is not None else None
     return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
-                    lines[0], np.array(lines, dtype=np.int64))
+                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line)
+
+
+def _delimiter(line: str) -> str:
+    """The delimiter of a header line: the one of :data:`DELIMITERS` that splits it into the most fields."""
+    return max(DELIMITERS, key=lambda d: len(next(csv.reader([line], delimiter=d))))
+
+
+def _names(line: str) -> list[str]:
+    """The stripped fields of one line, split at its own delimiter."""
+    return [name.strip() for name in next(csv.reader([line], delimiter=_delimiter(line)))]
 
 
 def _is_number(text: str) -> bool:
@@ -271,7 +315,7 @@ def _is_number(text: str) -> bool:
 
 def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = None, time_column: str | None = None,
                time_unit: str = "s", units: str | None = None, scale: str | None = None,
-               sample_rate: float | None = None, temperature_column: str | None = None,
+               offset: str | None = None, sample_rate: float | None = None, temperature_column: str | None = None,
                temperature: float | None = None, latitude: float | None = None, height: float | None = None,
                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC) -> ImportResult:
     """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
@@ -291,6 +335,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         ``--units``: the channels' units (or, with ``scale``, the unit the counts are per); default SI.
     scale : str or None
         ``--scale``: counts per unit, two or six entries; ``None``: the channels are in ``units``.
+    offset : str or None
+        ``--offset``: the counts read at zero input, two or six entries (needs ``scale``); the channels are
+        ``(counts − offset) / scale``. ``None``: 0.
     sample_rate : float or None
         Hz. Without a time column, required; with one, the nominal rate (default: estimated from it).
     temperature_column : str or None
@@ -315,6 +362,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if counts_per_unit is not None and units is None:
         raise ValueError(f"--scale {scale!r} needs --units: say which unit the counts are per (e.g. --units "
                          "deg/s,g)")
+    zero_counts = parse_offset(offset)
+    if zero_counts is not None and counts_per_unit is None:
+        raise ValueError(f"--offset {offset!r} needs --scale (and --units): the offset is in counts")
     if time_unit not in TIME_UNITS:
         raise ValueError(f"--time-unit {time_unit!r}; allowed: {', '.join(TIME_UNITS)}")
     if sample_rate is not None and not (sample_rate > 0 and math.isfinite(sample_rate)):
@@ -346,7 +396,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     n = table.channels.shape[0]
     factors = np.array([KINDS["angular_rate" if k < 3 else "acceleration"][u] for k, u in enumerate(unit_names)])
     divisors = np.ones(6) if counts_per_unit is None else np.array(counts_per_unit)
-    samples = table.channels / divisors * factors
+    offsets = np.zeros(6) if zero_counts is None else np.array(zero_counts)
+    samples = (table.channels - offsets) / divisors * factors
 
     warnings: list[LogWarning] = []
     time_s = None
@@ -396,7 +447,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                          f"accelerometer columns, units or scale right? (read as {unit_text})")
     for s in segmentation.saturation:
         first, last = table.lines[s.start], table.lines[s.stop - 1]
-        shown = s.value / factors[s.channel] * divisors[s.channel]
+        shown = s.value / factors[s.channel] * divisors[s.channel] + offsets[s.channel]  # as the file has it
         warnings.append(LogWarning("saturated", f"channel {CHANNELS[s.channel]} ({table.names[s.channel]}) stuck at "
                                                 f"{shown:.6g} (its extreme) on lines {first}-{last}: a rail? A turn "
                                                 "over it has no angle"))
@@ -428,6 +479,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "ignored_columns": list(table.ignored),
         "units": dict(zip(CHANNELS, unit_names)),
         "counts_per_unit": None if counts_per_unit is None else dict(zip(CHANNELS, counts_per_unit)),
+        "zero_offset_counts": None if zero_counts is None else dict(zip(CHANNELS, zero_counts)),
+        "preamble": list(table.preamble),
         "time_column": table.time_column,
         "time_unit": time_unit if table.time_column is not None else None,
         "detector": {
@@ -473,7 +526,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         recording = Recording(samples, schedule, attrs, timestamps=timestamps, temperature=table.temperature)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: {exc}") from None
-    return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings))
+    return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings),
+                        zero_counts)
 
 
 def _segment(span: Span, number: int, sample_rate: float, temperature: float) -> Segment:
@@ -516,8 +570,14 @@ def format_summary(result: ImportResult) -> str:
     unit_text = ", ".join(dict.fromkeys(result.units))
     if result.scale is not None:
         unit_text = "counts: " + ", ".join(f"{c:g}/{u}" for c, u in zip(result.scale, result.units))
+        if result.offset is not None:
+            unit_text += " after subtracting " + ", ".join(f"{c:g}" for c in result.offset) + " counts (--offset)"
     lines.append("  channels: " + " ".join(f"{c}={n}" for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
                  + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
+    if table.preamble:
+        shown = "; ".join(table.preamble[:4]) + ("; …" if len(table.preamble) > 4 else "")
+        lines.append(f"  before the header (line {table.header_line}): {len(table.preamble)} line(s) skipped, not "
+                     f"read as data: {shown}")
     if table.time is None:
         lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (given; no time column: gaps and jitter cannot be "
                      "seen)")
