@@ -142,3 +142,65 @@ def test_no_rest_at_all_is_too_few_static_samples():
         segment_log(x, None, FS)
     with pytest.raises(ValueError, match="too few samples: the log has 50"):
         segment_log(x[:50], None, FS)
+
+
+# ----------------------------------------------------------------------------- poses of a hand-held session
+
+def _hand(seed: int, **options):
+    """A simulated hand session (plansim.simulate.hand_session): 12 poses over the sphere, consumer MEMS noise."""
+    from plansim.fit.model import nominal_parameters
+    from plansim.model.parameters import PARAMETER_INDEX
+    from plansim.simulate.hand_session import hand_session, spread_poses
+
+    theta = nominal_parameters().copy()
+    for name, value in options.pop("set", {}).items():
+        theta[PARAMETER_INDEX[name]] = value
+    return hand_session(theta, spread_poses(12, seed=seed), seed=seed, gyro_noise=8.7e-4, accel_noise=9.8e-3,
+                        **options)
+
+
+def test_rests_in_different_poses_may_differ_by_the_gyros_g_sensitivity():
+    """A consumer gyro's g-sensitivity (here 0.15 deg/s/g on each gyro along x, the MPU-6050 data sheet allows 0.1)
+    moves its output at rest from pose to pose by more than the rest threshold (6 window-mean sigmas, ~0.05 deg/s):
+    every pose is still found, none taken for a turn (step 6 allows for it where no rest shares the pose)."""
+    g_sens = math.radians(0.15) / 9.80665
+    s = _hand(3, set={"gxx": g_sens, "gyx": g_sens, "gzx": g_sens})
+    result = segment_log(s.samples, s.time, 100.0)
+    assert len(result.of_kind("static")) == 12 and not result.steady_turns
+
+
+def test_poses_held_by_a_shaking_hand_are_found_and_flagged():
+    """The first pose rests on the bench; in the other eleven a tremor of 0.03 deg at 6 Hz (1.1 deg/s of rate, 20
+    times the gyro noise; 5 mg of tilt, half the accelerometer noise) shakes the gyros out of the rest test while
+    the accelerometers stay quiet. Every pose is found, the shaking ones by step 6b, each with how hard its gyros
+    shook against the bench's; the same poses without the tremor are plain rests. (In a log where every pose
+    shakes, the quietest stretch is itself a shaking one: the poses are still found, measured against it.)"""
+    amplitudes = np.r_[0.0, np.full(11, math.radians(0.03))]
+    shaking = segment_log(*(lambda s: (s.samples, s.time))(_hand(4, tremor=(amplitudes, 6.0))), 100.0)
+    still = segment_log(*(lambda s: (s.samples, s.time))(_hand(4)), 100.0)
+    assert len(shaking.of_kind("static")) == len(still.of_kind("static")) == 12
+    assert not math.isfinite(shaking.of_kind("static")[0].held)
+    assert all(math.isfinite(span.held) and span.held > 3 for span in shaking.of_kind("static")[1:])
+    assert all(not math.isfinite(span.held) for span in still.of_kind("static"))
+
+
+def test_a_pose_that_drifts_or_a_slow_turn_is_not_a_held_pose():
+    """Held-pose detection must not take motion for a pose: the unit tilting by 1.5 deg over a 'pose' (the
+    accelerometers see it), or turning about the vertical at 1 deg/s with the hand shaking (only the gyros see it)."""
+    s = _hand(5, tremor=(np.r_[0.0, np.full(11, math.radians(0.03))], 6.0))
+    x = s.samples.copy()
+    first = np.cumsum([0] + [seg.samples for seg in s.schedule.segments])
+    # pose 3 (segment 4): a slow turn about its vertical at 1 deg/s, on the gyros
+    a, b = first[4], first[5]
+    up = x[a:b, 3:].mean(axis=0)
+    x[a:b, :3] += math.radians(1.0) * up / np.linalg.norm(up)
+    # pose 5 (segment 8): the specific force turning by 1.5 deg across it
+    a, b = first[8], first[9]
+    f = x[a:b, 3:].mean(axis=0)
+    turn = np.cross(f, [1.0, 0.0, 0.0])
+    turn *= math.radians(1.5) / np.linalg.norm(turn)
+    ramp = np.linspace(-0.5, 0.5, b - a)[:, None]
+    x[a:b, 3:] += ramp * np.cross(turn, f)[None, :]
+    spans = segment_log(x, s.time, 100.0).of_kind("static")
+    starts = {span.start for span in spans}
+    assert len(spans) == 10 and first[4] not in starts and first[8] not in starts

@@ -32,12 +32,22 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    (0.5°) of gravity on each axis (a unit tumbling smoothly can be as quiet as its own quietest stretch,
    but its gravity turns).
 6. **At rest or turning steadily?** The run that holds ``Q`` is at rest. Working outwards from it, each
-   other run is at rest unless its mean gyro output differs from that of the nearest run at rest by more
-   than ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to ±Ω_E on
-   any axis, depending on its pose; comparing neighbours, a slow drift of the bias over a long log is not
-   a turn); otherwise it is a *steady turn* (a rate table holding a rate), and belongs to the motion
-   around it. A turn slower than that threshold cannot be told from rest by any detector without a
-   reference; the threshold is reported.
+   other run is compared with the nearest run at rest *in the same pose* (specific force within
+   ``SAME_POSE``): it is at rest unless its mean gyro output differs from that run's by more than
+   ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to ±Ω_E on any
+   axis, depending on its pose; comparing neighbours, a slow drift of the bias over a long log is not a
+   turn); otherwise it is a *steady turn* (a rate table holding a rate), and belongs to the motion around
+   it. Where no rest shares its pose, the gyros' g-sensitivity alone moves their output from pose to pose
+   (up to 0.1 °/s/g for a consumer unit; ``G_SENSITIVITY_ALLOWANCE`` allows twice that): the run is then a
+   steady turn only when its output differs from the nearest rest's *along its own gravity* (a table with
+   gravity steady turns about the vertical) by more than the threshold there plus that allowance times the
+   change of specific force. A turn slower than the threshold cannot be told from rest by any detector
+   without a reference; the threshold is reported.
+6b. **Poses held by hand.** Outside those runs, stretches of at least ``min_static`` where the
+   accelerometers pass step 5 and hold one pose while the gyros do not (a hand's tremor: 1 °/s at 5 Hz tilts
+   the unit by 0.03°) are poses too, when the attitude the gyros integrate about their mean swings by at
+   most ±``POSE_TOLERANCE`` and their mean passes step 6. They are joined to a rest in the same pose at
+   most a window away, and marked with how hard the gyros shook (``Span.held``).
 7. **Poses.** Each static span's up axis is the body axis nearest its mean specific force; the tilt is
    the angle between the two. The heading cannot be told without a heading reference: it is not
    reported.
@@ -90,6 +100,12 @@ MIN_WINDOW_SAMPLES = 10
 POSE_TOLERANCE = math.radians(0.5)
 #: the quietest stretch holds at least this many windows
 QUIET_WINDOWS = 8
+#: two runs are in the same pose when their mean specific forces are within this angle (step 6)
+SAME_POSE = math.radians(2.0)
+#: the g-sensitivity a MEMS gyro's rests in different poses are allowed, rad/s per m/s²: 0.2 °/s/g, twice a consumer
+#: unit's data-sheet figure (InvenSense MPU-6050, "linear acceleration sensitivity" 0.1 °/s/g); rests in different
+#: poses may differ by it times the change of specific force (step 6)
+G_SENSITIVITY_ALLOWANCE = math.radians(0.2) / 9.80665
 #: a rotation's integral lies along one body axis: the other two components at most this fraction of it
 OFF_AXIS_FRACTION = 0.1
 #: a rotation's integral is within this of its nominal angle: ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION × nominal
@@ -235,6 +251,8 @@ class Span:
     orientation: str = "unknown"
     steady_rate: float = math.nan
     reason: str = ""
+    #: static and held by hand (step 6b): the gyros' largest scatter over their quiet stretch's; NaN otherwise
+    held: float = math.nan
 
     @property
     def samples(self) -> int:
@@ -459,6 +477,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     # slow drift of the bias over a long log is not a turn)
     rate_threshold = RATE_FACTOR * window_sigma + 2.0 * EARTH_RATE
     medians = [clipped[a:b, :3].mean(axis=0) for a, b in runs]
+    forces = [x[a:b, 3:].mean(axis=0) for a, b in runs]
     at_rest = [False] * len(runs)
     if runs:
         first = min(range(len(runs)), key=lambda i: 0 if runs[i][0] <= start < runs[i][1]
@@ -467,13 +486,20 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         holds_quiet = runs[first][0] <= start and start + quiet_length <= runs[first][1]
         at_rest[first] = holds_quiet or bool(np.all(np.abs(medians[first] - bias) <= rate_threshold))
         for order in (range(first + 1, len(runs)), range(first - 1, -1, -1)):
-            reference = medians[first] if at_rest[first] else bias
+            rests = [first] if at_rest[first] else []
             for i in order:
-                at_rest[i] = bool(np.all(np.abs(medians[i] - reference) <= rate_threshold))
+                at_rest[i] = _at_rest(i, rests, medians, forces, bias, rate_threshold)
                 if at_rest[i]:
-                    reference = medians[i]
+                    rests.insert(0, i)  # nearest first
     static_runs = [run for run, rest in zip(runs, at_rest) if rest]
     steady = [run for run, rest in zip(runs, at_rest) if not rest]
+    # 6b. poses held by hand: the accelerometers quiet and one pose, the gyros shaking about a steady mean
+    held = _held_runs(x, times, thresholds[0], near_gap, n_min, w, accel_window, static_runs, steady,
+                      [medians[i] for i, rest in enumerate(at_rest) if rest],
+                      [forces[i] for i, rest in enumerate(at_rest) if rest], rate_threshold, bias)
+    if held:
+        static_runs = _merge_same_pose(sorted(static_runs + held), x, w)
+        held = [run for run in static_runs if any(run[0] <= a and b <= run[1] for a, b in held)]
     if not static_runs:
         longest = max((b - a for a, b in _runs(quiet_mask)), default=0)
         raise ValueError(f"too few static samples: no span at rest of at least {min_static:g} s ({n_min} samples) "
@@ -487,8 +513,10 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     for a, b in static_runs:
         m = x[a:b].mean(axis=0)
         up, tilt = nearest_axis(m[3:])
+        shake = float(np.max(np.std(x[a:b, :3], axis=0) / sigma[:3])) if (a, b) in held else math.nan
+        # a pose joined from pieces holds the samples between them too (at most a window of them)
         statics.append(Span("static", a, b, m, up=up, tilt=tilt,
-                            orientation="approximate" if tilt <= APPROXIMATE_TILT else "unknown"))
+                            orientation="approximate" if tilt <= APPROXIMATE_TILT else "unknown", held=shake))
     saturation = _saturation(x, statics, steady, sigma, step)
     spans: list[Span] = []
     previous = None
@@ -502,6 +530,85 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         previous = span
     return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
                         tuple(steady))
+
+
+def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray,
+             rate_threshold: np.ndarray) -> bool:
+    """Step 6 for run *i*, given the runs found at rest so far (*rests*, nearest first).
+
+    Against the nearest rest in the same pose (specific force within :data:`SAME_POSE` of run i's): at rest
+    when the mean gyro outputs agree within *rate_threshold* on every axis, as a bias that drifts slowly
+    would. Where no rest shares the pose, the gyro outputs of two rests also differ by the gyros'
+    g-sensitivity times the change of specific force, which for consumer MEMS exceeds the threshold (0.1
+    °/s/g between two flips is 0.2 °/s); and a rate table holding a rate with gravity steady turns about the
+    vertical. So the run is a steady turn only when its gyro output differs from the nearest rest's *along
+    its own gravity direction* by more than the threshold there plus :data:`G_SENSITIVITY_ALLOWANCE` times
+    the change of specific force."""
+    if not rests:
+        return bool(np.all(np.abs(medians[i] - bias) <= rate_threshold))
+    up = forces[i] / max(np.linalg.norm(forces[i]), 1e-300)
+    for j in rests:
+        other = forces[j] / max(np.linalg.norm(forces[j]), 1e-300)
+        if float(np.dot(up, other)) >= math.cos(SAME_POSE):
+            return bool(np.all(np.abs(medians[i] - medians[j]) <= rate_threshold))
+    j = rests[0]
+    along = abs(float(np.dot(medians[i] - medians[j], up)))
+    allowed = float(np.linalg.norm(rate_threshold * up)) + G_SENSITIVITY_ALLOWANCE * float(
+        np.linalg.norm(forces[i] - forces[j]))
+    return along <= allowed
+
+
+def _merge_same_pose(runs: list[tuple[int, int]], x: np.ndarray, w: int) -> list[tuple[int, int]]:
+    """Join runs at rest that are at most a window apart and in the same pose (specific force within
+    :data:`SAME_POSE`): a hand that shakes only now and then splits one pose into quiet and held pieces."""
+    out = [runs[0]]
+    for a, b in runs[1:]:
+        c, d = out[-1]
+        f, g = x[c:d, 3:].mean(axis=0), x[a:b, 3:].mean(axis=0)
+        if a - d <= w and float(np.dot(f, g)) >= math.cos(SAME_POSE) * float(np.linalg.norm(f) * np.linalg.norm(g)):
+            out[-1] = (c, b)
+        else:
+            out.append((a, b))
+    return out
+
+
+def _held_runs(x, times, accel_test, near_gap, n_min, w, accel_window, static_runs, steady, rest_medians,
+               rest_forces, rate_threshold, bias) -> list[tuple[int, int]]:
+    """Step 6b: stretches, outside the runs of steps 5-6, where the accelerometers are quiet (their test of step
+    5) for at least ``min_static`` and hold one pose, while the gyros scatter more than at rest: a unit held by
+    hand, whose tremor the gyros see and the accelerometers hardly do (a tremor of 1 °/s at 5 Hz tilts the unit
+    by 0.03°). Such a stretch is a pose when the attitude the gyros integrate about their mean rate swings by
+    no more than ±``POSE_TOLERANCE`` (no turn started and stopped inside it) and, as in step 6, its mean gyro
+    output is that of a rest (:func:`_at_rest`: along its own gravity, against the nearest rest)."""
+    ratio, threshold = accel_test
+    taken = np.zeros(x.shape[0], dtype=bool)
+    for a, b in static_runs + steady:
+        taken[a:b] = True
+    candidates = [(a, b) for a, b in _runs((ratio <= threshold) & ~near_gap & ~taken) if b - a >= n_min]
+    medians, forces, where = list(rest_medians), list(rest_forces), [0.5 * (a + b) for a, b in static_runs]
+    out = []
+    for a, b in candidates:
+        first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
+        allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
+        if not np.all(np.abs(last - first) <= allowed):
+            continue
+        gyro = x[a:b, :3]
+        centre = gyro.mean(axis=0)
+        # the attitude about its steady drift: the shaking may swing it by no more than ±POSE_TOLERANCE
+        swing = np.cumsum(gyro - centre, axis=0) * float(np.median(np.diff(times[a:b]))) if b - a > 1 else gyro * 0
+        if np.any(np.ptp(swing, axis=0) > 2.0 * POSE_TOLERANCE):
+            continue
+        medians.append(centre)
+        forces.append(x[a:b, 3:].mean(axis=0))
+        i = len(medians) - 1
+        nearest = sorted(range(i), key=lambda j: abs(where[j] - 0.5 * (a + b)))
+        if _at_rest(i, nearest, medians, forces, bias, rate_threshold):
+            out.append((a, b))
+            where.append(0.5 * (a + b))
+        else:
+            medians.pop()
+            forces.pop()
+    return out
 
 
 def _one_sided_reference(x: np.ndarray, w: int) -> np.ndarray:
@@ -532,8 +639,7 @@ def _sigma(variance: np.ndarray, w: int, floor: np.ndarray) -> np.ndarray:
 def _saturation(x: np.ndarray, statics: list[Span], steady: list[tuple[int, int]], sigma: np.ndarray,
                 step: np.ndarray) -> list[Saturation]:
     """Stretches stuck at a rail: see step 10 of the module docstring."""
-    n = x.shape[0]
-    at_rest = np.zeros(n, dtype=bool)
+    at_rest = np.zeros(x.shape[0], dtype=bool)
     for span in statics:
         at_rest[span.start:span.stop] = True
     found = []
@@ -544,14 +650,26 @@ def _saturation(x: np.ndarray, statics: list[Span], steady: list[tuple[int, int]
         for value in (x[:, c].max(), x[:, c].min()):
             if np.any(np.abs(levels - value) <= margin):
                 continue
-            for a, b in _runs(x[:, c] == value):
-                if b - a < 2 or at_rest[a:b].any():
-                    continue
-                entry = abs(x[a - 1, c] - value) if a > 0 else 0.0
-                leave = abs(x[b, c] - value) if b < n else 0.0
-                if max(entry, leave) > SATURATION_STEP * sigma[c]:
+            for a, b in stuck_runs(x[:, c], value, SATURATION_STEP * sigma[c]):
+                if not at_rest[a:b].any():
                     found.append(Saturation(c, a, b, float(value)))
     return sorted(found, key=lambda s: (s.start, s.channel))
+
+
+def stuck_runs(values: np.ndarray, value: float, jump: float) -> list[tuple[int, int]]:
+    """Runs ``[a, b)`` of two or more samples of *values* equal to *value* (a channel's extreme) that are entered
+    or left by a step of more than *jump*: a signal stuck at a rail. A smooth peak of a quantised channel
+    also repeats its extreme, but enters and leaves it by one step (step 10 of the module docstring)."""
+    n = values.shape[0]
+    out = []
+    for a, b in _runs(values == value):
+        if b - a < 2:
+            continue
+        entry = abs(values[a - 1] - value) if a > 0 else 0.0
+        leave = abs(values[b] - value) if b < n else 0.0
+        if max(entry, leave) > jump:
+            out.append((a, b))
+    return out
 
 
 def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,

@@ -60,7 +60,7 @@ _BLOCK_ROWS = 65536
 DEFAULT_TEMPERATURE = 20.0
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
-                 "unclosed_motion")
+                 "unclosed_motion", "held_pose")
 
 
 @dataclass(frozen=True)
@@ -457,6 +457,12 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                       f"{table.lines[span.stop - 1]} is tilted "
                                                       f"{math.degrees(span.tilt):.1f} deg from {span.up}: orientation "
                                                       "'unknown'"))
+    held = [span for span in statics if math.isfinite(span.held)]
+    if held:
+        warnings.append(LogWarning("held_pose", f"{len(held)} static pose(s) held by hand: the accelerometers are "
+                                                "quiet and hold one pose while the gyros shake (up to "
+                                                f"{max(span.held for span in held):.3g} times their quiet noise); the "
+                                                "fit gives such a pose's means their own scatter"))
     for span in segmentation.spans:
         if span.kind == "move" and span.reason.startswith("no static span"):
             warnings.append(LogWarning("unclosed_motion", f"lines {table.lines[span.start]}-"
@@ -533,8 +539,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
 def _segment(span: Span, number: int, sample_rate: float, temperature: float) -> Segment:
     common = dict(dwell=span.samples / sample_rate, settle=0.0, sample_rate=sample_rate, temperature=temperature)
     if span.kind == "static":
-        return Segment(f"static {number}: {span.up} up, tilt {math.degrees(span.tilt):.1f} deg", "static", 0, span.up,
-                       heading=math.nan, orientation=span.orientation, **common)
+        held = f", held (gyros shaking {span.held:.3g}x their quiet noise)" if math.isfinite(span.held) else ""
+        return Segment(f"static {number}: {span.up} up, tilt {math.degrees(span.tilt):.1f} deg{held}", "static", 0,
+                       span.up, heading=math.nan, orientation=span.orientation, **common)
     measured = math.degrees(float(span.integrated[span.axis])) if span.axis >= 0 else math.nan
     if span.kind == "rotation":
         steady = (f", steady at {math.degrees(span.steady_rate):.4g} deg/s" if math.isfinite(span.steady_rate)
