@@ -600,6 +600,36 @@ def stated_white_noise(scenario) -> np.ndarray:
     return np.where(stated > 0, stated, np.nan)
 
 
+#: a static segment whose scatter exceeds the others' at this upper-tail probability (F test, forward search) is
+#: "noisier than the others": a pose held by hand, a knock; its mean takes its own scatter (:func:`estimate_noise`)
+NOISIER_PROBABILITY = 1e-3
+
+
+def _noisier_segments(within: np.ndarray, within_dof: np.ndarray, static: list[int], step: float) -> list[int]:
+    """The static segments whose per-sample scatter exceeds that of the channel's quiet ones: a forward search
+    (Atkinson and Riani, *Robust Diagnostic Regression Analysis*, 2000). Ordered by scatter, the segments join a
+    pool one by one from the quietest; each must pass the F test against the pool so far (s²/s²_pool at most the
+    1 − :data:`NOISIER_PROBABILITY` quantile of F(ν, ν_pool), ν = samples − 1); the first that fails, and every
+    noisier one after it, are flagged. A pool grown from the quietest end is not inflated by the shaking
+    segments it is to find, however many of them there are (a hand may hold all but one pose).
+    Not for a channel quantised to about its noise (scatter < 2 steps): there the scatter says where a level sits
+    in its step, not how noisy the segment is."""
+    from scipy.stats import f as f_distribution
+
+    usable = [k for k in static if within_dof[k] >= 2 and not (step > 0 and within[k] < 2.0 * step)]
+    if len(usable) < 3:
+        return []
+    order = sorted(usable, key=lambda k: within[k])
+    pool_ss, pool_dof = within[order[0]] ** 2 * within_dof[order[0]], within_dof[order[0]]
+    for n, k in enumerate(order[1:], start=1):
+        ratio = 0.0 if within[k] == 0 else (within[k] ** 2 / (pool_ss / pool_dof) if pool_ss > 0 else math.inf)
+        if ratio > f_distribution.ppf(1.0 - NOISIER_PROBABILITY, within_dof[k], pool_dof):
+            return sorted(order[n:])
+        pool_ss += within[k] ** 2 * within_dof[k]
+        pool_dof += within_dof[k]
+    return []
+
+
 def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=None, stated_step=None) -> NoiseEstimate:
     """The noise of each channel and the variance of each segment mean, from the samples alone.
 
@@ -672,18 +702,30 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                                  "if the unit is quantised, state its acquisition (plansim fit --scenario), or "
                                  "every parameter that depends on this channel looks exact")
     channels = []
+    noisier = np.zeros((S, 6), dtype=bool)  # a static segment that scatters more than the channel's others
     for c, name in enumerate(CHANNELS):
         step = steps[c]
+        # the Allan deviation of the static segments, without those that scatter more than the channel's quiet ones
+        flagged = _noisier_segments(within[:, c], within_dof, static, step)
+        pooled_from = [k for k in static if k not in flagged]
         tau, avar, dof = pooled_allan_variance([(segment_samples[k][:, c], segments[k].sample_rate)
-                                                for k in static])
+                                                for k in pooled_from])
         if tau.size:
             white, bias_instability, random_walk = fit_allan(tau, avar, dof)
         else:
             tau = avar = dof = np.zeros(0)
             white = bias_instability = random_walk = math.nan
-        channels.append(ChannelNoise(name, white, bias_instability, random_walk, step, len(static),
-                                     int(sum(segment_samples[k].shape[0] for k in static)), tau,
+        noisier[flagged, c] = True
+        channels.append(ChannelNoise(name, white, bias_instability, random_walk, step, len(pooled_from),
+                                     int(sum(segment_samples[k].shape[0] for k in pooled_from)), tau,
                                      np.sqrt(avar), dof))
+        if flagged:
+            quiet = math.sqrt(sum(within[k, c] ** 2 * within_dof[k] for k in pooled_from)
+                              / sum(within_dof[k] for k in pooled_from))
+            times = f"{max(within[flagged, c]) / quiet:.3g} times" if quiet > 0 else "more than"
+            notes.append(f"{name}: {len(flagged)} static segment(s) scatter more than the channel's others (F test at "
+                         f"{NOISIER_PROBABILITY:g}; up to {times} the quiet ones' scatter: a unit held by hand, a "
+                         "knock): their means take their own scatter, and the Allan deviation is taken without them")
     if not static:
         notes.append("no static segment: white noise from the within-segment scatter only; bias instability and "
                      "random walk not estimated (NaN)")
@@ -719,6 +761,8 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                 white, white_dof = ch.white**2 / duration, static_dof
                 if s.is_rotating and s.rate_known and own > white:  # a table's rate jitter (a hand's is no noise)
                     white, white_dof = own, max(within_dof[k], 1)
+                if noisier[k, c]:  # a pose that shook: its own scatter, of which the white model knows nothing
+                    white, white_dof = max(own, white), max(within_dof[k], 1)
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             own_quantisation = 0.0
             if ch.quantisation_step > 0:
