@@ -237,7 +237,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         raise ValueError(f"null_draws = {null_draws!r}: must be a whole number >= 19 (p resolves to 1/(B + 1))")
     options = dict(site=site, turntable=turntable, turntable_source=turntable_source,
                    reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm,
-                   stated_white=stated_white, stated_step=stated_step)
+                   stated_white=stated_white, stated_step=stated_step,
+                   moves=False)  # the diagnosis tests the segment means' model; the moves' gyro fit is fit's
     # the samples' noise depends on the samples alone: estimated once, shared by every refit below
     options["noise"] = recording_noise(recording, stated_white, stated_step)
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the

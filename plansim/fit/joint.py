@@ -39,6 +39,7 @@ from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.fit.identify import Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
+from plansim.fit.moves import find_transitions, fit_moves
 from plansim.fit.noise import NoiseEstimate, estimate_noise, quantisation_harmonics
 from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
@@ -251,6 +252,12 @@ class FitResult:
     #: extra unknowns fitted with θ (``fit_recording(extra=…)``): their names, estimates, u and ν
     extra: Method | None = None
     extra_names: tuple[str, ...] = ()
+    #: the joint estimate's gain on the segment means, θ̂ − θ0 ≈ gain·(m − model) (39, 6S), and the independent
+    #: inputs of the means (sensitivity columns, u, ν, kind): what the moves' fit carries on (:mod:`plansim.fit.moves`)
+    gain: np.ndarray | None = field(default=None, repr=False)
+    sources: object = field(default=None, repr=False)
+    #: the gyros from the moves between poses (:func:`plansim.fit.moves.fit_moves`); None without two usable moves
+    moves: object = None
 
     @property
     def residuals(self) -> np.ndarray:
@@ -259,15 +266,30 @@ class FitResult:
 
     @property
     def identified(self) -> tuple[str, ...]:
-        return self.identifiability.identified
+        """The parameters identified by the segment means (the joint fit) or by the moves between poses, in the
+        order of eq. (1)/(2)."""
+        found = set(self.identifiability.identified) | set(self.moves.identified if self.moves else ())
+        return tuple(name for name in PARAMETER_NAMES if name in found)
 
     @property
     def not_identified(self) -> dict:
-        return self.identifiability.not_identified
+        """name -> why, for every parameter neither the joint fit nor the moves identify."""
+        out = {}
+        for name, reason in self.identifiability.not_identified.items():
+            if self.moves is None:
+                out[name] = reason
+            elif name in self.moves.identified:
+                continue
+            elif name in self.moves.relative:
+                out[name] = self.moves.relative[name]
+            else:
+                out[name] = reason
+        return out
 
     @property
     def methods(self) -> tuple[Method, ...]:
-        return (self.spec, self.joint) if self.spec is not None else (self.joint,)
+        out = (self.spec, self.joint) if self.spec is not None else (self.joint,)
+        return out + ((self.moves.method,) if self.moves is not None else ())
 
 
 @dataclass(frozen=True)
@@ -548,7 +570,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
                   between_noise: BetweenSegmentNoise | None = None, stated_white=None,
-                  noise: NoiseEstimate | None = None, stated_step=None) -> FitResult:
+                  noise: NoiseEstimate | None = None, stated_step=None, moves: bool = True) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -589,6 +611,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         The noise of the recording's samples, as :func:`recording_noise` returns it for this recording,
         *stated_white* and *stated_step*: given, it is not estimated again (it depends on the samples alone,
         and ``plansim diagnose`` refits the same recording several times).
+    moves : bool
+        Also fit the gyros from the moves between static poses (:mod:`plansim.fit.moves`; default True). The
+        joint fit and its result do not depend on it.
 
     Returns
     -------
@@ -764,7 +789,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         spec_note = "not run"
     # repeated settings against the prediction (not against the between-segment noise fitted to these residuals)
     between = _between_segments(used_schedule, residual, project @ V_predicted @ project.T, project, sources)
-    return FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
+    result = FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
                      tilts=np.asarray(tilts)[:2 * int(model.placed.sum())].reshape(-1, 2),
                      placed=tuple(np.asarray(used)[model.placed].tolist()),
                      hand_axes=use.hand_axes, axis_tilts=np.asarray(tilts)[2 * int(model.placed.sum()):].reshape(-1, 2),
@@ -777,7 +802,17 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
                      covariance=V, whitening=W, design=design, rows=rows,
                      segment_times=times, extra=extra_method,
-                     extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow)
+                     extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
+                     gain=gain, sources=sources)
+    if moves:
+        transitions, unused_moves = find_transitions(recording)
+        move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise, _Sources, _propagate,
+                             BETWEEN_LR_THRESHOLD, _chi2_verdict)
+        if move_fit is not None:
+            unused_note = {k: v for k, v in unused.items() if "a move between poses" not in v}
+            result = dataclasses.replace(result, moves=move_fit, unused=unused_note,
+                                         notes=result.notes + move_fit.notes)
+    return result
 
 
 def _middle_times(recording, used) -> np.ndarray:

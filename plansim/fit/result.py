@@ -16,7 +16,7 @@ from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
-JSON_KEYS = ("identified", "not_identified", "parameters", "noise", "residuals", "chi2_dof")
+JSON_KEYS = ("identified", "not_identified", "parameters", "noise", "residuals", "chi2_dof", "moves")
 
 
 def _number(value: float):
@@ -68,7 +68,26 @@ def fit_json(result: FitResult) -> dict:
         "chi2_dof": {"chi2": _number(result.chi2), "dof": int(result.chi2_dof),
                      "ratio": _number(result.chi2 / result.chi2_dof) if result.chi2_dof > 0 else None,
                      "verdict": result.chi2_verdict},
+        "moves": _moves_json(result.moves),
     }
+
+
+def _moves_json(moves) -> dict | None:
+    """The gravity sequence (``moves`` of ``plansim fit --json``); None when the recording has no two usable moves."""
+    if moves is None:
+        return None
+    used = [{"from_segment": int(t.before), "to_segment": int(t.after), "segments": [int(k) for k in t.between],
+             "duration": _number(moves.duration[m]), "duration_unit": "s",
+             "angle": _number(moves.angle[m]), "residual": [_number(v) for v in moves.residual[m]],
+             "u": [_number(v) for v in moves.residual_sd[m]], "unit": "rad"}
+            for m, t in enumerate(moves.transitions)]
+    return {"used": used,
+            "not_used": [{"segments": where, "reason": reason} for where, reason in moves.unused.items()],
+            "chi2_dof": {"chi2": _number(moves.chi2), "dof": int(moves.chi2_dof),
+                         "ratio": _number(moves.chi2 / moves.chi2_dof) if moves.chi2_dof > 0 else None,
+                         "verdict": moves.chi2_verdict},
+            "between_sd": _number(moves.between_sd), "between_sd_unit": "rad",
+            "relative_to_accelerometers": [{"name": name, "reason": reason} for name, reason in moves.relative.items()]}
 
 
 def fit_dataset(result: FitResult) -> xr.Dataset:
@@ -117,11 +136,25 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
                       "ratio"):
             data[f"between_{field}"] = ("channel", np.array([getattr(b, field) for b in result.between]),
                                         {"long_name": f"repeated settings: {field.replace('_', ' ')}"})
+    moves = result.moves
+    if moves is not None:
+        data["move_residual"] = (("move", "across_gravity"), moves.residual,
+                                 {"long_name": "residual of each move between poses across gravity at its end "
+                                               "(the gravity sequence)", "units": "rad"})
+        data["move_residual_u"] = (("move", "across_gravity"), moves.residual_sd,
+                                   {"long_name": "predicted standard deviation of that residual", "units": "rad"})
+        data["move_angle"] = ("move", moves.angle, {"long_name": "angle turned by the move", "units": "rad"})
+        data["move_duration"] = ("move", moves.duration, {"long_name": "duration of the move", "units": "s"})
     if result.placed:
         data["tilt"] = (("placed_segment", "tilt_axis"), result.tilts,
                         {"long_name": "fitted tilt of a pose placed by hand from its nominal pose", "units": "rad"})
     coords_extra = {"placed_segment": np.asarray(result.placed, dtype=np.int32), "tilt_axis": ["East", "North"]} \
         if result.placed else {}
+    if moves is not None:
+        coords_extra.update({"move": np.arange(len(moves.transitions), dtype=np.int32),
+                             "move_from_segment": ("move", np.array([t.before for t in moves.transitions], np.int32)),
+                             "move_to_segment": ("move", np.array([t.after for t in moves.transitions], np.int32)),
+                             "across_gravity": ["first", "second"]})
     ds = xr.Dataset(data, coords={**coords_extra, "parameter": list(PARAMETER_NAMES), "channel": list(CHANNELS),
                                   "segment": np.asarray(result.used, dtype=np.int32),
                                   "parameter_unit": ("parameter", units),
@@ -136,6 +169,8 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
         "chi2": result.chi2, "chi2_dof": result.chi2_dof, "chi2_verdict": result.chi2_verdict,
         "spec_note": result.spec_note,
         "not_identified": "; ".join(f"{k}: {v}" for k, v in result.not_identified.items()),
+        "moves": "none" if moves is None else (f"{len(moves.transitions)} used; chi2 {moves.chi2:.6g} on "
+                                               f"{moves.chi2_dof} dof: {moves.chi2_verdict}"),
         "unused_segments": "; ".join(f"{k}: {v}" for k, v in result.unused.items()),
         "notes": " | ".join(result.notes),
     })

@@ -60,6 +60,9 @@ def fit_report(result, residuals: bool = True) -> str:
     head = f"{'name':6s} {'unit':>13s} {'joint WLS':>14s} {'u':>10s} {'nu':>7s}"
     if result.spec is not None:
         head += f" {'JJF 2003 eq.':>14s} {'u':>10s} {'spec bias':>10s}"
+    moves = result.moves
+    if moves is not None:
+        head += f" {'moves':>14s} {'u':>10s} {'nu':>7s}"
     lines.append(head)
     for k, p in enumerate(PARAMETERS):
         f = p.display_factor
@@ -70,12 +73,20 @@ def fit_report(result, residuals: bool = True) -> str:
             bias = 0.0 if abs(bias) < 1e-6 * result.spec.u[k] else bias  # rounding of (M·J − I)·θ
             row += (f" {_g(result.spec.estimate[k] / f, 8):>14s} {_g(result.spec.u[k] / f, 3):>10s} "
                     f"{_g(bias / f, 3):>10s}")
+        if moves is not None:
+            mark = "~" if p.name in moves.relative else " "
+            row += (f" {_g(moves.method.estimate[k] / f, 8):>13s}{mark} {_g(moves.method.u[k] / f, 3):>10s} "
+                    f"{_dof(moves.method.dof[k]):>7s}")
         lines.append(row)
     if result.spec is not None:
         lines.append(f"JJF 2003 eq.: the specification's estimators ({result.spec.note}); spec bias = their expected "
                      "error at the joint estimate (the site's Earth rate, which eq. (7) and (8) do not model)")
     else:
         lines.append(f"The specification's estimators: not run — {result.spec_note}")
+    if moves is not None:
+        lines.append("moves: the gyros from the moves between poses (the gravity sequence, Tedaldi et al. 2014; "
+                     "below)" + ("; ~ = relative to the accelerometer triad (the frame where Ka is symmetric), not "
+                                 "the case" if moves.relative else ""))
     budget = result.joint.contributions
     if budget:
         lines.append("The joint fit's u comes from these kinds of input: " + ", ".join(budget)
@@ -101,6 +112,9 @@ def fit_report(result, residuals: bool = True) -> str:
         lines += ["", "Turns by hand: fitted misalignment of the turned axis (two small angles; deg)"]
         for axis, (first, second) in zip(result.hand_axes, result.axis_tilts):
             lines.append(f"  about {'xyz'[axis]}: {math.degrees(first):+.3f} {math.degrees(second):+.3f}")
+
+    if moves is not None:
+        lines += _moves_section(result, moves, residuals)
 
     between = result.between_noise
     if between is not None and np.any(between.variance > 0):
@@ -149,3 +163,30 @@ def fit_report(result, residuals: bool = True) -> str:
     if result.notes:
         lines += [""] + [f"note: {n}" for n in result.notes]
     return "\n".join(lines)
+
+
+def _moves_section(result, moves, residuals: bool) -> list[str]:
+    """The gravity sequence: which motions between poses were used, χ², the noise between moves, the residuals."""
+    lines = ["", f"Moves between poses (the gyros from the gravity sequence): {len(moves.transitions)} used, "
+             f"{len(moves.unused)} not"]
+    for where, reason in moves.unused.items():
+        lines.append(f"  {where}: {reason}")
+    ratio = moves.chi2 / moves.chi2_dof if moves.chi2_dof > 0 else math.nan
+    lines.append(f"  chi2/dof = {_g(moves.chi2, 5)}/{moves.chi2_dof} = {_g(ratio, 4)}: {moves.chi2_verdict}")
+    if moves.between_sd > 0:
+        lines.append(f"  noise between moves beyond the prediction (from their residuals): "
+                     f"{_g(math.degrees(moves.between_sd), 3)} deg per component, a Type A input of every u")
+    for name, reason in moves.relative.items():
+        lines.append(f"  {name}: {reason}")
+        break  # one sentence says it for all of them
+    if residuals:
+        lines += [f"  {'move':>4s} {'from':>5s} {'to':>5s} {'seconds':>8s} {'turned':>8s} "
+                  f"{'residual across gravity':>25s} {'u':>15s}  (deg)"]
+        for m, t in enumerate(moves.transitions):
+            r = np.degrees(moves.residual[m])
+            u = np.degrees(moves.residual_sd[m])
+            flag = " *" if np.any(np.abs(moves.residual[m]) > 3 * moves.residual_sd[m]) else ""
+            lines.append(f"  {m:>4d} {t.before:>5d} {t.after:>5d} {moves.duration[m]:8.2f} "
+                         f"{math.degrees(moves.angle[m]):8.1f} {r[0]:+12.4f} {r[1]:+12.4f} {u[0]:7.4f} "
+                         f"{u[1]:7.4f}{flag}")
+    return lines

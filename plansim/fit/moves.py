@@ -1,0 +1,492 @@
+"""The gyros from the moves between poses: the gravity sequence of a hand-held session.
+
+A unit carried by hand from one static pose to the next turns along a path nobody recorded, but both ends
+of the path are known in part: the accelerometers say where gravity is in the body at rest before and
+after. The gyro outputs over the move, corrected by a candidate gyro calibration and integrated, must turn
+the first direction into the second. Over many moves about many axes this identifies the gyros' scale
+factors and cross-couplings. It is the gyro half of the method of Tedaldi, Pretto and Menegatti, *A robust
+and easy to implement method for IMU calibration without external equipments*, ICRA 2014 (the accelerometer
+half is the joint fit's norm-based fit of poses placed by hand), here as a weighted least squares with a GUM
+uncertainty.
+
+**Transitions.** Two static segments of the recording with only moving segments between them (``move`` or
+``rotation``), none with a settle time (time not recorded) and no gap in the time axis, and no gyro stuck at
+its extreme over the recording (two samples or more, entered or left by a step of more than 5 times its noise
+at rest, as ``plansim import`` tells a rail: the rate there is not known).
+
+**Model** (per transition from pose i to pose j; JJF 2003 eq. (1) for the gyros, the joint fit's Ka, Ba and
+G as known inputs):
+
+- the gravity direction at rest, û = f/|f|, f = Ka⁻¹·(ā − Ba) from the pose's mean accelerometer output;
+- the gyros' bias over the move, interpolated linearly in time between the poses' middle times:
+  b_i = ω̄_i − G·f_i (the pose's mean gyro output, which holds Bg and Kg times the Earth rate there);
+- the body rate at each sample k, ω̂_k = Kg⁻¹·(y_k − b(t_k) − G·f_k), f_k = Ka⁻¹·(a_k − Ba) (the hand's pushes
+  are specific force too);
+- the rotation R it integrates to, each rate held over its sample interval
+  (:func:`plansim.kernels.trajectory.integrate_rotation`);
+- the residual r = Eⱼᵀ·(Rᵀ·ûᵢ − ûⱼ): the two components, across ûⱼ, of the miss (a rotation about gravity
+  leaves gravity where it is: the heading turned is not observed).
+
+Kg (9 entries) minimises rᵀV⁻¹r over every transition (``scipy.optimize.least_squares``, with the analytic
+Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kernel's sensitivities S_k = ∂(Rᵀû)/∂ω_k).
+
+**Uncertainty** (JCGM 100 5.1.2, independent inputs, as in :mod:`plansim.fit.joint`):
+
+- the gyro noise of the move's own samples: white, per sample variance N²/dt + q²/12 (the motion dithers the
+  quantiser), through S_k·Kg⁻¹, and a slow part held over the move, (2 ln 2/π)·B² + K²·T/3 (IEEE Std 952's
+  bias instability and rate random walk of the fitted noise model);
+- every input of the joint fit (the poses' mean outputs' noise, quantisation, the site, …), through
+  ∂r/∂m + ∂r/∂θ·A (m the segment means, θ = A·m the joint estimate: Ka, Ba and G, and the poses' means used
+  directly, are correlated through the data, and this carries the correlation);
+- the Earth rate during the move, which the linear interpolation of the bias does not follow: a rate of up
+  to Ω_E about an axis not known, Type B, u = Ω_E/√3 per axis, held over the move;
+- noise between moves beyond all of that (a hand that shakes at the ends of a pose, timing, effects beyond
+  eq. (1)): one variance per residual component, estimated by restricted maximum likelihood and taken when
+  2·Δlog L passes :data:`plansim.fit.joint.BETWEEN_LR_THRESHOLD`, as the joint fit's noise between segments.
+
+**Identifiability and the frame.** ∂r/∂Kg at Kg = I on the recorded motion goes through
+:func:`plansim.fit.identify.identifiability`. The moves see the body through the accelerometers, so Kg comes
+out in the frame where Ka's cross-couplings take the joint fit's values. Where the joint fit does not
+identify them (poses placed by hand: held at 0), Kg's cross-couplings are the gyros' misalignment relative to
+the accelerometer triad, not to the case; to first order they estimate Kg_ij − (Ka_ij − Ka_ji)/2. They are
+then reported with that frame and are not counted as identified; the scale factors Kg_ii do not depend on
+it (to first order) and are. docs/fitting.md.
+
+The moves read the accelerometers with the antisymmetric part of each such pair of Ka's cross-couplings
+removed (the joint fit may leave it anywhere in its null space: a common rotation of every pose is a rotation
+of the triad), so that the estimate is the same whatever the joint fit's start: the gyros' misalignment in
+the frame where the accelerometer triad's matrix is symmetric.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
+from plansim.fit.identify import identifiability
+from plansim.kernels.trajectory import integrate_rotation
+from plansim.model.environment import EARTH_RATE
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
+
+METHOD_MOVES = "gravity_sequence"
+#: the Kg entries, in the order of their 3×3 matrix (row by row)
+KG_NAMES = tuple(f"Kg{a}{b}" for a in "xyz" for b in "xyz")
+KG_INDEX = np.array([PARAMETER_INDEX[name] for name in KG_NAMES])
+#: the entries of the joint estimate the moves' model reads
+_USED_FROM_JOINT = tuple(f"{p}{a}{b}" for p in ("Ka", "g") for a in "xyz" for b in "xyz") + \
+    tuple(f"Ba{a}" for a in "xyz")
+#: central-difference steps: a segment mean (gyro rad/s, accelerometer m/s²) and a joint parameter (SI)
+_STEP_GYRO, _STEP_ACCEL, _STEP_PARAMETER = 1e-7, 1e-6, 1e-7
+#: two moves or fewer cannot identify anything (each gives two numbers)
+MIN_TRANSITIONS = 2
+
+
+@dataclass(frozen=True)
+class Transition:
+    """A motion between two static poses: schedule indices ``before``/``after`` and the ``between``
+    segments; samples ``start``…``stop − 1`` are integrated (``stop`` is the first sample of ``after``)."""
+
+    before: int
+    after: int
+    between: tuple[int, ...]
+    start: int
+    stop: int
+
+
+@dataclass(frozen=True)
+class MoveFit:
+    """What the moves say of the gyros (:func:`fit_moves`). Arrays over the transitions used (M of them).
+
+    ``method`` holds the 39 parameters' estimates and u (NaN but for the Kg entries the moves identify);
+    ``identified`` the Kg entries identified in the case frame; ``relative`` those estimated only relative
+    to the accelerometer triad (module docstring) with the reason; ``residual`` (M, 2) and ``residual_sd``
+    (M, 2) rad; ``angle`` (M,) the angle each move turned, rad; χ² against the prediction (without the noise
+    between moves estimated from these residuals).
+    """
+
+    transitions: tuple[Transition, ...]
+    unused: dict
+    method: object
+    identified: tuple[str, ...]
+    relative: dict
+    not_identified: dict
+    residual: np.ndarray
+    residual_sd: np.ndarray
+    angle: np.ndarray
+    duration: np.ndarray
+    chi2: float
+    chi2_dof: int
+    chi2_verdict: str
+    between_sd: float
+    between_dof: float
+    notes: tuple[str, ...] = ()
+    #: the gain of the Kg estimate on the residuals and the residuals' covariance, for what builds on it
+    covariance: np.ndarray | None = field(default=None, repr=False)
+
+
+def find_transitions(recording) -> tuple[list[Transition], dict]:
+    """The transitions of a recording (module docstring) and, for each motion that is not one, why."""
+    schedule = recording.schedule
+    segments = schedule.segments
+    first = np.asarray(recording.first_sample, dtype=np.int64)
+    samples = np.asarray(recording.samples, dtype=float)
+    static = [k for k, s in enumerate(segments) if s.test != "move" and not s.is_rotating]
+    time = recording.time if getattr(recording, "timestamps", None) is not None else None
+    # the gyros' extremes over the recording and their per-sample noise at rest (median scatter of the poses)
+    rails = [(samples[:, c].min(), samples[:, c].max()) for c in range(3)]
+    scatter = np.array([[np.std(recording.segment_samples(k)[:, c]) for c in range(3)] for k in static])
+    jump = SATURATION_STEP * np.median(scatter, axis=0) if len(static) else np.zeros(3)
+    out, unused = [], {}
+    for i, j in zip(static[:-1], static[1:]):
+        between = tuple(range(i + 1, j))
+        if not between:
+            continue  # two rests side by side: nothing moved
+        where = f"segments {between[0]}-{between[-1]}" if len(between) > 1 else f"segment {between[0]}"
+        late = [k for k in between + (j,) if segments[k].settle > 0]
+        if late:
+            unused[where] = (f"segment {late[0]} starts after a settle time that was not recorded: the motion "
+                             "between the poses is not all in the log")
+            continue
+        start, stop = int(first[between[0]]), int(first[j])
+        if time is not None:
+            steps = np.diff(time[start - 1:stop + 1])
+            period = 1.0 / segments[i].sample_rate
+            if np.any(steps > GAP_FACTOR * period):
+                unused[where] = "a gap in the time axis: samples are missing, the motion's integral is not known"
+                continue
+        stuck = _rail(samples[start:stop, :3], rails, jump)
+        if stuck is not None:
+            unused[where] = (f"gyro {'xyz'[stuck]} reads its extreme over the recording for two samples in a row: "
+                             "saturated? The rate there is not known")
+            continue
+        out.append(Transition(i, j, between, start, stop))
+    return out, unused
+
+
+def _rail(block: np.ndarray, rails, jump: np.ndarray) -> int | None:
+    """The first gyro channel of *block* stuck at the recording's extreme (:func:`stuck_runs`: two or more samples
+    there, entered or left by more than *jump*, SATURATION_STEP times its noise at rest), or None."""
+    for c in range(3):
+        for value in rails[c]:
+            if stuck_runs(block[:, c], value, jump[c]):
+                return c
+    return None
+
+
+class _Moves:
+    """The transitions' data and the residual model (module docstring)."""
+
+    def __init__(self, recording, transitions, pose_row: dict, means: np.ndarray, theta: np.ndarray,
+                 symmetrise=()):
+        #: pairs (i, j) of Ka's cross-couplings the joint fit does not identify: the moves read Ka with their
+        #: antisymmetric part (a rotation of the triad, which no pose fixes) removed, (Ka_ij + Ka_ji)/2 both
+        self.symmetrise = tuple(symmetrise)
+        segments = recording.schedule.segments
+        samples = np.asarray(recording.samples, dtype=float)
+        time = np.asarray(recording.time, dtype=float)
+        first = np.asarray(recording.first_sample, dtype=np.int64)
+        self.transitions = transitions
+        self.pose_row = pose_row  # schedule index -> row of the used segments' means
+        self.gyro, self.accel, self.dt, self.weight_before, self.duration = [], [], [], [], []
+        for t in transitions:
+            k = np.arange(t.start, t.stop)
+            fs = segments[t.before].sample_rate
+            dt = np.diff(time[t.start:t.stop + 1]) if t.stop < time.size else np.r_[np.diff(time[k]), 1.0 / fs]
+            mid_time = [float(np.mean(time[int(first[p]):int(first[p]) + segments[p].samples]))
+                        for p in (t.before, t.after)]
+            self.gyro.append(np.ascontiguousarray(samples[k, :3]))
+            self.accel.append(np.ascontiguousarray(samples[k, 3:]))
+            self.dt.append(np.ascontiguousarray(dt))
+            self.weight_before.append((mid_time[1] - time[k]) / (mid_time[1] - mid_time[0]))
+            self.duration.append(float(np.sum(dt)))
+        self.duration = np.asarray(self.duration)
+        # the basis across gravity at each move's end, fixed at the data and the joint estimate
+        self.basis = []
+        for t in transitions:
+            up = self._direction(means[pose_row[t.after], 3:], theta)
+            helper = np.eye(3)[int(np.argmin(np.abs(up)))]
+            e1 = np.cross(up, helper)
+            e1 /= np.linalg.norm(e1)
+            self.basis.append(np.column_stack([e1, np.cross(up, e1)]))
+
+    def _accel_model(self, theta):
+        Ka = theta[[PARAMETER_INDEX[f"Ka{a}{b}"] for a in "xyz" for b in "xyz"]].reshape(3, 3).copy()
+        for i, j in self.symmetrise:
+            Ka[i, j] = Ka[j, i] = 0.5 * (Ka[i, j] + Ka[j, i])
+        Ba = theta[[PARAMETER_INDEX[f"Ba{a}"] for a in "xyz"]]
+        G = theta[[PARAMETER_INDEX[f"g{a}{b}"] for a in "xyz" for b in "xyz"]].reshape(3, 3)
+        return np.linalg.inv(Ka), Ba, G
+
+    def _direction(self, accel_mean, theta):
+        Kinv, Ba, _ = self._accel_model(theta)
+        f = Kinv @ (accel_mean - Ba)
+        return f / np.linalg.norm(f)
+
+    def one(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray, details: bool = False):
+        """The residual (2,) of transition *m*; with *details* also the sensitivities (module docstring)."""
+        t = self.transitions[m]
+        Kinv, Ba, G = self._accel_model(theta)
+        before, after = means[self.pose_row[t.before]], means[self.pose_row[t.after]]
+        f_i, f_j = Kinv @ (before[3:] - Ba), Kinv @ (after[3:] - Ba)
+        u_i, u_j = f_i / np.linalg.norm(f_i), f_j / np.linalg.norm(f_j)
+        b_i, b_j = before[:3] - G @ f_i, after[:3] - G @ f_j
+        w = self.weight_before[m][:, None]
+        bias = w * b_i[None, :] + (1.0 - w) * b_j[None, :]
+        f_k = (self.accel[m] - Ba[None, :]) @ Kinv.T
+        M = np.linalg.inv(Kg)
+        rates = np.ascontiguousarray((self.gyro[m] - bias - f_k @ G.T) @ M.T)
+        n = rates.shape[0]
+        rotation, end, sens = np.empty((3, 3)), np.empty(3), np.empty((n, 3, 3))
+        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
+        E = self.basis[m]
+        r = E.T @ (end - u_j)
+        if not details:
+            return r
+        SM = sens @ M  # (n, 3, 3): ∂end/∂(gyro output at k)
+        # ∂r/∂Kg_ab = −Eᵀ Σ_k (S_k M)[:, a] ω̂_k[b]
+        jac = -np.einsum("xi,kxa,kb->iab", E, SM, rates).reshape(2, 9)
+        angle = float(np.linalg.norm(_log_rotation(rotation)))
+        return r, dict(jac=jac, SM=SM, S_sum=E.T @ sens.sum(axis=0), SM_sum=E.T @ SM.sum(axis=0), angle=angle)
+
+    def residuals(self, Kg, theta, means) -> np.ndarray:
+        return np.concatenate([self.one(m, Kg, theta, means) for m in range(len(self.transitions))])
+
+
+def _log_rotation(R: np.ndarray) -> np.ndarray:
+    cos_angle = min(1.0, max(-1.0, (np.trace(R) - 1.0) / 2.0))
+    angle = math.acos(cos_angle)
+    w = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    s = math.sin(angle)
+    return w * (angle / s) if s > 1e-9 else w
+
+
+def _dark_variance(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, threshold: float) -> float:
+    """REML estimate of one variance σ² added to every residual component (independent), 0 unless 2·Δlog L
+    against σ² = 0 passes *threshold* (as the joint fit's noise between segments)."""
+    from scipy.optimize import minimize_scalar
+
+    R = np.eye(residual.size) - hat
+    C = R @ V @ R.T
+    values, vectors = np.linalg.eigh(0.5 * (C + C.T))
+    keep = values > 1e-9 * values.max()
+    if keep.sum() == 0:
+        return 0.0
+    U = vectors[:, keep] / np.sqrt(values[keep])
+    y = U.T @ residual
+    lam, Q = np.linalg.eigh(U.T @ R @ R.T @ U)
+    lam = np.maximum(lam, 0.0)
+    z2 = (Q.T @ y) ** 2
+    scale = float(np.median(np.diag(C)))
+
+    def negative_log_likelihood(log_ratio):
+        s2 = scale * math.exp(log_ratio)
+        return 0.5 * float(np.sum(np.log1p(s2 * lam) + z2 / (1.0 + s2 * lam)))
+
+    result = minimize_scalar(negative_log_likelihood, bounds=(-12 * math.log(10), 8 * math.log(10)), method="bounded")
+    gain = -float(result.fun) + 0.5 * float(y @ y)
+    return scale * math.exp(result.x) if 2.0 * gain > threshold else 0.0
+
+
+def fit_moves(recording, fit, transitions, unused, noise, sources_class, propagate, threshold,
+              verdict) -> MoveFit | None:
+    """Kg from the transitions (module docstring), given the joint fit *fit* (its θ̂, gain and sources).
+
+    *noise* is the recording's :class:`plansim.fit.noise.NoiseEstimate` (its channels' N, B, K and q);
+    *sources_class*, *propagate*, *threshold* and *verdict* are the joint fit's input bookkeeping, GUM
+    propagation, likelihood-ratio threshold and χ² verdict (one of each in :mod:`plansim.fit.joint`).
+    Returns None when fewer than :data:`MIN_TRANSITIONS` transitions are usable.
+    """
+    if len(transitions) < MIN_TRANSITIONS:
+        return None
+    used = list(fit.used)
+    pose_row = {k: used.index(k) for t in transitions for k in (t.before, t.after)}
+    means = np.asarray(fit.observed, dtype=float)
+    theta = np.asarray(fit.theta, dtype=float)
+    joint_identified = set(fit.identifiability.identified)
+    symmetrise = [(i, j) for i in range(3) for j in range(i + 1, 3)
+                  if not {f"Ka{'xyz'[i]}{'xyz'[j]}", f"Ka{'xyz'[j]}{'xyz'[i]}"} <= joint_identified]
+    moves = _Moves(recording, transitions, pose_row, means, theta, symmetrise)
+    n_moves = len(transitions)
+    notes = []
+
+    # identifiability of Kg from the moves: ∂r/∂Kg at Kg = I on the recorded motion
+    design = np.zeros((2 * n_moves, len(PARAMETER_NAMES)))
+    for m in range(n_moves):
+        _, d = moves.one(m, np.eye(3), theta, means, details=True)
+        design[2 * m:2 * m + 2, KG_INDEX] = d["jac"]
+    ident = identifiability(design, what="the moves between poses")
+    kg_mask = ident.mask[KG_INDEX]
+    if not kg_mask.any():
+        return None
+    basis = ident.basis[KG_INDEX]  # (9, rank): Kg = I + basis·z
+
+    S = means.shape[0]
+
+    def mean_sensitivity(Kg):
+        """∂r/∂m (2M, 6S): the poses' mean outputs as the moves' model reads them directly."""
+        L = np.zeros((2 * n_moves, 6 * S))
+        for m, t in enumerate(transitions):
+            for pose in (t.before, t.after):
+                row = pose_row[pose]
+                for c in range(6):
+                    h = _STEP_GYRO if c < 3 else _STEP_ACCEL
+                    up, down = means.copy(), means.copy()
+                    up[row, c] += h
+                    down[row, c] -= h
+                    L[2 * m:2 * m + 2, 6 * row + c] += (moves.one(m, Kg, theta, up)
+                                                        - moves.one(m, Kg, theta, down)) / (2 * h)
+        return L
+
+    def joint_sensitivity(Kg):
+        """∂r/∂θ (2M, 39) for the entries of the joint estimate the model reads (Ka, Ba, G)."""
+        D = np.zeros((2 * n_moves, len(PARAMETER_NAMES)))
+        for name in _USED_FROM_JOINT:
+            k = PARAMETER_INDEX[name]
+            up, down = theta.copy(), theta.copy()
+            up[k] += _STEP_PARAMETER
+            down[k] -= _STEP_PARAMETER
+            D[:, k] = (moves.residuals(Kg, up, means) - moves.residuals(Kg, down, means)) / (2 * _STEP_PARAMETER)
+        return D
+
+    gyro_noise = noise.channels[:3]
+    white_var = np.array([ch.white**2 for ch in gyro_noise])
+    q2 = np.array([ch.quantisation_step**2 / 12.0 for ch in gyro_noise])
+
+    def slow_var(T):
+        """Variance of the gyro noise held over a move of T s: IEEE Std 952's B and K terms of the Allan model."""
+        return np.array([(2.0 * math.log(2.0) / math.pi) * ch.bias_instability**2 + ch.rate_random_walk**2 * T / 3.0
+                         for ch in gyro_noise])
+
+    white_dof = max(float(sum(ch.static_samples - ch.static_segments for ch in gyro_noise)) / 3.0, 1.0)
+    slow_dof = max(float(min(ch.static_segments for ch in gyro_noise)) - 1.0, 1.0)
+    joint_gain = fit.gain  # (39, 6S)
+    joint_sources = fit.sources
+
+    def build(Kg, dark):
+        sources = sources_class(2 * n_moves)
+        jacobian = np.zeros((2 * n_moves, 9))
+        angles = np.zeros(n_moves)
+        for m in range(n_moves):
+            _, d = moves.one(m, Kg, theta, means, details=True)
+            jacobian[2 * m:2 * m + 2] = d["jac"]
+            angles[m] = d["angle"]
+            E = moves.basis[m]
+            per_sample = white_var[None, :] / moves.dt[m][:, None] + q2[None, :]  # (n, 3)
+            C = E.T @ np.einsum("kia,ka,kja->ij", d["SM"], per_sample, d["SM"]) @ E
+            values, vectors = np.linalg.eigh(0.5 * (C + C.T))
+            for value, vector in zip(values, vectors.T):
+                if value > 0:
+                    column = np.zeros(2 * n_moves)
+                    column[2 * m:2 * m + 2] = vector
+                    sources.add(column, math.sqrt(value), white_dof, "noise")
+            slow = slow_var(moves.duration[m])
+            for c in range(3):
+                column = np.zeros(2 * n_moves)
+                column[2 * m:2 * m + 2] = d["SM_sum"][:, c]
+                if slow[c] > 0:
+                    sources.add(column, math.sqrt(slow[c]), slow_dof, "noise")
+                if fit.site.earth_rate:
+                    column = np.zeros(2 * n_moves)
+                    column[2 * m:2 * m + 2] = d["S_sum"][:, c]
+                    sources.add(column, EARTH_RATE / math.sqrt(3.0), math.inf, "site")
+        total = mean_sensitivity(Kg) + joint_sensitivity(Kg) @ joint_gain  # L = ∂r/∂m + ∂r/∂θ·A
+        for column, u, dof, kind in zip(joint_sources.columns, joint_sources.u, joint_sources.dof, joint_sources.kind):
+            sources.add(total @ column, u, dof, kind)
+        if dark > 0:
+            for i in range(2 * n_moves):
+                column = np.zeros(2 * n_moves)
+                column[i] = 1.0
+                sources.add(column, math.sqrt(dark), max(2 * n_moves - basis.shape[1], 1), "between")
+        return sources, jacobian, angles
+
+    def solve(V, Kg_start):
+        values, vectors = np.linalg.eigh(0.5 * (V + V.T))
+        values = np.maximum(values, 1e-14 * values.max())
+        W = (vectors / np.sqrt(values)).T
+
+        def fun(z):
+            return W @ moves.residuals(np.eye(3) + (basis @ z).reshape(3, 3), theta, means)
+
+        def jac(z):
+            Kg = np.eye(3) + (basis @ z).reshape(3, 3)
+            J = np.vstack([moves.one(m, Kg, theta, means, details=True)[1]["jac"] for m in range(n_moves)])
+            return W @ J @ basis
+
+        z0 = np.linalg.lstsq(basis, (Kg_start - np.eye(3)).ravel(), rcond=None)[0]
+        result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200)
+        Kg = np.eye(3) + (basis @ result.x).reshape(3, 3)
+        return Kg, W
+
+    Kg = np.eye(3)
+    dark = 0.0
+    V_predicted = None
+    for iteration in range(3):
+        sources, jacobian, angles = build(Kg, dark)
+        V = sources.covariance()
+        if iteration == 0:
+            Kg, W = solve(V, Kg)
+            continue
+        if iteration == 1:
+            V_predicted = V
+        Kg, W = solve(V, Kg)
+        r = moves.residuals(Kg, theta, means)
+        Jz = jacobian @ basis
+        Vinv = np.linalg.pinv(V)
+        hat = Jz @ np.linalg.solve(Jz.T @ Vinv @ Jz, Jz.T @ Vinv)
+        if iteration == 1:
+            residual_predicted = r
+            dark = _dark_variance(r, V, hat, threshold)
+            if dark == 0.0:
+                break
+    sources, jacobian, angles = build(Kg, dark)
+    V = sources.covariance()
+    Vinv = np.linalg.pinv(V)
+    Jz = jacobian @ basis
+    information = Jz.T @ Vinv @ Jz
+    gain_z = np.linalg.solve(information, Jz.T @ Vinv)  # (rank, 2M)
+    gain = np.zeros((len(PARAMETER_NAMES), 2 * n_moves))
+    gain[KG_INDEX] = -basis @ gain_z  # Kg moves against the residual it explains
+    mask = np.zeros(len(PARAMETER_NAMES), bool)
+    mask[KG_INDEX[kg_mask]] = True
+    method = propagate(METHOD_MOVES, gain, sources, mask)
+    estimate = np.full(len(PARAMETER_NAMES), math.nan)
+    estimate[KG_INDEX[kg_mask]] = Kg.ravel()[kg_mask]
+    method = type(method)(METHOD_MOVES, estimate, method.u, method.dof, method.contributions,
+                          "Tedaldi et al. 2014, gravity sequence of the moves between poses")
+    r = moves.residuals(Kg, theta, means)
+    hat = Jz @ gain_z
+    project = np.eye(2 * n_moves) - hat
+    residual_sd = np.sqrt(np.maximum(np.diag(project @ V @ project.T), 0.0)).reshape(n_moves, 2)
+    Vp = V_predicted if V_predicted is not None else V
+    chi2 = float(residual_predicted @ np.linalg.pinv(Vp) @ residual_predicted) if V_predicted is not None else \
+        float(r @ Vinv @ r)
+    dof = 2 * n_moves - basis.shape[1]
+
+    # the frame: Kg's cross-couplings are in the case frame only where the joint fit identifies Ka's
+    identified, relative, not_identified = [], {}, {}
+    for a in range(3):
+        for b in range(3):
+            name = f"Kg{'xyz'[a]}{'xyz'[b]}"
+            if not kg_mask[3 * a + b]:
+                not_identified[name] = ident.not_identified.get(name, "the moves do not identify it")
+                continue
+            if a == b or (min(a, b), max(a, b)) not in symmetrise:
+                identified.append(name)
+            else:
+                x, y = "xyz"[a], "xyz"[b]
+                relative[name] = (f"relative to the accelerometer triad only: the moves see the body through the "
+                                  "accelerometers, whose rotation no pose placed by hand fixes; the gravity_sequence "
+                                  f"estimate is in the frame where Ka is symmetric, i.e. Kg{x}{y} − (Ka{x}{y} − "
+                                  f"Ka{y}{x})/2 to first order")
+    if dark > 0:
+        notes.append(f"the moves' residuals scatter beyond the predicted noise: {math.degrees(math.sqrt(dark)):.3g} "
+                     "deg per component between moves, estimated from them, enters every u (kind 'between')")
+    return MoveFit(transitions=tuple(transitions), unused=dict(unused), method=method, identified=tuple(identified),
+                   relative=relative, not_identified=not_identified, residual=r.reshape(n_moves, 2),
+                   residual_sd=residual_sd, angle=angles, duration=moves.duration, chi2=chi2, chi2_dof=dof,
+                   chi2_verdict=verdict(chi2, dof), between_sd=math.sqrt(dark),
+                   between_dof=float(dof), notes=tuple(notes), covariance=V)
