@@ -29,13 +29,12 @@ from scipy.stats import t as student
 from plansim.cli import main
 from plansim.fit import fit_recording
 from plansim.fit.joint import BETWEEN_LR_THRESHOLD, _chi2_verdict, _propagate, _Sources, recording_noise
-from plansim.fit.model import nominal_parameters
 from plansim.fit.moves import KG_INDEX, KG_NAMES, _Moves, find_transitions, fit_moves
 from plansim.fit.site import Site
 from plansim.io.recording import Recording, read_recording
 from plansim.kernels.trajectory import integrate_rotation, trajectory_outputs
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
-from plansim.simulate.hand_session import hand_session, spread_poses
+from plansim.model.parameters import PARAMETER_INDEX
+from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
 
 SITE = Site(math.radians(45.0), 100.0, earth_rate=False)  # no Earth rate: the simulation has none
 #: per-sample noise of a consumer MEMS unit at 100 Hz: gyro 0.3 deg/sqrt(h), accelerometer 100 ug/sqrt(Hz)
@@ -43,23 +42,8 @@ GYRO_NOISE, ACCEL_NOISE = 8.7e-4, 9.8e-3
 
 
 def unit(seed: int, cross: float = 0.0) -> np.ndarray:
-    """A unit's 39 parameters (SI): scale factors 3e-3 off, Kg cross-couplings 3e-3, Ka cross-couplings *cross*,
-    biases of a MEMS unit, G of 1e-4 rad/s per m/s^2 (20 deg/h per m/s^2)."""
-    rng = np.random.default_rng(seed)
-    theta = nominal_parameters().copy()
-    for name in PARAMETER_NAMES:
-        k = PARAMETER_INDEX[name]
-        if name.startswith("Kg"):
-            theta[k] += rng.normal() * 3e-3
-        elif name.startswith("Ka"):
-            theta[k] += rng.normal() * (2e-3 if name[2] == name[3] else cross)
-        elif name.startswith("Bg"):
-            theta[k] = rng.normal() * 0.01
-        elif name.startswith("Ba"):
-            theta[k] = rng.normal() * 0.05
-        elif name.startswith("g"):
-            theta[k] = rng.normal() * 1e-4
-    return theta
+    """A consumer unit's 39 parameters (SI; plansim.simulate.hand_session.consumer_unit)."""
+    return consumer_unit(seed, cross)
 
 
 def session(seed: int, noise: bool = True, cross: float = 0.0, poses: int = 24, **options):

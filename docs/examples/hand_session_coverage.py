@@ -21,38 +21,19 @@ import numpy as np
 from scipy.stats import t as student
 
 from plansim.fit import fit_recording
-from plansim.fit.model import nominal_parameters
 from plansim.fit.moves import KG_INDEX
 from plansim.fit.site import Site
 from plansim.io.recording import Recording
-from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
-from plansim.simulate.hand_session import hand_session, spread_poses
+from plansim.model.parameters import PARAMETER_INDEX
+from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
 
 SITE = Site(math.radians(45.0), 100.0, earth_rate=False)
-
-
-def unit(rng: np.random.Generator) -> np.ndarray:
-    """A consumer unit: scale factors and gyro cross-couplings 3e-3 off, accelerometer cross-couplings 5e-4."""
-    theta = nominal_parameters().copy()
-    for name in PARAMETER_NAMES:
-        k = PARAMETER_INDEX[name]
-        if name.startswith("Kg"):
-            theta[k] += rng.normal() * 3e-3
-        elif name.startswith("Ka"):
-            theta[k] += rng.normal() * (2e-3 if name[2] == name[3] else 5e-4)
-        elif name.startswith("Bg"):
-            theta[k] = rng.normal() * 0.01
-        elif name.startswith("Ba"):
-            theta[k] = rng.normal() * 0.05
-        elif name.startswith("g"):
-            theta[k] = rng.normal() * 1e-4
-    return theta
 
 
 def main(sessions: int, push: float) -> None:
     covered, z, chi2 = [], [], []
     for trial in range(sessions):
-        theta = unit(np.random.default_rng(100 + trial))
+        theta = consumer_unit(100 + trial, ka_cross=5e-4)
         s = hand_session(theta, spread_poses(24, seed=trial), seed=trial, gravity=SITE.gravity, gyro_noise=8.7e-4,
                          accel_noise=9.8e-3, push=push)
         moves = fit_recording(Recording(s.samples, s.schedule, {"source": "simulated"}), SITE).moves

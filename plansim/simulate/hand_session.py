@@ -71,6 +71,30 @@ def _log(R: np.ndarray) -> np.ndarray:
     return angle * w / (2.0 * math.sin(angle))
 
 
+def consumer_unit(seed: int, ka_cross: float = 0.0) -> np.ndarray:
+    """(39,) SI: a consumer MEMS unit drawn with numpy's generator seeded *seed* — scale factors and gyro
+    cross-couplings 3e-3 (1 σ) off, accelerometer scale factors 2e-3, their cross-couplings *ka_cross*, gyro biases
+    0.01 rad/s (0.6 °/s), accelerometer biases 0.05 m/s², G 1e-4 rad/s per m/s² (0.1 °/s/g in a few entries),
+    P zero."""
+    from plansim.model.parameters import PARAMETER_INDEX
+
+    rng = np.random.default_rng(seed)
+    theta = np.zeros(len(PARAMETER_NAMES))
+    for name in PARAMETER_NAMES:
+        k = PARAMETER_INDEX[name]
+        if name.startswith("Kg"):
+            theta[k] = (1.0 if name[2] == name[3] else 0.0) + rng.normal() * 3e-3
+        elif name.startswith("Ka"):
+            theta[k] = 1.0 + rng.normal() * 2e-3 if name[2] == name[3] else rng.normal() * ka_cross
+        elif name.startswith("Bg"):
+            theta[k] = rng.normal() * 0.01
+        elif name.startswith("Ba"):
+            theta[k] = rng.normal() * 0.05
+        elif name.startswith("g"):
+            theta[k] = rng.normal() * 1e-4
+    return theta
+
+
 def spread_poses(count: int, seed: int = 0) -> np.ndarray:
     """(count, 3, 3) body → world rotations whose up axes (the world's up read in the body) lie on a spiral
     that covers the sphere evenly (a Fibonacci lattice), each at a random heading; shuffled. What a careful
