@@ -417,3 +417,40 @@ def test_simulated_recording_times_are_the_nominal_ones():
     # the test logs above are built from this clock: global time, settle times included
     recording = simulated_log(settle=10.0)
     assert np.array_equal(recording.time, nominal_time(recording.schedule))
+
+
+def test_a_commented_header_and_ns_timestamps_as_euroc_writes_them(tmp_path):
+    """EuRoC / TUM-VI / Kalibr write '#timestamp [ns],w_RS_S_x [rad s^-1],…' with epoch nanoseconds: the commented
+    header names the columns, and 1.4e18 ns read as float64 keep the sample period to 256 ns (2.6e-5 of 10 ms)."""
+    t, x = synthetic_log()
+    names = ["w_RS_S_x [rad s^-1]", "w_RS_S_y [rad s^-1]", "w_RS_S_z [rad s^-1]", "a_RS_S_x [m s^-2]",
+             "a_RS_S_y [m s^-2]", "a_RS_S_z [m s^-2]"]
+    stamps = 1403636579758555392 + np.round(t * 1e9).astype(np.int64)
+    lines = ["#timestamp [ns]," + ",".join(names)]
+    lines += [f"{s}," + ",".join(f"{v:.12g}" for v in row) for s, row in zip(stamps, x)]
+    (tmp_path / "data.csv").write_text("\n".join(lines) + "\n")
+    result = import_log(tmp_path / "data.csv", columns=tuple(names), time_column="timestamp [ns]", time_unit="ns")
+    assert result.timing.sample_rate == pytest.approx(100.0, rel=1e-6)
+    assert [s.test for s in result.recording.schedule.segments] == ["static", "rotation", "static"]
+    assert result.table.header_line == 1 and not result.table.preamble
+
+
+def test_semicolons_and_decimal_commas_as_a_spreadsheet_exports_them(tmp_path, capsys):
+    """A log exported by a spreadsheet in a locale with decimal commas: 'time;gx;…' and '0,01;0,0052;…'. The values
+    are those of the same log written with points; with commas as separators a decimal comma cannot be, and a bad
+    value is still refused naming its line and column."""
+    t, x = synthetic_log()
+    write_synthetic(tmp_path / "points.csv", t, x)
+    text = (tmp_path / "points.csv").read_text().replace(",", ";").replace(".", ",")
+    (tmp_path / "commas.csv").write_text(text)
+    a = import_log(tmp_path / "points.csv", time_column="time")
+    b = import_log(tmp_path / "commas.csv", time_column="time")
+    np.testing.assert_array_equal(a.recording.samples, b.recording.samples)
+    assert b.table.decimal_comma and not a.table.decimal_comma
+    assert main(["import", str(tmp_path / "commas.csv"), "--out", str(tmp_path / "r.nc"), "--time", "time"]) == 0
+    assert "decimal comma" in capsys.readouterr().out
+    bad = text.splitlines()
+    bad[5] = bad[5].replace(";", ";x", 1)
+    (tmp_path / "bad.csv").write_text("\n".join(bad) + "\n")
+    with pytest.raises(ValueError, match="line 6; expected a number"):
+        import_log(tmp_path / "bad.csv", time_column="time")

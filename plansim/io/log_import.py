@@ -94,6 +94,7 @@ class LogTable:
     #: ("Fs,100"), skipped and reported, never read as numbers (:data:`MAX_PREAMBLE_LINES` at most)
     preamble: tuple[str, ...] = ()
     header_line: int = 1  # the file line of the header (1-based)
+    decimal_comma: bool = False  # some values were written with a decimal comma (";"- or tab-separated logs)
 
 
 @dataclass(frozen=True)
@@ -179,8 +180,9 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     Parameters
     ----------
     path : str or os.PathLike
-        The log: UTF-8 text, optional ``#`` comment lines, a header line of column names, one row per sample;
-        comma-, semicolon- or tab-separated.
+        The log: UTF-8 text, optional ``#`` comment lines, a header line of column names (a commented one
+        counts, as EuRoC's ``#timestamp [ns],w_RS_S_x [rad s^-1],…``), one row per sample; comma-, semicolon-
+        or tab-separated (with ``;`` or tabs, a decimal comma is read: ``0,123``).
     columns : tuple of 6 str or None
         The column names of gx gy gz ax ay az; columns not named (and not the time or temperature column)
         are ignored. ``None``: the columns must be named ``gx gy gz ax ay az`` and the log may hold no other.
@@ -215,7 +217,14 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         for line in fh:
             header_line += 1
             stripped = line.strip()
-            if not stripped or stripped.startswith("#"):
+            if not stripped:
+                continue
+            if stripped.startswith("#"):
+                # a commented header names the columns too (EuRoC, TUM-VI, Kalibr: "#timestamp [ns],w_RS_S_x …")
+                uncommented = stripped.lstrip("#").strip()
+                if uncommented and set(wanted) <= set(_names(uncommented)):
+                    header = uncommented
+                    break
                 continue
             if first is None:
                 first = (header_line, line)
@@ -253,6 +262,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                              "are then ignored)")
         index = [header_names.index(name) for name in wanted]
         width = len(header_names)
+        decimal_comma = False
         blocks: list[np.ndarray] = []  # rows converted block by block: floats, not text, are kept
         block: list[list[float]] = []
         lines: list[int] = []
@@ -270,7 +280,16 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
             try:
                 numbers = [float(row[k]) for k in index]
             except ValueError:
-                j = next(j for j, k in enumerate(index) if not _is_number(row[k]))
+                numbers = None
+                if delimiter != ",":  # a decimal comma (a spreadsheet's export in many locales): 0,123;4,5
+                    try:
+                        numbers = [float(row[k].replace(",", ".", 1)) if row[k].count(",") == 1 else float(row[k])
+                                   for k in index]
+                        decimal_comma = True
+                    except ValueError:
+                        numbers = None
+            if numbers is None:
+                j = next(j for j, k in enumerate(index) if not _is_number(row[k], delimiter))
                 raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
                                  "expected a number") from None
             if not all(map(math.isfinite, numbers)):
@@ -292,7 +311,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     time = data[:, 6] if time_column is not None else None
     temperature = data[:, -1] if temperature_column is not None else None
     return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
-                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line)
+                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma)
 
 
 def _delimiter(line: str) -> str:
@@ -305,11 +324,16 @@ def _names(line: str) -> list[str]:
     return [name.strip() for name in next(csv.reader([line], delimiter=_delimiter(line)))]
 
 
-def _is_number(text: str) -> bool:
+def _is_number(text: str, delimiter: str = ",") -> bool:
     try:
         float(text)
     except ValueError:
-        return False
+        if delimiter == "," or text.count(",") != 1:
+            return False
+        try:
+            float(text.replace(",", ".", 1))
+        except ValueError:
+            return False
     return True
 
 
@@ -581,6 +605,8 @@ def format_summary(result: ImportResult) -> str:
             unit_text += " after subtracting " + ", ".join(f"{c:g}" for c in result.offset) + " counts (--offset)"
     lines.append("  channels: " + " ".join(f"{c}={n}" for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
                  + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
+    if table.decimal_comma:
+        lines.append("  numbers with a decimal comma (0,123) read as such: the values are separated by ';' or tabs")
     if table.preamble:
         shown = "; ".join(table.preamble[:4]) + ("; …" if len(table.preamble) > 4 else "")
         lines.append(f"  before the header (line {table.header_line}): {len(table.preamble)} line(s) skipped, not "
