@@ -70,6 +70,34 @@ def test_a_lever_arm_is_not_identifiable_in_jjf2003_and_is_aliased_with_p():
         assert scores[effect].identifiable, effect
 
 
+def test_what_only_the_earth_rate_reaches_is_not_testable():
+    """A session of static poses by hand (no table rate): the gyros' asymmetry and nonlinearity reach the segment
+    means only through the Earth rate (15 deg/h, the only rate there is). As in the fit's identifiability, that does
+    not count: they are not identifiable, get no p-value and say what would separate them (rate points), while the
+    candidates gravity reaches (g², K2) and the drift stay testable. With the site's Earth rate on, the
+    columns are not zero: the rule, not the arithmetic, leaves them out."""
+    import math
+
+    from plansim.fit.site import Site
+    from plansim.io.recording import Recording
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    site = Site(math.radians(40.0), 50.0)
+    earth = np.array([0.0, math.cos(site.latitude), math.sin(site.latitude)]) * 7.292115e-5
+    s = hand_session(consumer_unit(3), spread_poses(16, seed=3), seed=3, gravity=site.gravity, earth_rate=earth,
+                     gyro_noise=8.7e-4, accel_noise=9.8e-3)
+    fit = fit_recording(Recording(s.samples, s.schedule, {"source": "simulated"}), site, moves=False)
+    sigs = {sig.effect: sig for sig in signatures(fit)}
+    assert np.linalg.norm(sigs["gyro_scale_asymmetry"].columns) > 0
+    assert np.all(sigs["gyro_scale_asymmetry"].designed < 1e-9)
+    scores = {sc.effect: sc for sc in score_candidates(fit, tuple(sigs.values()), null_draws=100)}
+    for effect in ("gyro_scale_asymmetry", "gyro_scale_nonlinearity"):
+        assert not scores[effect].identifiable and np.isnan(scores[effect].p_value)
+        assert "rate" in scores[effect].separating
+    for effect in ("gyro_g2_sensitivity", "accel_quadratic", "bias_drift"):
+        assert scores[effect].identifiable, effect
+
+
 def test_zero_noise_an_injected_effect_is_selected_and_the_parameters_after_are_the_truth():
     asymmetry = np.array([2e-3, -1e-3, 5e-4])
     scenario = _scenario("ideal", gyro_asymmetry=asymmetry)

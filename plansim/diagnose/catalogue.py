@@ -54,21 +54,35 @@ class Signature:
     description: str
     #: components in the same unit share a group (the excitation test compares like with like); default one group
     unit_groups: tuple[int, ...] | None = None
+    #: (m,) the part of each component's column that the designed excitation (table rates, gravity; the Earth rate
+    #: left out) gives, ‖x without the Earth rate‖/‖x‖: near 0 when only the Earth rate reaches the component (a
+    #: gyro's asymmetry seen in static poses through 15 °/h), which, as in the fit's identifiability, does not
+    #: count; None: 1 for every component
+    designed: np.ndarray | None = None
 
     def groups(self) -> np.ndarray:
         return np.zeros(len(self.components), dtype=int) if self.unit_groups is None else np.asarray(self.unit_groups)
 
 
-def _kernel_columns(fit, argument: str, entries) -> np.ndarray:
-    """Columns (S, 6, m) of the kernel's effect array *argument* at each (row, column) of *entries*."""
+def _kernel_columns(fit, argument: str, entries) -> tuple[np.ndarray, np.ndarray]:
+    """Columns (S, 6, m) of the kernel's effect array *argument* at each (row, column) of *entries*, and (m,) the
+    part of each that the designed excitation gives (:attr:`Signature.designed`)."""
     model, theta, tilts = fit.model, fit.theta, fit.nuisance
-    base = model.means(theta, tilts)
-    out = []
+    draws = model.draws(theta, tilts)
+    no_earth = np.zeros(3)
+    base = model.averaged(draws, effects=None)[0]
+    base_designed = model.averaged(draws, earth_enu=no_earth, effects=None)[0]
+    out, designed = [], []
     for index in entries:
         effects = model.effect_arguments()
         effects[argument][index] += STEP
-        out.append((model.means(theta, tilts, effects={argument: effects[argument]}) - base) / STEP)
-    return np.stack(out, axis=-1)
+        column = (model.averaged(draws, effects={argument: effects[argument]})[0] - base) / STEP
+        without = (model.averaged(draws, earth_enu=no_earth, effects={argument: effects[argument]})[0]
+                   - base_designed) / STEP
+        out.append(column)
+        norm = float(np.linalg.norm(column))
+        designed.append(float(np.linalg.norm(without)) / norm if norm > 0 else 0.0)
+    return np.stack(out, axis=-1), np.array(designed)
 
 
 def signatures(fit) -> tuple[Signature, ...]:
@@ -76,22 +90,27 @@ def signatures(fit) -> tuple[Signature, ...]:
     if fit.model is None or fit.theta is None:
         raise ValueError("fit: it carries no model (a FitResult from plansim.fit.fit_recording is needed)")
     S = fit.observed.shape[0]
+    asymmetry = _kernel_columns(fit, "sensor", [(EFF_GYRO_ASYMMETRY, a) for a in range(3)])
+    quadratic = _kernel_columns(fit, "sensor", [(EFF_GYRO_QUADRATIC, a) for a in range(3)])
+    cubic = _kernel_columns(fit, "sensor", [(EFF_GYRO_CUBIC, a) for a in range(3)])
+    g2 = _kernel_columns(fit, "S2", [(i, j) for i in range(3) for j in range(3)])
+    k2 = _kernel_columns(fit, "sensor", [(EFF_ACCEL_SECOND_ORDER, a) for a in range(3)])
     out = [
-        Signature("gyro_scale_asymmetry", tuple(AXES), "1",
-                  _kernel_columns(fit, "sensor", [(EFF_GYRO_ASYMMETRY, a) for a in range(3)]), "gyro_asymmetry",
-                  "the scale factor differs between positive and negative rates: (K+ − K−)/K per gyro"),
+        Signature("gyro_scale_asymmetry", tuple(AXES), "1", asymmetry[0], "gyro_asymmetry",
+                  "the scale factor differs between positive and negative rates: (K+ − K−)/K per gyro",
+                  designed=asymmetry[1]),
         Signature("gyro_scale_nonlinearity", tuple(f"{a}2" for a in AXES) + tuple(f"{a}3" for a in AXES),
                   "1/(rad/s) (x2 y2 z2), 1/(rad/s)^2 (x3 y3 z3)",
-                  np.concatenate([_kernel_columns(fit, "sensor", [(EFF_GYRO_QUADRATIC, a) for a in range(3)]),
-                                  _kernel_columns(fit, "sensor", [(EFF_GYRO_CUBIC, a) for a in range(3)])], axis=-1),
+                  np.concatenate([quadratic[0], cubic[0]], axis=-1),
                   "gyro_nonlinearity_quadratic, gyro_nonlinearity_cubic",
-                  "the gyro output has terms in ω² and ω³ of its own rate", (0, 0, 0, 1, 1, 1)),
+                  "the gyro output has terms in ω² and ω³ of its own rate", (0, 0, 0, 1, 1, 1),
+                  designed=np.concatenate([quadratic[1], cubic[1]])),
         Signature("gyro_g2_sensitivity", tuple(f"{i}{j}" for i in AXES for j in AXES), "rad/s/(m/s^2)^2",
-                  _kernel_columns(fit, "S2", [(i, j) for i in range(3) for j in range(3)]), "gyro_g2_sensitivity",
-                  "the gyro output has terms in products of the specific-force components (g²-sensitivity)"),
-        Signature("accel_quadratic", tuple(AXES), "1/(m/s^2)",
-                  _kernel_columns(fit, "sensor", [(EFF_ACCEL_SECOND_ORDER, a) for a in range(3)]),
-                  "accel_second_order", "the accelerometer output has a term K2·f² in its own specific force"),
+                  g2[0], "gyro_g2_sensitivity",
+                  "the gyro output has terms in products of the specific-force components (g²-sensitivity)",
+                  designed=g2[1]),
+        Signature("accel_quadratic", tuple(AXES), "1/(m/s^2)", k2[0], "accel_second_order",
+                  "the accelerometer output has a term K2·f² in its own specific force", designed=k2[1]),
     ]
     times = np.asarray(fit.segment_times, dtype=float)
     drift = np.zeros((S, 6, 6))
@@ -99,9 +118,10 @@ def signatures(fit) -> tuple[Signature, ...]:
         drift[:, c, c] = times - times.mean()
     out.append(Signature("bias_drift", CHANNELS, "rad/s/s (gyros), m/s^2/s (accelerometers)", drift, None,
                          "a bias that drifts linearly in time over the recording (per channel)", (0, 0, 0, 1, 1, 1)))
-    out.append(Signature("lever_arm", tuple(f"{i}{k}" for i in AXES for k in AXES), "m",
-                         _kernel_columns(fit, "lever", [(i, k) for i in range(3) for k in range(3)]), "accel_lever_arm",
-                         "accelerometer i sits off the turning axis: the centripetal acceleration ω×(ω×r)"))
+    lever = _kernel_columns(fit, "lever", [(i, k) for i in range(3) for k in range(3)])
+    out.append(Signature("lever_arm", tuple(f"{i}{k}" for i in AXES for k in AXES), "m", lever[0], "accel_lever_arm",
+                         "accelerometer i sits off the turning axis: the centripetal acceleration ω×(ω×r)",
+                         designed=lever[1]))
     for signature in out:  # rows the fit does not fit (a hand turn's accelerometers) carry no signature
         signature.columns[~fit.fitted_rows] = 0.0
     return tuple(out)

@@ -71,6 +71,10 @@ ALIAS_TOLERANCE = 1e-3
 #: largest (a second-order path only, such as a lever arm across an accelerometer's own axis through Ka's
 #: cross-couplings)
 EXCITATION_TOLERANCE = 1e-2
+#: a component whose column the designed excitation (table rates, gravity) gives less than this part of, the rest
+#: being the Earth rate's, counts as not excited: the fit's rule for the 39 parameters (docs/fitting.md,
+#: Identifiability), for the candidates (a gyro's asymmetry in static poses, through 15 °/h, is not testable)
+EARTH_ONLY_TOLERANCE = 1e-3
 #: the step test leaves out a channel whose segment means' predicted variance is more than this share an undithered
 #: quantiser's (jjf2003's 12-bit accelerometers: all of it). Their means sit on a few codes, V describes their
 #: scatter only roughly, and a step statistic — the largest of many 1-dof scores, sensitive to one odd segment —
@@ -266,6 +270,8 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         groups = sig.groups()
         largest = np.array([norms[groups == grp].max() for grp in groups])
         excited = norms > EXCITATION_TOLERANCE * np.maximum(largest, 1e-300)
+        if sig.designed is not None:  # reached by the Earth rate alone: true, and of no use (docs/fitting.md)
+            excited &= sig.designed > EARTH_ONLY_TOLERANCE
         usable = excited & (surviving > ALIAS_TOLERANCE * np.maximum(norms, 1e-300))
         # noise-equivalent size: the size at which the component alone gives its 1-dof score a non-centrality of 1,
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
