@@ -829,3 +829,32 @@ def test_a_channel_that_reads_one_code_in_every_pose_takes_the_stated_step_not_e
     bare = fit_recording(recording, site, **{k: v for k, v in options.items() if k != "stated_step"})
     assert bare.noise.channels[5].quantisation_step == 0.0
     assert any("weigh as exact" in note for note in bare.noise.notes)
+
+
+def test_the_quantisers_covariance_is_the_full_harmonic_sum():
+    """quantiser_covariance sums the first harmonics over every pair and the rest only where the damping leaves
+    something: against the direct sum of all 2000 harmonics over all pairs (segments never leaving their level,
+    b_k ~ q/πk, and dithered ones; 20 segments at one level), equal to 1e-12 of the largest entry."""
+    import math
+
+    from plansim.fit.joint import quantiser_covariance
+    from plansim.fit.noise import quantisation_harmonics
+
+    rng = np.random.default_rng(0)
+    S, q = 120, 0.0039
+    sigma = np.where(rng.random(S) < 0.5, 0.0, rng.uniform(0.0, 0.2, S)) * q
+    b = quantisation_harmonics(q, sigma)
+    mu = rng.uniform(0.0, 10.0, S) * q
+    mu[:20] = mu[0]
+    level = np.diag(rng.uniform(0.0, 0.01, S) * q**2)
+    level[:20, :20] = 0.999 * level[0, 0]
+    np.fill_diagonal(level, np.maximum(np.diag(level), level[0, 0]))
+    var_diff = np.maximum(np.diag(level)[:, None] + np.diag(level)[None, :] - 2.0 * level, 0.0)
+    difference = mu[:, None] - mu[None, :]
+    direct = np.zeros((S, S))
+    for k in range(1, b.shape[0] + 1):
+        direct += (0.5 * np.outer(b[k - 1], b[k - 1]) * np.cos(2 * math.pi * k * difference / q)
+                   * np.exp(-2 * math.pi**2 * k**2 * var_diff / q**2))
+    assert b.shape[0] == 2000
+    np.testing.assert_allclose(quantiser_covariance(b, difference, var_diff, q), direct, rtol=0,
+                               atol=1e-12 * np.abs(direct).max())
