@@ -89,6 +89,14 @@ def add_set_option(p) -> None:
                         "(dotted key as in the scenario file; repeatable; checked as the file is)")
 
 
+def add_procedure_option(p) -> None:
+    """``--procedure KEY=VALUE`` (repeatable): a setting of the JJF 1535 procedure
+    (:class:`plansim.schedule.jjf1535.Jjf1535Settings`), checked by building it."""
+    p.add_argument("--procedure", action="append", default=[], metavar="KEY=VALUE",
+                   help="with the procedure jjf1535: one of its settings, e.g. --procedure points=15 --procedure "
+                        "repeats=5 --procedure maximum_rate=\"100 deg/s\" (repeatable; docs/jjf1535.md)")
+
+
 def run_experiment(args, run, figure, as_json, as_text) -> int:
     """The tail of ``plansim run`` for a built-in experiment (``jjf1537``, ``vibration_g2``), once its options are
     checked: *run* () → result, timed; ``--plot`` written by *figure* (result, path, format) and committed with the

@@ -57,8 +57,8 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
     from plansim.report.jjf1535 import header, items_json, items_table, not_simulated_json
     from plansim.report.progress import end_progress_line, stderr_progress
     from plansim.runner import jjf1535_angle_random_walk, jjf1535_run
-    from plansim.schedule.jjf1535 import jjf1535_procedure
-    from plansim.uncertainty.jjf1535_monte_carlo import DEFAULT_MAXIMUM_RATE, jjf1535_scenario
+    from plansim.simulate.overrides import jjf1535_settings
+    from plansim.uncertainty.jjf1535_monte_carlo import jjf1535_scenario
 
     # every check before any work: the options that do not apply, the numbers, the unit
     for option, value in (("--out", args.out), ("--plot", args.plot)):
@@ -73,7 +73,8 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
     unit = _load_unit(args)
-    procedure = jjf1535_procedure(DEFAULT_MAXIMUM_RATE)
+    settings = jjf1535_settings(args.procedure or ())
+    procedure = settings.procedure()
     jjf1535_scenario(unit, procedure)  # refuses a unit the procedure would drive past its limits, before any work
 
     options = {} if args.trials is None else {"trials": args.trials}
@@ -88,6 +89,7 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
     if args.json:
         print(json.dumps({
             "procedure": "jjf1535", "unit_scenario": unit.name, "overrides": list(unit.overrides),
+            "procedure_settings": list(settings.overrides),
             "trials": result.trials, "seed": result.seed, "path": result.path,
             "plansim_version": _version(), "elapsed_s": elapsed,
             "units": "SI: each item's 'unit'; budget_U and the *_relative figures are relative (Appendix A reads "
@@ -99,6 +101,8 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
         }, indent=2))
     else:
         print(header(result, unit, procedure, elapsed))
+        if settings.overrides:
+            print(f"Procedure settings (--procedure): {'; '.join(settings.overrides)}")
         print()
         print(items_table(rows, arw))
     return 0
@@ -121,20 +125,24 @@ def validate_jjf1535_command(args) -> int:
     """
     from plansim.report.progress import end_progress_line
     from plansim.report.validation import format_jjf1535_report, jjf1535_json, validate_progress
+    from plansim.simulate.overrides import jjf1535_settings
     from plansim.uncertainty.jjf1535_validation import validate_jjf1535
 
     if args.claims:
         raise ValueError(VALIDATE_CLAIMS_REFUSAL)
     unit = _load_unit(args)
+    settings = jjf1535_settings(args.procedure or ())
     progress = validate_progress(f"plansim validate jjf1535 --unit {unit.name}", args.quiet or args.json)
-    report = validate_jjf1535(unit, digits=args.digits, trials_per_block=args.trials_per_block,
+    report = validate_jjf1535(unit, settings.procedure(), digits=args.digits, trials_per_block=args.trials_per_block,
                               max_trials=args.max_trials, seed=args.seed, path=args.path, progress=progress)
     end_progress_line()
     if args.json:
         print(json.dumps({**jjf1535_json(report), "overrides": list(unit.overrides),
-                          "plansim_version": _version()}, indent=2))
+                          "procedure_settings": list(settings.overrides), "plansim_version": _version()}, indent=2))
     else:
         if unit.overrides:
             print(f"Overrides (--set): {'; '.join(unit.overrides)}")
+        if settings.overrides:
+            print(f"Procedure settings (--procedure): {'; '.join(settings.overrides)}")
         print(format_jjf1535_report(report, details=not args.summary))
     return 0

@@ -7,9 +7,71 @@ import json
 import os
 import time
 
-from plansim.cli.common import COMMANDS, add_set_option
+from plansim.cli.common import COMMANDS, add_procedure_option, add_set_option
 from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
+
+
+def _cmd_sweep_jjf1535(args) -> int:
+    """``plansim sweep jjf1535``: the JJF 1535 Monte Carlo over a grid of its settings and the unit's fields."""
+    from plansim.planning.grid import load_grid
+    from plansim.planning.jjf1535_sweep import cheapest_cell, jjf1535_cells, sweep_jjf1535
+    from plansim.report.jjf1535 import parse_targets, sweep_jjf1535_json, sweep_jjf1535_table
+    from plansim.report.progress import end_progress_line, stderr_progress
+
+    # every check before any work: options that do not apply, the outputs, the grid, the targets, every cell
+    for option, value in (("--predict-only", args.predict_only), ("--executor", args.executor != "serial"),
+                          ("--workers", args.workers is not None), ("--scheduler", args.scheduler is not None)):
+        if value:
+            raise ValueError(f"{option}: not available with the procedure jjf1535 (its cells are a Monte Carlo, "
+                             "run one after another)")
+    if args.out is not None:
+        check_output_path(args.out, "--out", (".nc",))
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    if args.trials is not None and args.trials < 2:
+        raise ValueError(f"--trials {args.trials}: must be >= 2 (the standard deviations need two trials)")
+    unit = args.unit or "jjf2003"
+    grid = load_grid(args.grid)
+    targets = parse_targets(args.target)
+    jjf1535_cells(unit, grid, args.set, args.procedure)
+    trials = 1000 if args.trials is None else args.trials
+    with OutputSet() as outputs:
+        out = outputs.stage(args.out, "--out", (".nc",)) if args.out is not None else None
+        plot = outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES) if args.plot is not None else None
+        progress = None if (args.quiet or args.json) else stderr_progress("plansim sweep jjf1535", unit="cells")
+        start = time.perf_counter()
+        result = sweep_jjf1535(unit, grid, unit_overrides=args.set, procedure_overrides=args.procedure,
+                               trials=trials, seed=args.seed, path=args.path, progress=progress)
+        elapsed = time.perf_counter() - start
+        end_progress_line()
+        best = cheapest_cell(result, targets) if targets else None
+        if out is not None:
+            result.to_netcdf(out, engine="h5netcdf")
+        if plot is not None:
+            from plansim.report.plot import sweep_jjf1535_figure
+
+            sweep_jjf1535_figure(result, plot, list(targets) or None, targets,
+                                 format=os.path.splitext(args.plot)[1].lstrip("."))
+        outputs.commit()
+    if args.json:
+        print(json.dumps({**sweep_jjf1535_json(result, targets, best), "elapsed_s": elapsed}, indent=2,
+                         allow_nan=False))
+    else:
+        print(f"plansim sweep jjf1535 --unit {unit}: {grid.size} cells, {trials} trials per cell, seed "
+              f"{result.attrs['seed']}, {elapsed:.1f} s")
+        for label, items in (("Overrides (--set) on every cell", args.set),
+                             ("Procedure settings (--procedure) on every cell", args.procedure)):
+            if items:
+                print(f"{label}: {'; '.join(items)}")
+        print()
+        print(sweep_jjf1535_table(result, targets, best))
+        for label, path in (("sweep", args.out), ("figure", args.plot)):
+            if path:
+                print(f"\nwrote {label}: {path}")
+    return 0
 
 
 def _cmd_sweep(args) -> int:
@@ -19,6 +81,12 @@ def _cmd_sweep(args) -> int:
     from plansim.report.progress import end_progress_line, stderr_progress
     from plansim.report.sweep import sweep_json, sweep_table
 
+    if args.scenario == "jjf1535":
+        return _cmd_sweep_jjf1535(args)
+    for option, value in (("--unit", args.unit), ("--procedure", args.procedure), ("--target", args.target)):
+        if value:
+            raise ValueError(f"{option}: only with the procedure jjf1535 (plansim sweep jjf1535 --grid GRID "
+                             f"{option} …); the scenario {args.scenario!r} is its own unit")
     # every check before any work: the outputs, the grid, the scenario and every cell
     if args.out is not None:
         check_output_path(args.out, "--out", (".nc",))
@@ -125,10 +193,19 @@ def add_commands(sub) -> None:
         description="Predict (GUM) and simulate (Monte Carlo) a scenario over a grid of its fields: "
                     "uncertainty, table time and JJF 2003 compliance per cell (docs/planning.md)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
-                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003")
+                   help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003; or the "
+                        "procedure jjf1535 (a Monte Carlo per cell of its settings; docs/jjf1535.md)")
     p.add_argument("--grid", required=True,
-                   help="grid file (TOML): [vary] field = [values, ...], optional [zip] (docs/planning.md)")
+                   help="grid file (TOML): [vary] field = [values, ...], optional [zip] (docs/planning.md); with "
+                        "jjf1535, keys procedure.SETTING or the unit's fields")
     add_set_option(p)
+    p.add_argument("--unit", default=None, metavar="SCENARIO",
+                   help="with the procedure jjf1535: the unit scenario (default jjf2003)")
+    add_procedure_option(p)
+    p.add_argument("--target", action="append", default=[], metavar="ITEM=VALUE",
+                   help="with the procedure jjf1535: the largest acceptable 95 %% |error| of an item (its spread "
+                        "where it has no true value), in the item's unit as the report prints it, e.g. "
+                        "--target nonlinearity=100 (ppm); the shortest session meeting every target is named")
     how = p.add_mutually_exclusive_group()
     how.add_argument("--trials", type=int, default=None,
                      help="Monte Carlo trials per cell (default: the scenario's)")

@@ -6,7 +6,7 @@ import json
 import os
 import time
 
-from plansim.cli.common import COMMANDS, add_set_option
+from plansim.cli.common import COMMANDS, add_procedure_option, add_set_option
 from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, run_jjf1535, validate_jjf1535_command
 from plansim.cli.jjf1537 import DYNAMIC_TESTS, run_jjf1537_command
 from plansim.cli.vibration import EXPERIMENTS as VIBRATION_EXPERIMENTS
@@ -192,6 +192,7 @@ def _add_validate_command(sub) -> None:
                    help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
                         f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
+    add_procedure_option(p)
     p.add_argument("--claims", default=None,
                    help="TOML file of claimed expanded uncertainties ([items.\"A.2\"] U = ...; [parameters.Bgx] "
                         "U = \"10 deg/h\"; k = 2 by default); default: the Appendix A budgets as printed")
@@ -226,6 +227,7 @@ def add_commands(sub) -> None:
                    help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
                         f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
+    add_procedure_option(p)
     p.add_argument("--trials", type=int, default=None,
                    help="number of simulated calibrations (default: the scenario's; jjf1535: 1000; jjf1537: 500)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's, or the unit's)")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from plansim.estimate.jjf1535_items import ITEMS
 from plansim.io.recording import plansim_version
 from plansim.uncertainty.jjf1535_monte_carlo import (
@@ -242,3 +244,123 @@ def _effects_line(unit, procedure) -> str:
             f"{_g(e.gyro_resolution[i] / DEG)} °/s, warm-up {_g(e.gyro_warm_up_amplitude[i] / (DEG / HOUR))} °/h × "
             f"exp(−t/{_g(e.gyro_warm_up_time_constant[i])} s), turn-on bias σ "
             f"{_g(e.gyro_turn_on_bias[i] / (DEG / HOUR))} °/h per power cycle")
+
+
+# ------------------------------------------------------------------------------------------ plansim sweep jjf1535
+
+#: the items the sweep's table shows when no target names others
+SWEEP_ITEMS = ("scale_factor", "nonlinearity", "asymmetry", "scale_repeatability", "bias_up_down", "bias_stability")
+
+
+def parse_targets(items) -> dict:
+    """``--target ITEM=VALUE`` items as {item: value, SI}: VALUE in the item's JJF 1535 unit as the report prints
+    it (:data:`plansim.estimate.jjf1535_items.ITEMS`; ppm, deg/h, …), optionally followed by that unit."""
+    out = {}
+    for text in items:
+        name, sep, value = str(text).partition("=")
+        name, value = name.strip(), value.strip().strip("'\"")
+        if not sep or name not in ITEMS:
+            raise ValueError(f"--target {text!r}: expected ITEM=VALUE with ITEM one of {', '.join(ITEMS)}")
+        unit, scale = ITEMS[name][2], ITEMS[name][3]
+        number, _, given = value.partition(" ")
+        if given.strip() and given.strip() != unit:
+            raise ValueError(f"--target {text!r}: {name} is in {unit}; give the number in it (or '<number> {unit}')")
+        try:
+            number = float(number)
+        except ValueError:
+            raise ValueError(f"--target {text!r}: {number!r} is not a number") from None
+        if not (number > 0 and math.isfinite(number)):
+            raise ValueError(f"--target {text!r}: expected a positive number of {unit}")
+        if name in out:
+            raise ValueError(f"--target {text!r}: {name} is given twice")
+        out[name] = number * scale
+    return out
+
+
+def sweep_cells(ds):
+    """Yield ``(dims, index, {dim: index})`` of every cell of a JJF 1535 sweep Dataset, in C order."""
+    dims = list(ds["session_hours"].dims)
+    for index in np.ndindex(*ds["session_hours"].shape):
+        yield dims, index, dict(zip(dims, index))
+
+
+def compared_value(ds, where, item) -> tuple[float, str]:
+    """The figure a target is compared with: the 95 % |error| where the item has a true value, else the spread."""
+    u95 = float(ds["mc_U95"].isel(where).sel(item=item))
+    if math.isfinite(u95):
+        return u95, "U95"
+    return float(ds["figure_std"].isel(where).sel(item=item)), "sd"
+
+
+def sweep_jjf1535_table(ds, targets: dict, best: dict | None) -> str:
+    """The sweep as text: per cell its fields, the session's hours and, per item, the 95 % |error| (U95) or the
+    reported figure's standard deviation (sd), in the item's JJF 1535 unit; then the cheapest cell that meets
+    the targets."""
+    items = list(targets) or list(SWEEP_ITEMS)
+    fields = ds.attrs["fields"].split("; ")
+    head = [f"{f:>24s}" for f in fields] + [f"{'hours':>7s}"]
+    kinds = {}
+    for item in items:
+        first = next(sweep_cells(ds))[2]
+        kinds[item] = compared_value(ds, first, item)[1]
+        head.append(f"{item + ' ' + kinds[item]:>26s}")
+    lines = ["per item: U95 = 95 % quantile of |reported - true| over the trials; sd = standard deviation of the "
+             "reported figure (no true value); in the item's unit: "
+             + ", ".join(f"{i} {ITEMS[i][2]}" for i in items), " ".join(head)]
+    for _, index, where in sweep_cells(ds):
+        row = [f"{str(v):>24s}" for v in cell_fields(ds, index).values()]
+        row.append(f"{float(ds['session_hours'].isel(where)):7.2f}")
+        for item in items:
+            value, _ = compared_value(ds, where, item)
+            mark = ""
+            if item in targets:
+                mark = " ok" if math.isfinite(value) and value <= targets[item] else "   "
+            row.append(f"{_g(value / ITEMS[item][3], 4):>23s}{mark}")
+        lines.append(" ".join(row))
+    if targets:
+        wanted = ", ".join(f"{i} <= {_g(v / ITEMS[i][3])} {ITEMS[i][2]}" for i, v in targets.items())
+        if best is None:
+            lines.append(f"\nNo cell meets every target ({wanted}).")
+        else:
+            fields = "; ".join(f"{k} = {v}" for k, v in best["fields"].items())
+            lines.append(f"\nShortest session meeting every target ({wanted}): {fields}, "
+                         f"{best['session_hours']:.2f} h")
+    return "\n".join(lines)
+
+
+def sweep_jjf1535_json(ds, targets: dict, best: dict | None) -> dict:
+    """The sweep as one JSON object, SI: ``cells`` [{fields, session_hours, segments, seed, items: [{item, unit,
+    mean_error, std_error, mc_U95, figure: {mean, std, q025, q975}, undetermined}]}], ``targets`` and ``best``."""
+    cells = []
+    for _, index, where in sweep_cells(ds):
+        entry = {"fields": cell_fields(ds, index),
+                 "session_hours": float(ds["session_hours"].isel(where)),
+                 "segments": int(ds["segments"].isel(where)), "seed": int(ds["seed"].isel(where)), "items": []}
+        for item in ds["item"].values:
+            v = {name: _number(float(ds[name].isel(where).sel(item=item))) for name in
+                 ("mean_error", "std_error", "mc_U95", "figure_mean", "figure_std", "figure_q025", "figure_q975",
+                  "undetermined")}
+            entry["items"].append({"item": str(item), "unit": str(ds["item_unit"].sel(item=item).values),
+                                   "mean_error": v["mean_error"], "std_error": v["std_error"], "mc_U95": v["mc_U95"],
+                                   "figure": {k: v[f"figure_{k}"] for k in ("mean", "std", "q025", "q975")},
+                                   "undetermined": v["undetermined"]})
+        cells.append(entry)
+    return {"procedure": "jjf1535", "unit_scenario": ds.attrs["unit_scenario"],
+            "trials_per_cell": int(ds.attrs["trials_per_cell"]), "seed": int(ds.attrs["seed"]),
+            "plansim_version": ds.attrs["plansim_version"], "cells": cells,
+            "targets": [{"item": i, "value": v, "unit": SI_UNITS[ITEMS[i][2]],
+                         "compared_with": "mc_U95 (95 % |error|), or the figure's std where there is no true value"}
+                        for i, v in targets.items()],
+            "best": None if best is None else {"fields": best["fields"], "session_hours": best["session_hours"],
+                                               "values": best["values"]}}
+
+
+def cell_fields(ds, index) -> dict:
+    """The grid fields of the cell at *index* (of the dimensions of ``session_hours``), as the grid wrote them."""
+    dims = list(ds["session_hours"].dims)
+    out = {}
+    for field in ds.attrs["fields"].split("; "):
+        coordinate = ds[field]
+        value = coordinate.values[index[dims.index(coordinate.dims[0])]]
+        out[field] = value.item() if hasattr(value, "item") else value
+    return out

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -212,4 +213,59 @@ def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> N
     fig.suptitle(f"plansim sweep of {sweep.attrs.get('scenario', '?')}: "
                  + (f"{trials} Monte Carlo trials per cell" if trials > 1 else "the prediction (GUM) only"),
                  fontsize=10)
+    save(fig, path, chosen, dpi=110)
+
+
+def sweep_jjf1535_figure(sweep, path: str | os.PathLike, items=None, targets=None, format: str | None = None) -> None:
+    """``plansim sweep jjf1535 --plot``: per item, its 95 % |error| (or the reported figure's standard deviation
+    where it has no true value) against the session's length, one point per cell, labelled with the cell's fields;
+    a target drawn as a dashed line.
+
+    Parameters
+    ----------
+    sweep : xarray.Dataset
+        :func:`plansim.planning.jjf1535_sweep.sweep_jjf1535`'s output (or its NetCDF file, opened).
+    path : str or os.PathLike
+        The figure file, written whole or not at all.
+    items : list of str, optional
+        The items drawn (default :data:`plansim.report.jjf1535.SWEEP_ITEMS`).
+    targets : dict, optional
+        item → target, SI.
+    format : {"png", "pdf", "svg"}, optional
+    """
+    from plansim.estimate.jjf1535_items import ITEMS
+    from plansim.report.jjf1535 import SWEEP_ITEMS, cell_fields, compared_value, sweep_cells
+
+    chosen = figure_format(path, format)
+    plt = pyplot()
+    items = list(items or SWEEP_ITEMS)
+    targets = targets or {}
+    columns = min(3, len(items))
+    rows = math.ceil(len(items) / columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.3 * columns, 3.4 * rows), constrained_layout=True,
+                             squeeze=False)
+    for ax, item in zip(axes.ravel(), items):
+        scale, unit = ITEMS[item][3], ITEMS[item][2]
+        hours, values, labels, kind = [], [], [], "U95"
+        for _, index, where in sweep_cells(sweep):
+            value, kind = compared_value(sweep, where, item)
+            hours.append(float(sweep["session_hours"].isel(where)))
+            values.append(value / scale)
+            labels.append(", ".join(f"{f.split('.')[-1]}={v}" for f, v in cell_fields(sweep, index).items()
+                                    if sweep[f].size > 1))  # the fields that vary
+        ax.plot(hours, values, "o", color="tab:blue", ms=5)
+        for x, y, text in zip(hours, values, labels):
+            ax.annotate(text, (x, y), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        if item in targets:
+            ax.axhline(targets[item] / scale, ls="--", color="tab:red", lw=1.0, label="target")
+            ax.legend(fontsize=7)
+        ax.set_title(f"{item} ({ITEMS[item][0]}): {'95 % |error|' if kind == 'U95' else 'sd of the figure'}",
+                     fontsize=9)
+        ax.set_xlabel("session (h)", fontsize=8)
+        ax.set_ylabel(unit, fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in axes.ravel()[len(items):]:
+        ax.set_visible(False)
+    fig.suptitle(f"plansim sweep jjf1535 on {sweep.attrs.get('unit_scenario', '?')}: "
+                 f"{sweep.attrs.get('trials_per_cell', '?')} trials per cell", fontsize=10)
     save(fig, path, chosen, dpi=110)

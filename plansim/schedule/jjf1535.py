@@ -382,3 +382,56 @@ def jjf1535_procedure(maximum_rate: float, axis: str = "x", points: int | None =
     on += [float(starts[rec[0]] - segments[rec[0]].settle) for rec in room_bias[1:]]
     on += [float(starts[rec[0]]) for rec in warm_up]
     return dataclasses.replace(procedure, power_on=tuple(sorted(on)))
+
+
+@dataclass(frozen=True)
+class Jjf1535Settings:
+    """The settings of :func:`jjf1535_procedure` a lab chooses, SI (rad/s, s, Hz, °C), as one value: what
+    ``plansim run jjf1535 --procedure KEY=VALUE`` and ``plansim sweep jjf1535`` vary (:data:`SETTING_KINDS`).
+
+    Every field is an argument of :func:`jjf1535_procedure` of the same name (its docstring says what each one
+    is and which clause asks for it); ``points = 0`` keeps every R5 point. ``overrides`` holds the
+    ``KEY=VALUE`` items that made it, for the report.
+    """
+
+    maximum_rate: float = 100.0 * DEG
+    axis: str = "x"
+    points: int = 0
+    minimum_rate: float = 1.0 * DEG
+    repeats: int = 3
+    repeat_interval: float = 1800.0
+    settle: float = 10.0
+    sample_rate: float = 1.0 / SAMPLE_PERIOD
+    averaging_period: float = 10.0
+    bias_periods: int = 60
+    position_dwell: float = 60.0
+    allan_duration: float = 7200.0
+    room_temperature: float = 20.0
+    upper_temperature: float = 60.0
+    lower_temperature: float = -20.0
+    soak: float = 3600.0
+    threshold_maximum: float = 0.1 * DEG
+    threshold_minimum: float = 0.001 * DEG
+    resolution_base_rate: float = 0.5 * DEG
+    warm_up_duration: float = 1200.0
+    warm_up_records: int = 2
+    specified_stability: float = 10.0 * DEG / 3600.0
+    power_on_lead: float = 1800.0
+    overrides: tuple[str, ...] = ()
+
+    def procedure(self) -> Jjf1535Procedure:
+        """The procedure these settings describe (every check of :func:`jjf1535_procedure` applies)."""
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "overrides"}
+        values["points"] = None if values["points"] == 0 else values["points"]
+        return jjf1535_procedure(values.pop("maximum_rate"), **values)
+
+
+#: each setting's kind for ``KEY=VALUE`` (a unit kind of :data:`plansim.units.KINDS`, ``count`` or ``choice``)
+SETTING_KINDS = {"maximum_rate": "angular_rate", "axis": "choice", "points": "count", "minimum_rate": "angular_rate",
+                 "repeats": "count", "repeat_interval": "time", "settle": "time", "sample_rate": "frequency",
+                 "averaging_period": "time", "bias_periods": "count", "position_dwell": "time",
+                 "allan_duration": "time", "room_temperature": "temperature", "upper_temperature": "temperature",
+                 "lower_temperature": "temperature", "soak": "time", "threshold_maximum": "angular_rate",
+                 "threshold_minimum": "angular_rate", "resolution_base_rate": "angular_rate",
+                 "warm_up_duration": "time", "warm_up_records": "count", "specified_stability": "angular_rate",
+                 "power_on_lead": "time"}

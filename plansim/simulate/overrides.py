@@ -13,7 +13,8 @@ import dataclasses
 from plansim.units import parse_quantity
 
 
-def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), count_minimum: dict | None = None):
+def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), count_minimum: dict | None = None,
+                    option: str = "--set"):
     """*settings* (a frozen dataclass with an ``overrides`` tuple) with ``KEY=VALUE`` strings applied.
 
     Parameters
@@ -28,6 +29,8 @@ def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), coun
         The kinds taken as written (a choice of names, a set of axes).
     count_minimum : dict, optional
         field -> the smallest count allowed, for the error message.
+    option : str
+        The command-line option the items came with, for the error message.
 
     Returns
     -------
@@ -44,7 +47,7 @@ def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), coun
         key, sep, text = str(item).partition("=")
         key, text = key.strip(), text.strip().strip("'\"")
         if not sep or key not in kinds:
-            raise ValueError(f"--set {item!r}: expected KEY=VALUE with KEY one of {', '.join(kinds)}")
+            raise ValueError(f"{option} {item!r}: expected KEY=VALUE with KEY one of {', '.join(kinds)}")
         kind = kinds[key]
         if kind in words:
             changes[key] = text
@@ -53,11 +56,27 @@ def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), coun
                 changes[key] = int(text)
             except ValueError:
                 least = (count_minimum or {}).get(key)
-                raise ValueError(f"--set {item!r}: {key} expects an integer"
+                raise ValueError(f"{option} {item!r}: {key} expects an integer"
                                  + ("" if least is None else f" >= {least}")) from None
         else:
             try:  # a bare number is a dimensionless quantity with the unit ''
                 changes[key] = parse_quantity(text, kind, key)
             except ValueError as exc:
-                raise ValueError(f"--set {item!r}: {exc}") from None
+                raise ValueError(f"{option} {item!r}: {exc}") from None
     return dataclasses.replace(settings, **changes, overrides=tuple(settings.overrides) + tuple(overrides))
+
+
+def jjf1535_settings(overrides=()):
+    """The JJF 1535 procedure's settings (:class:`plansim.schedule.jjf1535.Jjf1535Settings`) with ``KEY=VALUE`` items
+    applied (``plansim run|validate|sweep jjf1535 --procedure``), checked by building the procedure once: an error
+    names the item, the key and what is allowed."""
+    from plansim.schedule.jjf1535 import SETTING_KINDS, Jjf1535Settings
+
+    settings = apply_overrides(Jjf1535Settings(), tuple(overrides), SETTING_KINDS,
+                               count_minimum={"points": 11, "repeats": 2, "bias_periods": 2, "warm_up_records": 1},
+                               option="--procedure")
+    try:
+        settings.procedure()
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"--procedure {'; '.join(settings.overrides) or '(defaults)'}: {exc}") from None
+    return settings
