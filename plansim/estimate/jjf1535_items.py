@@ -49,7 +49,7 @@ from plansim.estimate.jjf1535 import (
     threshold,
     warm_up_time,
 )
-from plansim.model.jjf1535_effects import exponential_segment_mean
+from plansim.model.jjf1535_effects import exponential_segment_mean, own_axis_response
 from plansim.model.parameters import unpack
 from plansim.schedule.jjf1535 import Jjf1535Procedure, RateRun
 from plansim.units import DEG, HOUR, STANDARD_GRAVITY
@@ -221,8 +221,7 @@ def true_items(truth, procedure: Jjf1535Procedure, *, scale_temperature_coeffici
     K = kg * (1.0 + kappa * (procedure.room_temperature - float(reference_temperature)))
     bias_room = float(p["Bg"][i]) + beta * (procedure.room_temperature - float(reference_temperature))
     rates = np.array([procedure.schedule.segments[k].rate for k in procedure.room_runs[0].points])
-    response = (K * rates + nonlinearity_quadratic * rates**2 + nonlinearity_cubic * rates**3
-                + 0.5 * asymmetry * kg * np.abs(rates))
+    response = own_axis_response(rates, K, kg, nonlinearity_quadratic, nonlinearity_cubic, asymmetry)
     out = {"scale_factor": K,
            "nonlinearity": scale_factor_nonlinearity(rates, response),
            "asymmetry": scale_factor_asymmetry(rates, response),

@@ -76,3 +76,17 @@ def exponential_segment_mean(start, samples, sample_period, amplitude: float, ti
         raise ValueError(f"time_constant = {time_constant!r}: must be > 0 s when the amplitude is set")
     ratio = np.expm1(-n * dt / time_constant) / (n * np.expm1(-dt / time_constant))
     return amplitude * np.exp(-t0 / time_constant) * ratio
+
+
+def own_axis_response(rates, gain: float, kg: float, quadratic: float = 0.0, cubic: float = 0.0,
+                      asymmetry: float = 0.0) -> np.ndarray:
+    """The gyro's output from the input rate w along its own axis (rad/s): ``gain·w + n2·w² + n3·w³ + ½·α·Kg·|w|``.
+
+    The own-axis terms of :func:`plansim.kernels.physics.gyro_output` in numpy, with *gain* the scale factor at the
+    segment's temperature (Kg_ii·(1 + κ·ΔT)), *kg* = Kg_ii, *quadratic* n2 (1/(rad/s)), *cubic* n3 (1/(rad/s)²) and
+    *asymmetry* α (docs/model.md): what the JJF 1535 effects' correction (:mod:`plansim.simulate.jjf1535_effects`)
+    and the items' true values (:func:`plansim.estimate.jjf1535_items.true_items`) both read.
+    """
+    x = np.asarray(rates, dtype=float)
+    half_alpha = 0.5 * asymmetry * kg
+    return gain * x + quadratic * x**2 + cubic * x**3 + half_alpha * np.abs(x)

@@ -33,7 +33,7 @@ import numpy as np
 
 from plansim.config import Scenario
 from plansim.config.scenario import JJF1535_EFFECTS
-from plansim.model.jjf1535_effects import exponential_segment_mean, input_response
+from plansim.model.jjf1535_effects import exponential_segment_mean, input_response, own_axis_response
 from plansim.model.parameters import unpack
 from plansim.schedule.jjf1535 import Jjf1535Procedure
 from plansim.schedule.segments import axis_vector, body_to_level
@@ -92,13 +92,10 @@ def apply_jjf1535_effects(means: np.ndarray, truth, scenario: Scenario, procedur
         kg = float(unpack(np.asarray(truth, dtype=float))["Kg"][i, i])
         temperatures = np.array([s.temperature for s in procedure.schedule.segments])
         gain = kg * (1.0 + float(e.gyro_scale_temperature_coefficient[i]) * (temperatures - e.reference_temperature))
-        n2, n3 = float(e.gyro_nonlinearity_quadratic[i]), float(e.gyro_nonlinearity_cubic[i])
-        half_alpha = 0.5 * float(e.gyro_asymmetry[i]) * kg
-
-        def response(x):
-            return gain * x + n2 * x**2 + n3 * x**3 + half_alpha * np.abs(x)
-
-        out[:, i] += response(input_response(w, dead_zone, resolution)) - response(w)
+        shape = dict(kg=kg, quadratic=float(e.gyro_nonlinearity_quadratic[i]),
+                     cubic=float(e.gyro_nonlinearity_cubic[i]), asymmetry=float(e.gyro_asymmetry[i]))
+        out[:, i] += (own_axis_response(input_response(w, dead_zone, resolution), gain, **shape)
+                      - own_axis_response(w, gain, **shape))
     cycle, since = procedure.power_cycles()
     amplitude = float(e.gyro_warm_up_amplitude[i])
     if amplitude != 0:
