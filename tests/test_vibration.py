@@ -29,6 +29,7 @@ from plansim.simulate.vibration import (
     VibrationExperiment,
     run_vibration_experiment,
     simulate_record,
+    vibration_monte_carlo,
     with_overrides,
 )
 from plansim.units import STANDARD_GRAVITY
@@ -212,8 +213,8 @@ def test_cli_bad_input_exits_2_naming_the_field(capsys):
     assert cli.main(["run", "vibration_g2", "--set", "oversampling=3"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("plansim: error: oversampling: 3") and "allowed" in err
-    assert cli.main(["run", "vibration_g2", "--trials", "5"]) == 2
-    assert "--trials 5: not available with the experiment vibration_g2" in capsys.readouterr().err
+    assert cli.main(["run", "vibration_g2", "--trials", "1"]) == 2
+    assert "--trials 1: must be >= 2" in capsys.readouterr().err
     assert cli.main(["run", "vibration_g2", "--path", "segment"]) == 2
     assert "--path segment: not available with the experiment vibration_g2" in capsys.readouterr().err
     assert cli.main(["run", "vibration_g2", "--seed", "-1"]) == 2
@@ -225,3 +226,32 @@ def test_scenarios_lists_vibration_g2_as_an_experiment_last(capsys):
     last = capsys.readouterr().out.splitlines()[-1]
     assert last.startswith("vibration_g2 ")
     assert "[experiment, not a scenario file: plansim run vibration_g2 [--set KEY=VALUE]]" in last
+
+
+def test_the_monte_carlo_over_records_is_each_records_experiment():
+    """--trials N: the records of seeds S … S + N − 1, each the single experiment of that seed (so any one can be
+    looked at alone with --seed); the summary is their mean, spread and 95 % range."""
+    settings = VibrationExperiment(**SHORT)
+    mc = vibration_monte_carlo(settings, trials=3, seed=40)
+    for i in range(3):
+        one = run_vibration_experiment(settings, seed=40 + i)
+        np.testing.assert_array_equal(mc.shift[i], one.shift)
+        np.testing.assert_array_equal(mc.mean_error["g2_g3"][i], one.errors["g2_g3"]["mean"])
+        assert mc.g2_ratio[i, 2] == pytest.approx(one.coefficients["g2"][2, 2] / one.truth.S2[2, 2], rel=1e-12)
+    summary = mc.summary(mc.mean_error["static"])
+    np.testing.assert_allclose(summary["std"], np.std(mc.mean_error["static"], axis=0, ddof=1), rtol=1e-12)
+    with pytest.raises(ValueError, match="trials = 1"):
+        vibration_monte_carlo(settings, trials=1)
+
+
+def test_cli_monte_carlo_json_and_text(capsys, tmp_path):
+    plot = tmp_path / "mc.png"
+    assert cli.main(["run", "vibration_g2", "--trials", "2", "--seed", "7", "--quiet", "--plot", str(plot),
+                     *SHORT_SET]) == 0
+    text = capsys.readouterr().out
+    assert "--trials 2: seeds 7–8" in text and "the paper: shift" in text and plot.stat().st_size > 10_000
+    assert cli.main(["run", "vibration_g2", "--trials", "2", "--seed", "7", "--json", *SHORT_SET]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["seeds"] == [7, 8] and len(doc["shift"]["per_record"]) == 2
+    assert set(doc["mean_error"]) == {"static", "g2", "g2_g3"}
+    assert set(doc["mean_error"]["static"]["summary"]) == {"mean", "std", "q025", "q975"}

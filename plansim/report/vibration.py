@@ -137,3 +137,84 @@ def vibration_figure(result, path: str | os.PathLike, format: str | None = None)
     right.set_title("compensated output minus the Earth rate")
     fig.tight_layout()
     save(fig, path, fmt, dpi=90)
+
+
+def _stats_json(stats: dict) -> dict:
+    return {k: _list(v) for k, v in stats.items()}
+
+
+def vibration_mc_json(mc, elapsed: float, version: str) -> dict:
+    """``plansim run vibration_g2 --trials N --json``: per record and summarised over the records, SI (rad/s)."""
+    s = mc.settings
+    return {
+        "experiment": "vibration_g2", "trials": mc.trials, "seeds": [mc.seed, mc.seed + mc.trials - 1],
+        "overrides": list(s.overrides), "plansim_version": version, "elapsed_s": elapsed,
+        "units": "SI: rad/s; g2_ratio 1", "vibration_axes": s.vibration_axes,
+        "shift": {"per_record": mc.shift.tolist(), "summary": _stats_json(mc.summary(mc.shift)),
+                  "predicted": _list(mc.predicted_shift)},
+        "mean_error": {m: {"per_record": v.tolist(), "summary": _stats_json(mc.summary(v))}
+                       for m, v in mc.mean_error.items()},
+        "rms_averaged": {m: {"per_record": v.tolist(), "summary": _stats_json(mc.summary(v))}
+                         for m, v in mc.rms_averaged.items()},
+        "g2_ratio": {"per_record": mc.g2_ratio.tolist(), "summary": _stats_json(mc.summary(mc.g2_ratio))},
+        "predicted": None if mc.predicted is None else {
+            "g2_ratio": mc.predicted["g2_ratio"], "static": _list(mc.predicted["static"]),
+            "g2": _list(mc.predicted["g2"])},
+        "paper_deg_per_h": PAPER,
+    }
+
+
+def vibration_mc_text(mc, elapsed: float) -> str:
+    """The Monte Carlo over records as text, °/h: mean ± sd and the 95 % range of each figure, per gyro."""
+    s = mc.settings
+
+    def row(label, values, scale=DEG_H, digits=2):
+        st = mc.summary(values)
+        cells = "".join(f"{st['mean'][a] / scale:9.{digits}f} ± {st['std'][a] / scale:<6.{digits}f}"
+                        f"[{st['q025'][a] / scale:.{digits}f}, {st['q975'][a] / scale:.{digits}f}]  "
+                        for a in range(3))
+        return f"{label:44s}{cells}"
+
+    lines = [f"plansim run vibration_g2 --trials {mc.trials}: seeds {mc.seed}–{mc.seed + mc.trials - 1}, "
+             f"{elapsed:.1f} s (vibration along {s.vibration_axes})",
+             "", "deg/h: mean ± sd [95 % range] over the records" + " " * 14 + "x gyro" + " " * 26 + "y gyro"
+             + " " * 26 + "z gyro",
+             row("output shift", mc.shift),
+             f"{'output shift, closed form':44s}" + "".join(f"{v / DEG_H:9.2f}{'':30s}" for v in mc.predicted_shift)]
+    for m, label in MODELS.items():
+        lines.append(row("mean error, " + label, mc.mean_error[m]))
+    for m, label in MODELS.items():
+        lines.append(row("r.m.s. of 1 s means, " + label, mc.rms_averaged[m]))
+    lines.append(row("fitted g² / truth (shaken axis)", mc.g2_ratio, scale=1.0))
+    if mc.predicted is not None:
+        lines.append(f"predicted: g² ratio {mc.predicted['g2_ratio']:.2f}; mean error "
+                     + ", ".join(f"{MODELS[m]} {mc.predicted[m][2] / DEG_H:.2f}" for m in ("static", "g2"))
+                     + " deg/h (z gyro; without noise or calibration errors)")
+    static_z = mc.summary(mc.mean_error["static"])
+    after_z = mc.summary(mc.mean_error["g2_g3"])
+    lines += ["", f"the paper: shift ≈ {PAPER['shift']:g} deg/h, compensation {PAPER['before']} -> {PAPER['after']} "
+                  f"deg/h; here, z gyro: {static_z['mean'][2] / DEG_H:.1f} ± {static_z['std'][2] / DEG_H:.1f} -> "
+                  f"{after_z['mean'][2] / DEG_H:.1f} ± {after_z['std'][2] / DEG_H:.1f} deg/h"]
+    return "\n".join(lines)
+
+
+def vibration_mc_figure(mc, path: str | os.PathLike, format: str | None = None) -> None:
+    """Per gyro, the distribution over the records of the mean error during vibration, static model against the
+    g² (and g³) compensation, with the paper's figures marked (°/h)."""
+    chosen = figure_format(path, format)
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), constrained_layout=True)
+    for a, ax in enumerate(axes):
+        for m, color in (("static", "tab:red"), ("g2", "tab:orange"), ("g2_g3", "tab:blue")):
+            ax.hist(mc.mean_error[m][:, a] / DEG_H, bins=max(5, mc.trials // 3), alpha=0.5, color=color,
+                    label=MODELS[m])
+        if a == 2:
+            for key, style in (("before", "--"), ("after", ":")):
+                ax.axvline(PAPER[key], color="k", ls=style, lw=1.0, label=f"paper, {key}: {PAPER[key]} deg/h")
+        ax.set_title(f"{'xyz'[a]} gyro: mean error during vibration", fontsize=9)
+        ax.set_xlabel("deg/h", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[2].legend(fontsize=6)
+    fig.suptitle(f"plansim run vibration_g2 --trials {mc.trials} (seeds {mc.seed}–{mc.seed + mc.trials - 1})",
+                 fontsize=10)
+    save(fig, path, chosen, dpi=110)

@@ -361,3 +361,59 @@ def predicted_errors(settings: VibrationExperiment, record: VibrationRecord) -> 
     static = S * (g * g + variance) + D * (g**3 + 3 * g * variance)
     return {"sampled_variance": sampled, "g2_ratio": ratio, "static": static,
             "g2": static - ratio * S * (g * g + sampled)}
+
+
+@dataclass(frozen=True)
+class VibrationMonteCarlo:
+    """The experiment run on *trials* records, seeds ``seed``, ``seed + 1``, … (each reproducible alone with
+    ``plansim run vibration_g2 --seed``), SI (rad/s). ``shift`` (N, 3); ``mean_error`` and ``rms_averaged``: per
+    compensation (``static``, ``g2``, ``g2_g3``) (N, 3), the mean error during vibration and the r.m.s. of its 1 s
+    means; ``g2_ratio`` (N, 3): each gyro's fitted g² coefficient on the shaken axis over the truth's."""
+
+    settings: VibrationExperiment
+    seed: int
+    trials: int
+    shift: np.ndarray
+    predicted_shift: np.ndarray
+    mean_error: dict
+    rms_averaged: dict
+    g2_ratio: np.ndarray
+    predicted: dict | None
+
+    def summary(self, values: np.ndarray) -> dict:
+        """Mean, standard deviation (n − 1) and 2.5 %/97.5 % quantiles over the trials, per axis (3,) each."""
+        v = np.asarray(values, dtype=float)
+        q = np.quantile(v, [0.025, 0.975], axis=0)
+        return {"mean": v.mean(axis=0), "std": v.std(axis=0, ddof=1), "q025": q[0], "q975": q[1]}
+
+
+def vibration_monte_carlo(settings: VibrationExperiment | None = None, trials: int = 20, seed: int = 20200612,
+                          progress=None) -> VibrationMonteCarlo:
+    """:func:`run_vibration_experiment` on *trials* records, seeds *seed* … *seed* + trials − 1 (module docstring;
+    ``plansim run vibration_g2 --trials N``): how much the shift and the compensation's residual error scatter from
+    one record to the next, which one record (the paper's) cannot say. ``progress(done, trials)`` after each."""
+    settings = VibrationExperiment() if settings is None else settings
+    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 2:
+        raise ValueError(f"trials = {trials!r}: expected a whole number >= 2 (a spread needs two records)")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
+    shift, mean_error, rms, ratio = [], {m: [] for m in ("static", "g2", "g2_g3")}, {m: [] for m in
+                                                                                       ("static", "g2", "g2_g3")}, []
+    predicted_shift, predicted = [], None
+    axis = "xyz".index(settings.vibration_axes[0])
+    for i in range(int(trials)):
+        result = run_vibration_experiment(settings, seed=int(seed) + i)
+        shift.append(result.shift)
+        for m in mean_error:
+            mean_error[m].append(result.errors[m]["mean"])
+            rms[m].append(result.errors[m]["rms_averaged"])
+        true = result.truth.S2[:, axis]
+        fitted = result.coefficients["g2"][:, MONOMIALS.index("xyz"[axis] * 2)]
+        ratio.append(np.where(true != 0, fitted / np.where(true != 0, true, 1.0), np.nan))
+        predicted_shift.append(result.predicted_shift)
+        predicted = result.predicted
+        if progress is not None:
+            progress(i + 1, int(trials))
+    return VibrationMonteCarlo(settings, int(seed), int(trials), np.array(shift), np.mean(predicted_shift, axis=0),
+                               {m: np.array(v) for m, v in mean_error.items()},
+                               {m: np.array(v) for m, v in rms.items()}, np.array(ratio), predicted)
