@@ -245,6 +245,26 @@ def test_the_attribution_says_how_reliably_the_schedule_tells_two_candidates_apa
     assert _attribution(best, [best])["probability_correct"] == 1.0
 
 
+def test_an_asymmetry_in_jjf2003_order_is_a_scale_change_in_time_and_the_report_says_so():
+    """JJF 2003's rate test runs each axis from -100 to +100 deg/s: a scale factor that changes between the -5 and
+    the 0 deg/s points moves every positive rate and no negative one, which with Kg and Bg free is exactly the
+    asymmetry's signature. The selection names the asymmetry and the attribution names that change beside it
+    (cosine > 0.9999: 'this recording cannot say which'); with the rate signs interleaved the two come apart."""
+    scenario = _scenario("jjf2003", gyro_asymmetry=[1e-3, 0.0, 0.0])
+    d = _diagnose(scenario, seed=5, trial=0)
+    assert d.selected == ("gyro_scale_asymmetry",)
+    t = d.attribution[0]["time_alternative"]
+    assert t["parameter"] == "Kgxx" and t["component"] == "x" and t["cosine"] > 0.9999
+    assert t["labels"] == ["rate x -5 deg/s", "rate x +0 deg/s"]
+    assert "this recording cannot say which" in diagnose_report(d)
+    interleaved = load_scenario("jjf2003", ['schedule.rate_points=["5 deg/s", "-5 deg/s", "20 deg/s", "-20 deg/s", '
+                                            '"50 deg/s", "-50 deg/s", "100 deg/s", "-100 deg/s", "0 deg/s"]'])
+    interleaved = dataclasses.replace(interleaved, effects=scenario.effects)
+    d = _diagnose(interleaved, seed=5, trial=0)
+    assert d.selected == ("gyro_scale_asymmetry",)
+    assert d.attribution[0]["time_alternative"]["cosine"] < 0.99
+
+
 def test_a_bias_step_between_segments_is_unexplained_and_placed():
     """A step of 20 times a gx segment mean's standard uncertainty from the middle sample of a linear_gaussian
     recording (no quantiser): the lack of fit flags it and its step test places it on gx at the boundary where

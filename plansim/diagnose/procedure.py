@@ -43,7 +43,7 @@ from plansim.diagnose.within import within_segment_tests
 from plansim.fit import fit_recording, recording_noise
 from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
-from plansim.model.parameters import PARAMETERS
+from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
 #: Shares of ``alpha``, the false-alarm rate of the whole diagnosis (Bonferroni: they sum to 1). The selections (the
 #: closed test over the catalogue) get half; "something is unexplained" gets the other half, split between the
@@ -176,6 +176,66 @@ def _attribution(best, significant) -> dict:
     return entry
 
 
+def time_alternative(fit, best, signature) -> dict | None:
+    """The change in time that looks most like the chosen candidate: of every identified parameter p of eq. (1)/(2)
+    and every boundary between segments adjacent in time, the column "p changes there" (p's column of the design,
+    on the segments after the boundary), the one whose efficient score correlates most with the candidate's
+    strongest component (cosine ρ, M⁺ metric, as between candidates); with the probability Φ(δ·√((1 − |ρ|)/2))
+    that the schedule tells the two apart at this size (δ = √T of the component, as :func:`_attribution`).
+
+    A change of a parameter part-way through the run is outside the catalogue, and a schedule that visits its
+    settings in order can make it look like a catalogue effect: JJF 2003's rate test runs from −100 °/s up to
+    +100 °/s on each axis, so a scale factor that changes at its 0 °/s point reads as an asymmetry. The report
+    names it beside the chosen effect, so that an effect outside the catalogue is not silently given a catalogue
+    name. ``None`` when no such column survives the base model."""
+    from scipy.stats import norm
+
+    from plansim.diagnose.scores import ALIAS_TOLERANCE, _Geometry
+
+    usable = [j for j in range(len(signature.components)) if best.usable[j]]
+    statistics = np.asarray(best.component_statistic, dtype=float)
+    if not usable or not np.any(np.isfinite(statistics)):
+        return None
+    j = int(np.nanargmax(np.where(np.isfinite(statistics), statistics, -np.inf)))
+    g = _Geometry(fit)
+    z = g.project(g.W @ signature.columns[:, :, j].ravel())
+    design = fit.model.parameter_jacobian(tilts=fit.nuisance)  # (6S, 39)
+    times = np.asarray(fit.segment_times, dtype=float)
+    order = np.argsort(times, kind="stable")
+    S = times.size
+    identified = [PARAMETER_NAMES.index(n) for n in fit.identifiability.identified]
+    columns, where = [], []
+    for k in range(1, S):
+        after = np.zeros((S, 1))
+        after[order[k:]] = 1.0
+        for p in identified:
+            column = (design[:, p].reshape(S, 6) * after).ravel()
+            if np.any(column):
+                columns.append(column)
+                where.append((p, int(order[k - 1]), int(order[k])))
+    if not columns:
+        return None
+    whitened = g.W @ np.array(columns).T
+    Z = g.project(whitened)
+    keep = np.linalg.norm(Z, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
+    if not np.any(keep):
+        return None
+    Z = Z[:, keep]
+    where = [w for w, k in zip(where, keep) if k]
+    P = g._pinv()
+    Pz = P @ z
+    information = np.sum(Z * (P @ Z), axis=0)
+    cosines = (Z.T @ Pz) / np.sqrt(np.maximum(information * float(z @ Pz), 1e-300))
+    i = int(np.argmax(np.abs(cosines)))
+    rho = float(abs(cosines[i]))
+    delta = math.sqrt(max(float(statistics[j]), 0.0))
+    p, before_segment, after_segment = where[i]
+    return {"parameter": PARAMETER_NAMES[p], "between": [int(fit.used[before_segment]), int(fit.used[after_segment])],
+            "labels": [fit.labels[before_segment], fit.labels[after_segment]],
+            "at_s": float(0.5 * (times[before_segment] + times[after_segment])), "component": signature.components[j],
+            "cosine": rho, "probability_distinct": float(norm.cdf(delta * math.sqrt((1.0 - rho) / 2.0)))}
+
+
 def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
     """Whether *column* (S, 6) is outside the span of the fit's design and the *columns* already added, on the
     fitted rows (each column scaled to unit norm; singular values below RANK_TOLERANCE of the largest are zero).
@@ -277,8 +337,9 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         # held-out prediction error (it penalised the six-component nonlinearity against the three-component
         # asymmetry: 0–1 of 5 quadratic nonlinearities at 5× were named) compares like with like.
         best = max(open_, key=lambda c: (c.strongest_component(), -c.adjusted_p_value))
-        attribution.append(_attribution(best, open_))
         signature = by_effect[best.effect]
+        attribution.append({**_attribution(best, open_),
+                            "time_alternative": time_alternative(current, best, signature)})
         best_extra = dict(extra)
         for j, component in enumerate(signature.components):
             if best.usable[j] and _adds_rank(current, list(best_extra.values()), signature.columns[:, :, j]):
@@ -384,8 +445,9 @@ def diagnosis_json(d: Diagnosis) -> dict:
             "unexplained": d.unexplained, "before": side(d.before, d.holdout["before"]),
             "after": side(d.after, d.holdout["after"]), "parameters": parameters, "absorbed": absorbed(d),
             "information": d.information, "alpha": d.alpha, "levels": levels(d.alpha),
-            "attribution": [{k: (_number(v) if isinstance(v, float) else v) for k, v in a.items()}
-                            for a in d.attribution],
+            "attribution": [{k: (_number(v) if isinstance(v, float) else
+                                 {kk: (_number(vv) if isinstance(vv, float) else vv) for kk, vv in v.items()}
+                                 if isinstance(v, dict) else v) for k, v in a.items()} for a in d.attribution],
             "within_segment": {"alpha": d.within.alpha, "draws": d.within.draws,
                                "segments_tested": len(d.within.segments),
                                "smallest_adjusted_p_value": d.within.smallest_adjusted_p(),

@@ -67,6 +67,14 @@ def diagnose_report(d) -> str:
                              f"{a['statistic']:.1f} against {a['runner_up_statistic']:.1f}; their signatures' cosine "
                              f"{a['cosine']:.3f}: at this size the schedule tells them apart about "
                              f"{100 * a['probability_correct']:.0f} % of the time)")
+            t = a.get("time_alternative")
+            if t is not None:
+                lines.append(f"  or, outside the catalogue: {t['parameter']} changing between segments "
+                             f"{t['between'][0]} and {t['between'][1]} (at {t['at_s'] / 60:.1f} min) looks like "
+                             f"{a['effect']}"
+                             f"[{t['component']}] with cosine {t['cosine']:.3f}: at this size the schedule tells "
+                             f"them apart about {100 * t['probability_distinct']:.0f} % of the time"
+                             + (" — this recording cannot say which" if t["cosine"] > 0.99 else ""))
     else:
         lines.append("Found: no catalogue effect is significant.")
     after = d.lack_of_fit_after
