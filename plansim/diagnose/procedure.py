@@ -227,7 +227,7 @@ def time_alternative(fit, best, signature) -> dict | None:
     information = np.sum(Z * (P @ Z), axis=0)
     cosines = (Z.T @ Pz) / np.sqrt(np.maximum(information * float(z @ Pz), 1e-300))
     i = int(np.argmax(np.abs(cosines)))
-    rho = float(abs(cosines[i]))
+    rho = min(float(abs(cosines[i])), 1.0)  # rounding can carry an exact alias past 1
     delta = math.sqrt(max(float(statistics[j]), 0.0))
     p, before_segment, after_segment = where[i]
     return {"parameter": PARAMETER_NAMES[p], "between": [int(fit.used[before_segment]), int(fit.used[after_segment])],
@@ -379,12 +379,19 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
             sizes[effect] = {"components": [n[len(effect) + 1:-1] for n in names],
                              "value": [float(after.extra.estimate[i]) for i in idx],
                              "u": [float(after.extra.u[i]) for i in idx], "unit": unit}
-    step = lof_after.step if lof_after.flagged and lof_after.step is not None and \
-        lof_after.step["p_value"] <= lof_after.omnibus_p_value else None
+    # where it sits: the step or the change of a parameter, whichever has the smaller p, when it is at least as
+    # telling as the omnibus test
+    pattern = [(x["p_value"], name, x) for name, x in (("step", lof_after.step), ("change", lof_after.change))
+               if x is not None and lof_after.flagged and x["p_value"] <= lof_after.omnibus_p_value]
+    pattern = min(pattern, key=lambda item: item[0]) if pattern else (None, None, None)
+    step = pattern[2] if pattern[1] == "step" else None
+    change = pattern[2] if pattern[1] == "change" else None
     unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged),
                    "where": _where(after, lof_after) if lof_after.flagged else [],
                    "step": None if step is None else {**step, "unit": UNITS_SI[channel_kind(
                        CHANNELS.index(step["channel"]))]["mean"]},
+                   "change": None if change is None else {**change, "unit": next(
+                       q.si_unit for q in PARAMETERS if q.name == change["parameter"])},
                    "within_segments": [dict(item) for item in within.flagged]}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
     return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=within,
@@ -418,7 +425,9 @@ def diagnosis_json(d: Diagnosis) -> dict:
         return {"statistic": _number(x.statistic), "dof": int(x.dof), "p_value": _number(x.p_value),
                 "flagged": bool(x.flagged), "omnibus_p_value": _number(x.omnibus_p_value),
                 "step": None if x.step is None else {k: (_number(v) if isinstance(v, float) else v)
-                                                     for k, v in x.step.items()}}
+                                                     for k, v in x.step.items()},
+                "change": None if x.change is None else {k: (_number(v) if isinstance(v, float) else v)
+                                                         for k, v in x.change.items()}}
 
     def side(fit, hold):
         return {"residual_rms": {k: _number(v) for k, v in _rms_per_channel(fit).items()},

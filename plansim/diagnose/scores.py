@@ -129,6 +129,9 @@ class LackOfFit:
     per_channel: dict  # channel -> (statistic, dof, p_value)
     omnibus_p_value: float = math.nan
     step: dict | None = None
+    #: the largest change of one parameter part-way through the run (:func:`change_columns`): its statistic, p,
+    #: parameter, place and size (SI), or None
+    change: dict | None = None
 
 
 #: what would separate each effect from what it aliases with, when it is not identifiable
@@ -466,6 +469,64 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
     return statistic, null_max, size, where
 
 
+#: the parameters whose change in time the lack of fit looks for (the biases' changes are the step test's)
+CHANGE_GROUPS = ("Kg", "G", "Ka", "P")
+
+
+def change_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+    """The columns (6S, m) of a change of one parameter of eq. (1)/(2) part-way through the run: for each identified
+    parameter of :data:`CHANGE_GROUPS` and each boundary between segments adjacent in time, the parameter's column
+    of the design (at the fit's solution) on the segments after it; and each column's (parameter index, last
+    segment before, first segment after). A parameter read by a channel left out of the step test (its means'
+    noise an undithered quantiser's, :data:`UNDITHERED_SHARE`) is left out here too."""
+    from plansim.model.parameters import PARAMETERS
+
+    times = np.asarray(fit.segment_times, dtype=float)
+    S = times.size
+    order = np.argsort(times, kind="stable")
+    rows = np.asarray(fit.fitted_rows, dtype=bool)
+    noise = getattr(fit, "noise", None)
+    excluded = {c for c in range(6) if noise is not None and np.median(
+        noise.quantisation_variance[:, c] / np.maximum(noise.mean_variance[:, c], 1e-300)) > UNDITHERED_SHARE}
+    design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(S, 6, -1)
+    design[~rows] = 0.0
+    identified = set(fit.identifiability.identified)
+    chosen = [k for k, spec in enumerate(PARAMETERS) if spec.group in CHANGE_GROUPS and spec.name in identified
+              and not excluded & {c for c in range(6) if np.any(design[:, c, k])}]
+    columns, where = [], []
+    for k in range(1, S):
+        later = order[k:]
+        for p in chosen:
+            column = np.zeros((S, 6))
+            column[later] = design[later, :, p]
+            if np.any(column) and np.any(design[order[:k], :, p]):  # a change, not the parameter itself
+                columns.append(column.ravel())
+                where.append((p, int(order[k - 1]), int(order[k])))
+    return (np.array(columns).T if columns else np.zeros((6 * S, 0))), where
+
+
+def _change_scores(g: _Geometry, columns: np.ndarray, where: list, null: np.ndarray):
+    """Each change column's efficient 1-dof score (zᵀM⁺r_w)²/(zᵀM⁺z) on the data and the largest over columns of
+    each null draw's; its size (zᵀM⁺r_w)/(zᵀM⁺z) (the parameter's change, SI); None if no column survives."""
+    whitened = g.W @ columns
+    Z = g.project(whitened)
+    keep = np.linalg.norm(Z, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
+    if not np.any(keep):
+        return None
+    Z, where = Z[:, keep], [w for w, k in zip(where, keep) if k]
+    PZ = g._pinv() @ Z
+    information = np.sum(Z * PZ, axis=0)
+    ok = information > 0
+    Z, PZ, information = Z[:, ok], PZ[:, ok], information[ok]
+    where = [w for w, k in zip(where, ok) if k]
+    if not where:
+        return None
+    cross = PZ.T @ g.r
+    statistic = cross**2 / information
+    null_max = np.max((PZ.T @ null) ** 2 / information[:, None], axis=0)
+    return statistic, null_max, cross / information, where
+
+
 def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
                 null: np.ndarray | None = None) -> LackOfFit:
     """The segment-level lack of fit against the simulated null (module docstring, "Lack of fit"): the omnibus
@@ -484,24 +545,44 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     # the largest step: each column's profile likelihood ratio, the channel's between-segment noise re-estimated
     # with the step in the model (_step_likelihood_ratios), maximised over channels and boundaries
     columns, where = step_columns(fit)
-    step = None
-    p = p_omnibus
+    step = change = None
+    # each statistic's p against the simulated null, and each null draw's own p (its rank among the draws): the
+    # family's p is the min-p over the statistics, against the min-p of the same draws
+    ranks = [(B - np.argsort(np.argsort(L_null, kind="stable"), kind="stable")) / B]
+    p_values = [p_omnibus]
     profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
     if profiled is not None:
         scores, null_scores, sizes, where = profiled
         best = int(np.argmax(scores))
         T = float(scores[best])
         p_step = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
-        # min-p of the two over the same draws: each draw's own p-values against the others' (ranks)
-        rank_L = (B - np.argsort(np.argsort(L_null, kind="stable"), kind="stable")) / B
-        rank_T = (B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B
-        p = (1 + np.count_nonzero(np.minimum(rank_L, rank_T) <= min(p_omnibus, p_step))) / (B + 1)
+        ranks.append((B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B)
+        p_values.append(p_step)
         c, before, after = where[best]
         step = {"statistic": T, "p_value": float(p_step), "channel": CHANNELS[c],
                 "between": [int(fit.used[before]), int(fit.used[after])],
                 "labels": [fit.labels[before], fit.labels[after]],
                 "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])),
                 "size": float(sizes[best])}
+    # the largest change of one parameter part-way through the run (a scale factor, a cross-coupling, a g-term)
+    columns, where = change_columns(fit)
+    scored = _change_scores(g, columns, where, null) if columns.shape[1] else None
+    if scored is not None:
+        scores, null_scores, sizes, where = scored
+        best = int(np.argmax(scores))
+        T = float(scores[best])
+        p_change = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
+        ranks.append((B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B)
+        p_values.append(p_change)
+        k, before, after = where[best]
+        change = {"statistic": T, "p_value": float(p_change), "parameter": PARAMETER_NAMES[k],
+                  "between": [int(fit.used[before]), int(fit.used[after])],
+                  "labels": [fit.labels[before], fit.labels[after]],
+                  "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])),
+                  "size": float(sizes[best])}
+    p = p_omnibus
+    if len(p_values) > 1:
+        p = (1 + np.count_nonzero(np.min(ranks, axis=0) <= min(p_values))) / (B + 1)
     per_channel = {}
     for c, name in enumerate(CHANNELS):
         sel = g.channel_of_row == c
@@ -510,7 +591,7 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         Lc = float(np.sum(g.r[sel] ** 2))
         pc = (1 + np.count_nonzero(np.sum(null[sel] ** 2, axis=0) >= Lc)) / (B + 1)
         per_channel[name] = (Lc, int(sel.sum()), float(pc))
-    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step)
+    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change)
 
 
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:

@@ -94,6 +94,13 @@ def diagnose_report(d) -> str:
             lines.append(f"  a step in {step['channel']} of {step['size'] / factor:+.3g} {unit} between segment "
                          f"{step['between'][0]} {step['labels'][0]} and {step['between'][1]} {step['labels'][1]} "
                          f"(at about {step['at_s']:.0f} s; p = {_p(step['p_value'])})")
+        change = d.unexplained.get("change")
+        if change is not None:
+            spec = next(q for q in PARAMETERS if q.name == change["parameter"])
+            lines.append(f"  a change of {change['parameter']} by {change['size'] / spec.display_factor:+.3g} "
+                         f"{spec.display_unit} between segment {change['between'][0]} {change['labels'][0]} and "
+                         f"{change['between'][1]} {change['labels'][1]} (at about {change['at_s']:.0f} s; "
+                         f"p = {_p(change['p_value'])})")
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
     lines += _within_lines(d)
