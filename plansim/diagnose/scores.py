@@ -527,6 +527,19 @@ def _change_scores(g: _Geometry, columns: np.ndarray, where: list, null: np.ndar
     return statistic, null_max, cross / information, where
 
 
+def _largest(fit, scores, null_scores, sizes, where, B: int, what) -> tuple[dict, np.ndarray]:
+    """The largest of a family's statistics (a step, a change) against the largest of each null draw: its
+    ``{statistic, p_value, …what(first of where), between, labels, at_s, size}`` and each draw's own p (its rank)."""
+    best = int(np.argmax(scores))
+    T = float(scores[best])
+    first, before, after = where[best]
+    found = {"statistic": T, "p_value": float((1 + np.count_nonzero(null_scores >= T)) / (B + 1)), **what(first),
+             "between": [int(fit.used[before]), int(fit.used[after])],
+             "labels": [fit.labels[before], fit.labels[after]],
+             "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])), "size": float(sizes[best])}
+    return found, (B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B
+
+
 def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
                 null: np.ndarray | None = None) -> LackOfFit:
     """The segment-level lack of fit against the simulated null (module docstring, "Lack of fit"): the omnibus
@@ -552,34 +565,16 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     p_values = [p_omnibus]
     profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
     if profiled is not None:
-        scores, null_scores, sizes, where = profiled
-        best = int(np.argmax(scores))
-        T = float(scores[best])
-        p_step = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
-        ranks.append((B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B)
-        p_values.append(p_step)
-        c, before, after = where[best]
-        step = {"statistic": T, "p_value": float(p_step), "channel": CHANNELS[c],
-                "between": [int(fit.used[before]), int(fit.used[after])],
-                "labels": [fit.labels[before], fit.labels[after]],
-                "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])),
-                "size": float(sizes[best])}
+        step, rank = _largest(fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
+        ranks.append(rank)
+        p_values.append(step["p_value"])
     # the largest change of one parameter part-way through the run (a scale factor, a cross-coupling, a g-term)
     columns, where = change_columns(fit)
     scored = _change_scores(g, columns, where, null) if columns.shape[1] else None
     if scored is not None:
-        scores, null_scores, sizes, where = scored
-        best = int(np.argmax(scores))
-        T = float(scores[best])
-        p_change = (1 + np.count_nonzero(null_scores >= T)) / (B + 1)
-        ranks.append((B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B)
-        p_values.append(p_change)
-        k, before, after = where[best]
-        change = {"statistic": T, "p_value": float(p_change), "parameter": PARAMETER_NAMES[k],
-                  "between": [int(fit.used[before]), int(fit.used[after])],
-                  "labels": [fit.labels[before], fit.labels[after]],
-                  "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])),
-                  "size": float(sizes[best])}
+        change, rank = _largest(fit, *scored, B, lambda k: {"parameter": PARAMETER_NAMES[k]})
+        ranks.append(rank)
+        p_values.append(change["p_value"])
     p = p_omnibus
     if len(p_values) > 1:
         p = (1 + np.count_nonzero(np.min(ranks, axis=0) <= min(p_values))) / (B + 1)
