@@ -500,9 +500,19 @@ def dither_for_error(step: float, mean_square: float) -> float:
     the quantiser's error that a conditional error (:func:`quantisation_error_given_levels`) stands for."""
     if step <= 0 or mean_square >= step**2 / 12.0:
         return 0.0
+    ratios, table = _dither_table()  # the mean square over q², decreasing in σ/q
+    return float(np.interp(mean_square / step**2, table[::-1], ratios[::-1]) * step)
+
+
+@functools.lru_cache(maxsize=1)
+def _dither_table() -> tuple[np.ndarray, np.ndarray]:
+    """σ/q on a grid of 801 from 0 to 2 and :func:`quantisation_error_variance` there for q = 1: the error scales
+    with q², so one table serves every step (it was computed anew for each segment: 2000 harmonics × 801)."""
     ratios = np.linspace(0.0, 2.0, 801)
-    table = quantisation_error_variance(step, ratios * step)  # decreasing in σ
-    return float(np.interp(mean_square, table[::-1], ratios[::-1]) * step)
+    table = quantisation_error_variance(1.0, ratios)
+    ratios.setflags(write=False)
+    table.setflags(write=False)
+    return ratios, table
 
 
 @dataclass(frozen=True)
