@@ -169,8 +169,8 @@ def test_validate_jjf1535_refuses_claims_saying_what_is_not_built_and_exits_2(ca
     code = cli.main(["validate", "jjf1535", "--claims", "claims.toml"])
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
-    assert err.startswith("plansim: error: --claims: not available with the procedure jjf1535")
-    assert "JJF 1535 items are not built" in err and "plansim run jjf1535" in err
+    assert err.startswith("plansim: error: --claims: not available with 'plansim validate jjf1535'")
+    assert "plansim run jjf1535 --claims" in err
     code = cli.main(["validate", "jjf2003", "--unit", "ideal"])
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and "--unit 'ideal'" in err and "only with a procedure" in err

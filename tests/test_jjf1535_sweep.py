@@ -140,3 +140,48 @@ def test_bad_sweeps_exit_2_before_any_work(tmp_path, capsys, monkeypatch):
         assert cli.main(argv) == 2, argv
         assert message in capsys.readouterr().err, argv
     assert parse_grid({"vary": {"procedure.points": [11]}}).size == 1
+
+
+# ------------------------------------------------------------------------------------------ claims on JJF 1535 items
+
+def test_claims_on_items_are_judged_by_their_coverage_of_the_truth(tmp_path, capsys):
+    """A certificate's U per item against the Monte Carlo: coverage = trials with |error| <= U (relative for K), the
+    half-width needed for 95 %, and the verdict; checked against the trials' errors computed here."""
+    from plansim.io.claims import load_jjf1535_claims
+    from plansim.uncertainty.jjf1535_claims import judge_jjf1535_claims
+
+    path = tmp_path / "claims.toml"
+    path.write_text("[jjf1535.scale_factor]\nU = 1.1e-3\nrelative = true\n\n[jjf1535.nonlinearity]\nU = 100\n")
+    claims = load_jjf1535_claims(path)
+    assert claims["nonlinearity"].expanded_uncertainty == pytest.approx(100e-6) and claims["scale_factor"].relative
+    mc = jjf1535_run("jjf2003", trials=200, seed=3)
+    rows = {r["item"]: r for r in judge_jjf1535_claims(mc, claims)}
+    err = np.abs(mc.column("nonlinearity") - mc.column("nonlinearity", "truth"))
+    assert rows["nonlinearity"]["coverage"] == pytest.approx(np.mean(err <= 100e-6))
+    assert rows["nonlinearity"]["needed"] == pytest.approx(np.quantile(err, 0.95))
+    assert rows["nonlinearity"]["verdict"].startswith("under-stated")  # the noise alone reads ~90 ppm (docs)
+    rel = np.abs(mc.column("scale_factor") / mc.column("scale_factor", "truth") - 1.0)
+    assert rows["scale_factor"]["coverage"] == pytest.approx(np.mean(rel <= 1.1e-3))
+    assert cli.main(["run", "jjf1535", "--trials", "200", "--seed", "3", "--quiet", "--claims", str(path),
+                     "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert [c["item"] for c in document["claims"]] == ["scale_factor", "nonlinearity"]
+    assert document["claims"][0]["unit"] == "1 (relative)" and document["claims"][1]["unit"] == "1"  # ppm -> 1
+
+
+def test_bad_claims_are_refused_naming_the_item(tmp_path, capsys):
+    from plansim.uncertainty.jjf1535_claims import parse_jjf1535_claims
+
+    for document, message in (({"items": {}}, "unknown section"), ({"jjf1535": {"linearity": {"U": 1}}},
+                                                                     "unknown item"),
+                              ({"jjf1535": {"bias_stability": {"U": 1}}}, "no true value"),
+                              ({"jjf1535": {"bias": {"U": -1}}}, "expected a number > 0"),
+                              ({"jjf1535": {"bias": {"U": 1, "p": 2}}}, r"expected U \(required\)"),
+                              ({"jjf1535": {"bias": {"U": 1, "relative": "yes"}}}, "expected true or false"),
+                              ({"jjf1535": {}}, "no claim")):
+        with pytest.raises((ValueError, TypeError), match=message):
+            parse_jjf1535_claims(document)
+    assert cli.main(["run", "jjf2003", "--claims", str(tmp_path / "x.toml")]) == 2
+    assert "--claims: only with the procedure jjf1535" in capsys.readouterr().err
+    assert cli.main(["run", "jjf1535", "--claims", str(tmp_path / "missing.toml")]) == 2
+    assert "no such file" in capsys.readouterr().err

@@ -21,10 +21,9 @@ DEFAULT_UNIT = "jjf2003"
 
 #: what ``plansim validate jjf1535`` still refuses (exit status 2): a claims file names JJF 2003 parameters and items
 VALIDATE_CLAIMS_REFUSAL = (
-    "--claims: not available with the procedure jjf1535. A claims file states the uncertainty of JJF 2003 "
-    "parameters ([parameters.NAME]) or JJF 2003 Appendix A items ([items.\"A.x\"]); claims on JJF 1535 items are "
-    "not built. 'plansim validate jjf1535' checks the GUM of the items against the Monte Carlo; JJF 1535's own "
-    "Appendix A budgets (K and B0) against the Monte Carlo are in 'plansim run jjf1535 [--unit SCENARIO]'")
+    "--claims: not available with 'plansim validate jjf1535', which checks the GUM of the items against the "
+    "adaptive Monte Carlo; a certificate's claims on JJF 1535 items ([jjf1535.ITEM] U = …) are judged by "
+    "'plansim run jjf1535 --claims claims.toml' (docs/jjf1535.md)")
 
 
 def _load_unit(args):
@@ -54,10 +53,12 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
     default_chunk_size : int
         ``--chunk-size``'s default: any other value is refused (the JJF 1535 Monte Carlo uses its own chunks).
     """
-    from plansim.report.jjf1535 import header, items_json, items_table, not_simulated_json
+    from plansim.io.claims import load_jjf1535_claims
+    from plansim.report.jjf1535 import claims_json, claims_table, header, items_json, items_table, not_simulated_json
     from plansim.report.progress import end_progress_line, stderr_progress
     from plansim.runner import jjf1535_angle_random_walk, jjf1535_run
     from plansim.simulate.overrides import jjf1535_settings
+    from plansim.uncertainty.jjf1535_claims import judge_jjf1535_claims
     from plansim.uncertainty.jjf1535_monte_carlo import jjf1535_scenario
 
     # every check before any work: the options that do not apply, the numbers, the unit
@@ -76,6 +77,7 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
     settings = jjf1535_settings(args.procedure or ())
     procedure = settings.procedure()
     jjf1535_scenario(unit, procedure)  # refuses a unit the procedure would drive past its limits, before any work
+    claims = load_jjf1535_claims(args.claims) if args.claims else {}
 
     options = {} if args.trials is None else {"trials": args.trials}
     progress = None if args.quiet else stderr_progress(f"plansim run jjf1535 --unit {unit.name}")
@@ -85,6 +87,7 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
     elapsed = time.perf_counter() - start
     end_progress_line()
     rows = result.summary()
+    judged = judge_jjf1535_claims(result, claims) if claims else []
 
     if args.json:
         print(json.dumps({
@@ -98,6 +101,7 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
             "angle_random_walk": {"clause": "7.2.13", "trial": 0, "unit": "rad/s^0.5", "reported": arw[0],
                                   "simulated": arw[1]},
             "not_simulated": not_simulated_json(),
+            "claims": claims_json(judged) if claims else None,
         }, indent=2))
     else:
         print(header(result, unit, procedure, elapsed))
@@ -105,6 +109,9 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
             print(f"Procedure settings (--procedure): {'; '.join(settings.overrides)}")
         print()
         print(items_table(rows, arw))
+        if judged:
+            print()
+            print(claims_table(judged, args.claims))
     return 0
 
 

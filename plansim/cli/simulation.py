@@ -33,6 +33,10 @@ def _cmd_run(args) -> int:
 
     if args.scenario in PROCEDURES:  # a built-in procedure run on a unit scenario, not a scenario file
         return run_jjf1535(args, DEFAULT_CHUNK_SIZE)
+    for option, value in (("--procedure", args.procedure), ("--claims", args.claims)):
+        if value:
+            raise ValueError(f"{option}: only with the procedure jjf1535 (plansim run jjf1535 {option} …); "
+                             f"{args.scenario!r} takes its settings with --set")
     if args.scenario in DYNAMIC_TESTS:  # a built-in dynamic test, a Monte Carlo with its own settings (--set)
         return run_jjf1537_command(args, DEFAULT_CHUNK_SIZE)
     if args.scenario in VIBRATION_EXPERIMENTS:  # a built-in experiment with its own settings (--set)
@@ -228,6 +232,9 @@ def add_commands(sub) -> None:
                         f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
     add_procedure_option(p)
+    p.add_argument("--claims", default=None,
+                   help="with the procedure jjf1535: a TOML file of a certificate's stated U per item "
+                        "([jjf1535.ITEM] U = …, relative, k), judged against the Monte Carlo (docs/jjf1535.md)")
     p.add_argument("--trials", type=int, default=None,
                    help="number of simulated calibrations (default: the scenario's; jjf1535: 1000; jjf1537: 500)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's, or the unit's)")

@@ -7,8 +7,27 @@ from pathlib import Path
 
 from plansim.config import Scenario
 from plansim.uncertainty.claims import Claim, parse_claims
+from plansim.uncertainty.jjf1535_claims import Jjf1535Claim, parse_jjf1535_claims
 
-__all__ = ["load_claims"]
+__all__ = ["load_claims", "load_jjf1535_claims"]
+
+
+def _document(path) -> tuple[dict, str]:
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"--claims {str(path)!r}: no such file")
+    try:
+        with open(p, "rb") as fh:
+            return tomllib.load(fh), p.name
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"claims file {str(path)!r} is not valid TOML: {exc}") from None
+
+
+def load_jjf1535_claims(path) -> dict[str, Jjf1535Claim]:
+    """Claims on JJF 1535 items from a TOML file (:mod:`plansim.uncertainty.jjf1535_claims`), U in SI or relative;
+    errors name the file."""
+    document, name = _document(path)
+    return parse_jjf1535_claims(document, source=name)
 
 
 def load_claims(path, scenario: Scenario) -> dict[str, Claim]:
@@ -31,12 +50,5 @@ def load_claims(path, scenario: Scenario) -> dict[str, Claim]:
         No such file, a file that is not valid TOML (naming the file), or a bad claim
         (:func:`plansim.uncertainty.claims.parse_claims`).
     """
-    p = Path(path)
-    if not p.is_file():
-        raise ValueError(f"--claims {str(path)!r}: no such file")
-    try:
-        with open(p, "rb") as fh:
-            document = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"claims file {str(path)!r} is not valid TOML: {exc}") from None
-    return parse_claims(document, scenario, source=p.name)
+    document, name = _document(path)
+    return parse_claims(document, scenario, source=name)

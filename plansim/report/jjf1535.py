@@ -364,3 +364,28 @@ def cell_fields(ds, index) -> dict:
         value = coordinate.values[index[dims.index(coordinate.dims[0])]]
         out[field] = value.item() if hasattr(value, "item") else value
     return out
+
+
+# ------------------------------------------------------------------------------------------ claims on JJF 1535 items
+
+def claims_table(rows: list[dict], source: str) -> str:
+    """The claims of a certificate against the Monte Carlo (:func:`plansim.uncertainty.jjf1535_claims.
+    judge_jjf1535_claims`), in each item's JJF 1535 unit (or relative)."""
+    lines = [f"Claims ({source}) against the Monte Carlo: coverage = trials with |error| <= U (relative: |error/true| "
+             "<= U); needed = the half-width the Monte Carlo needs for the claim's probability",
+             f"  {'item':30s} {'unit':>16s} {'claimed U':>11s} {'k':>4s} {'needed':>11s} {'coverage':>9s}  verdict"]
+    for r in rows:
+        unit, scale = ("1 (relative)", 1.0) if r["relative"] else (ITEMS[r["item"]][2], ITEMS[r["item"]][3])
+        lines.append(f"  {LABELS.get(r['item'], r['item']):30s} {unit:>16s} {_g(r['U'] / scale):>11s} {r['k']:>4g} "
+                     f"{_g(r['needed'] / scale):>11s} {100 * r['coverage']:8.1f}%  {r['verdict']}")
+    return "\n".join(lines)
+
+
+def claims_json(rows: list[dict]) -> list[dict]:
+    """The judged claims as the JSON's ``claims``, SI (``unit``: the item's SI unit, or ``1 (relative)``)."""
+    out = []
+    for r in rows:
+        entry = {k: (_number(v) if isinstance(v, float) else v) for k, v in r.items()}
+        entry["unit"] = "1 (relative)" if r["relative"] else SI_UNITS[ITEMS[r["item"]][2]]
+        out.append(entry)
+    return out
