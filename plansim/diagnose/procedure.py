@@ -300,7 +300,9 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                    stated_white=stated_white, stated_step=stated_step,
                    moves=False)  # the diagnosis tests the segment means' model; the moves' gyro fit is fit's
     # the samples' noise depends on the samples alone: estimated once, shared by every refit below
-    options["noise"] = recording_noise(recording, stated_white, stated_step)
+    # (every static segment at the model's noise: one that scatters more is the within tests' finding, and its mean
+    # is tested as any other's — estimate_noise's noisier=False)
+    options["noise"] = recording_noise(recording, stated_white, stated_step, noisier=False)
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the
     # null hypothesis — the base model — as a score test estimates its nuisance parameters; every fit below then
     # takes it as given. Estimated with the candidates in the model instead, it came out too small wherever a

@@ -640,7 +640,8 @@ def _noisier_segments(within: np.ndarray, within_dof: np.ndarray, static: list[i
     return []
 
 
-def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=None, stated_step=None) -> NoiseEstimate:
+def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=None, stated_step=None,
+                   noisier: bool = True) -> NoiseEstimate:
     """The noise of each channel and the variance of each segment mean, from the samples alone.
 
     Parameters
@@ -660,6 +661,12 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
         there, its segment means would make every parameter that depends on it look exact (jjf2003's 12-bit
         accelerometers, σ 0.05 of a step: in one null recording of about 140, all three read one code in each of
         their 18 poses, on three levels only, and K_a,zz came out with u = 1.4e-10 against an error of 7e-4).
+
+    noisier : bool
+        Give the static segments that scatter more than the channel's quiet ones their own scatter and leave them
+        out of the Allan fit (:func:`_noisier_segments`; default). ``plansim diagnose`` turns it off: there such a
+        segment is a finding of the within-segment tests, and its mean is tested as any other's (a segment a turn
+        spilled into is off, not merely noisy; weighed by its own scatter it left the rest to catalogue names).
 
     Returns
     -------
@@ -712,11 +719,11 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                                  "if the unit is quantised, state its acquisition (plansim fit --scenario), or "
                                  "every parameter that depends on this channel looks exact")
     channels = []
-    noisier = np.zeros((S, 6), dtype=bool)  # a static segment that scatters more than the channel's others
+    shaken = np.zeros((S, 6), dtype=bool)  # a static segment that scatters more than the channel's others
     for c, name in enumerate(CHANNELS):
         step = steps[c]
         # the Allan deviation of the static segments, without those that scatter more than the channel's quiet ones
-        flagged = _noisier_segments(within[:, c], within_dof, static, step)
+        flagged = _noisier_segments(within[:, c], within_dof, static, step) if noisier else []
         pooled_from = [k for k in static if k not in flagged]
         tau, avar, dof = pooled_allan_variance([(segment_samples[k][:, c], segments[k].sample_rate)
                                                 for k in pooled_from])
@@ -725,7 +732,7 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
         else:
             tau = avar = dof = np.zeros(0)
             white = bias_instability = random_walk = math.nan
-        noisier[flagged, c] = True
+        shaken[flagged, c] = True
         channels.append(ChannelNoise(name, white, bias_instability, random_walk, step, len(pooled_from),
                                      int(sum(segment_samples[k].shape[0] for k in pooled_from)), tau,
                                      np.sqrt(avar), dof))
@@ -771,7 +778,7 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                 white, white_dof = ch.white**2 / duration, static_dof
                 if s.is_rotating and s.rate_known and own > white:  # a table's rate jitter (a hand's is no noise)
                     white, white_dof = own, max(within_dof[k], 1)
-                if noisier[k, c]:  # a pose that shook: its own scatter, of which the white model knows nothing
+                if shaken[k, c]:  # a pose that shook: its own scatter, of which the white model knows nothing
                     white, white_dof = max(own, white), max(within_dof[k], 1)
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             own_quantisation = 0.0
