@@ -311,3 +311,21 @@ def test_the_noisier_segment_test_rarely_fires_on_clean_segments():
         tests += 6 * sum(1 for seg in rec.schedule.segments if not seg.is_rotating)
     assert tests == 1080
     assert flags <= binom.ppf(0.999, tests, 1e-3), flags
+
+
+def test_a_gyro_wired_with_its_sign_flipped_is_found_and_said():
+    """The y gyro's column negated (a log from a unit whose axes a user mapped with one sign wrong): started from
+    Kg = I alone the fit stopped in a local minimum (χ² 3e8 on 29 dof, every entry wrong); started from every sign
+    pattern of the diagonal it finds row y of Kg negated, within 4u, a χ² consistent with the noise, and the
+    report says which scale factor is negative and why."""
+    s, rec = session(12, poses=20)
+    x = np.array(rec.samples)
+    x[:, 1] *= -1.0
+    fit = fit_recording(Recording(x, rec.schedule, rec.attrs, timestamps=rec.time), SITE)
+    moves = fit.moves
+    truth = combination(s.theta)
+    truth[1] *= -1.0
+    z = (moves.method.estimate[KG_INDEX] - truth.ravel()) / moves.method.u[KG_INDEX]
+    assert np.all(np.abs(z) < 4.0), z
+    assert moves.chi2 / moves.chi2_dof < 2.0
+    assert any("the scale factor of the y gyro is negative" in note for note in fit.notes)

@@ -83,6 +83,8 @@ _USED_FROM_JOINT = tuple(f"{p}{a}{b}" for p in ("Ka", "g") for a in "xyz" for b 
 _STEP_GYRO, _STEP_ACCEL, _STEP_PARAMETER = 1e-7, 1e-6, 1e-7
 #: two moves or fewer cannot identify anything (each gives two numbers)
 MIN_TRANSITIONS = 2
+#: the first solve starts from Kg = diag(±1, ±1, ±1), each sign pattern, and keeps the smallest χ²
+SIGN_STARTS = tuple((a, b, c) for a in (1.0, -1.0) for b in (1.0, -1.0) for c in (1.0, -1.0))
 
 
 @dataclass(frozen=True)
@@ -416,9 +418,14 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             J = np.vstack([moves.one(m, Kg, theta, means, details=True)[1]["jac"] for m in range(n_moves)])
             return W @ J @ basis
 
-        z0 = np.linalg.lstsq(basis, (Kg_start - np.eye(3)).ravel(), rcond=None)[0]
-        result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200)
-        Kg = np.eye(3) + (basis @ result.x).reshape(3, 3)
+        best = None
+        for start in np.atleast_3d(Kg_start).transpose(2, 0, 1) if np.ndim(Kg_start) == 3 else [Kg_start]:
+            z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
+            result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                                   max_nfev=200)
+            if best is None or result.cost < best.cost:
+                best = result
+        Kg = np.eye(3) + (basis @ best.x).reshape(3, 3)
         return Kg, W
 
     Kg = np.eye(3)
@@ -428,7 +435,11 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         sources, jacobian, angles = build(Kg, dark)
         V = sources.covariance()
         if iteration == 0:
-            Kg, W = solve(V, Kg)
+            # from each sign of the three scale factors: a gyro wired with its sign flipped against the
+            # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
+            # stops in a local minimum (every move's miss of the order of its angle)
+            starts = np.stack([np.diag(signs) for signs in SIGN_STARTS], axis=2)
+            Kg, W = solve(V, starts)
             continue
         if iteration == 1:
             V_predicted = V
@@ -482,6 +493,12 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                                   "accelerometers, whose rotation no pose placed by hand fixes; the gravity_sequence "
                                   f"estimate is in the frame where Ka is symmetric, i.e. Kg{x}{y} − (Ka{x}{y} − "
                                   f"Ka{y}{x})/2 to first order")
+    flipped = [a for a in range(3) if kg_mask[4 * a] and Kg[a, a] < 0]
+    if flipped:
+        notes.append("the scale factor of the " + ", ".join(f"{'xyz'[a]} gyro" for a in flipped) + " is negative "
+                     f"({', '.join(f'{Kg[a, a]:+.4g}' for a in flipped)}): its sign is opposite to the accelerometer "
+                     "triad's — a gyro, or an accelerometer, wired or mapped with its axis flipped (check --columns "
+                     "and the axes' signs)")
     if dark > 0:
         notes.append(f"the moves' residuals scatter beyond the predicted noise: {math.degrees(math.sqrt(dark)):.3g} "
                      "deg per component between moves, estimated from them, enters every u (kind 'between')")
