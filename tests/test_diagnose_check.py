@@ -57,6 +57,10 @@ def test_the_effects_outside_the_catalogue_are_what_they_say():
     assert np.std(burst[inside, 0]) == pytest.approx(0.3, rel=0.04)
     with pytest.raises(ValueError, match="clock_slow"):
         _add_out_of_catalogue("clock_slow", flat, 1.0, 0)
+    # the x gyro's scale factor 1e-3 larger from the middle on: (gx - bias) grows by that fraction there
+    scaled = _add_out_of_catalogue("scale_change", ramp.copy() + 7.0, 1e-3, 0, bias=7.0) - (ramp + 7.0)
+    assert np.all(scaled[:500] == 0) and np.all(scaled[:, 1:] == 0)
+    np.testing.assert_allclose(scaled[500:, 0], 1e-3 * ramp[500:, 0], rtol=1e-12)
 
 
 def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(monkeypatch):

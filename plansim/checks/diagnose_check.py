@@ -16,7 +16,9 @@ Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simul
   makes) (:func:`_add_out_of_catalogue`): a step in
   the x gyro's bias half-way through the recording, of k × the standard uncertainty of a gx segment mean; a
   sample clock that runs fast by k × 100 ppm (the segment table, in nominal time, drifts off the data); a burst
-  of extra white noise on gx over a tenth of the run, of k × its noise per sample. And a lever arm of 5 mm on
+  of extra white noise on gx over a tenth of the run, of k × its noise per sample; a change of the x gyro's scale
+  factor half-way through, of k × the change that moves a segment at the schedule's largest rate by a gx segment
+  mean's standard uncertainty. And a lever arm of 5 mm on
   the x accelerometer that the fit is not told (aliased with P in JJF 2003: it must never be attributed).
 
 ``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, the
@@ -44,6 +46,7 @@ from plansim.fit import resolve_site, scenario_fit_options
 from plansim.io.scenario_file import apply_overrides
 from plansim.kernels.layout import ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP
 from plansim.kernels.quantiser import quantise
+from plansim.model.parameters import PARAMETER_INDEX
 from plansim.runner import simulate_and_record
 from plansim.simulate.arguments import kernel_arguments
 from plansim.simulate.chunks import simulate_recording
@@ -54,7 +57,7 @@ FIELDS = {"gyro_scale_asymmetry": "gyro_asymmetry", "gyro_scale_nonlinearity": N
           "gyro_g2_sensitivity", "accel_quadratic": "accel_second_order", "lever_arm": "accel_lever_arm"}
 #: effects outside the catalogue, added to the samples (:func:`_add_out_of_catalogue`); the lever arm the fit is
 #: not told is run with the catalogue effects
-OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst")
+OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst", "scale_change")
 #: the catalogue effects injected (the lever arm at a fixed 5 mm, the others at each size)
 CATALOGUE_CASES = ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
                    "bias_drift", "lever_arm")
@@ -260,9 +263,10 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     u_mean = float(np.median(np.sqrt(np.diag(reference.before.covariance)).reshape(-1, 6)[:, 0]))
     white = reference.before.noise.channels[0].white
     sigma_sample = float(white * math.sqrt(sample_rate)) if math.isfinite(white) else u_mean
+    max_rate = max(abs(seg.rate) for seg in scenario.schedule.segments if seg.rate_known)
     for effect in (e for e in OUT_OF_CATALOGUE if e in effects):
         for k in sizes:
-            size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample)
+            size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample, max_rate)
             flagged, named = 0, 0
             for i in range(per_effect):
                 s = case_seed(seed, f"{effect}/{k}", i)
@@ -270,7 +274,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 # without the quantiser, then quantised as the scenario's acquisition does
                 recording = simulate_and_record(unquantised, seed=s, trial=0)
                 _, _, truth = simulate_recording(scenario, s, 0)
-                samples = _add_out_of_catalogue(effect, np.array(recording.samples, dtype=float), size, s)
+                samples = _add_out_of_catalogue(effect, np.array(recording.samples, dtype=float), size, s,
+                                                bias=float(truth[PARAMETER_INDEX["Bgx"]]))
                 recording = type(recording)(_acquire(scenario, samples), recording.schedule, dict(recording.attrs))
                 d, _ = _run(scenario, recording, truth, alpha, null_draws, s)
                 flagged += _alarm(d)
@@ -287,7 +292,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
 CLOCK_ERROR_PER_K = 1e-4
 
 
-def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: float) -> tuple[float, str, str]:
+def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: float,
+                           max_rate: float = math.nan) -> tuple[float, str, str]:
     """(size, unit, what k multiplies) of an out-of-catalogue effect at multiple *k*."""
     if effect == "bias_step":
         return k * u_mean, "rad/s", "the standard uncertainty of a gx segment mean (the fit's V)"
@@ -295,16 +301,20 @@ def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: f
         return k * CLOCK_ERROR_PER_K, "1", f"{CLOCK_ERROR_PER_K:g} of relative clock error"
     if effect == "noise_burst":
         return k * sigma_sample, "rad/s", "the gx noise per sample"
+    if effect == "scale_change":
+        return (k * u_mean / max_rate, "1", "the change of the x gyro's scale factor that moves a segment at the "
+                "schedule's largest rate by a gx segment mean's standard uncertainty")
     raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
 
 
-def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: int) -> np.ndarray:
+def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: int, bias: float = 0.0) -> np.ndarray:
     """The samples (n, 6) with an out-of-catalogue effect of *size* (:func:`_out_of_catalogue_size`) added.
 
     ``bias_step``: gx + size from the middle sample on. ``clock_fast``: the sensor's clock runs fast by the
     relative error *size*, so sample i holds the signal of nominal sample i·(1 + size) (linear interpolation;
     the segment table, in nominal time, drifts off the data by up to size × the run). ``noise_burst``: white
-    noise of sd *size* added to gx over a tenth of the run, from 40 % of it.
+    noise of sd *size* added to gx over a tenth of the run, from 40 % of it. ``scale_change``: the x gyro's scale
+    factor grows by the relative *size* from the middle sample on (gx − *bias*, the unit's Bgx, times *size* added).
     """
     n = samples.shape[0]
     if effect == "bias_step":
@@ -316,6 +326,8 @@ def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: i
     elif effect == "noise_burst":
         start, stop = int(0.4 * n), int(0.5 * n)
         samples[start:stop, 0] += size * np.random.default_rng(seed).standard_normal(stop - start)
+    elif effect == "scale_change":
+        samples[n // 2:, 0] += size * (samples[n // 2:, 0] - bias)
     else:
         raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
     return samples
