@@ -53,7 +53,14 @@ from plansim.simulate.chunks import (
 from plansim.simulate.jjf1535_effects import without_jjf1535_effects
 from plansim.simulate.paths import PATH_NAMES, choose_path
 from plansim.uncertainty import APPENDIX_A, AppendixABudget
-from plansim.uncertainty.chapter_comparison import CHAPTER_TURN_RATE, MisalignmentComparison, compare_misalignment
+from plansim.uncertainty.chapter_comparison import (
+    CHAPTER_TESTS,
+    CHAPTER_TURN_RATE,
+    DRIFT_REPEATS,
+    ChapterComparison,
+    compare_chapter,
+    compare_misalignment,
+)
 from plansim.uncertainty.jjf1535_monte_carlo import Jjf1535MonteCarlo, jjf1535_monte_carlo, jjf1535_scenario
 
 if TYPE_CHECKING:
@@ -463,7 +470,7 @@ def validate(scenario: Scenario | str = "jjf2003", claims=None, *, path: str = "
 
 def compare_chapter_misalignment(scenario: Scenario | str = "jjf2003", trials: int = 1000, seed: int | None = None,
                                  rate: float = CHAPTER_TURN_RATE, turns: int = 1,
-                                 path: str = "auto") -> MisalignmentComparison:
+                                 path: str = "auto") -> ChapterComparison:
     """The gyro misalignments of the same units by JJF 2003 §7.2.3 and by the chapter's ± rate turns, eq. (6-8).
 
     *scenario* (a built-in name, a TOML path or a :class:`~plansim.config.Scenario`; default ``jjf2003``)
@@ -474,6 +481,25 @@ def compare_chapter_misalignment(scenario: Scenario | str = "jjf2003", trials: i
     sc = _scenario_of(scenario)
     seed = sc.seed if seed is None else seed
     return compare_misalignment(sc, trials, seed, rate=rate, turns=turns, path=path)
+
+
+def compare_chapter_procedures(scenario: Scenario | str = "jjf2003", trials: int = 1000, seed: int | None = None,
+                               tests=CHAPTER_TESTS, rate: float = CHAPTER_TURN_RATE, turns: int = 1,
+                               repeats: int = DRIFT_REPEATS, path: str = "auto", chunk_size: int = 256,
+                               progress: ProgressCallback | None = None) -> ChapterComparison:
+    """The textbook chapter's procedures and JJF 2003 on the same units: gyro misalignments (eq. (6-8)),
+    accelerometer cross-axis terms (the 8-position test, eq. (6-9)) and the gyro drift model D0–D3 with its
+    random drift (eq. (6-6)).
+
+    *scenario* (a built-in name, a TOML path or a :class:`~plansim.config.Scenario`; default ``jjf2003``)
+    is simulated with its JJF 2003 schedule plus the chapter's tests; see
+    :func:`plansim.uncertainty.chapter_comparison.compare_chapter`. *seed* defaults to the scenario's.
+    ``plansim run chapter --unit SCENARIO`` prints its summary.
+    """
+    sc = _scenario_of(scenario)
+    seed = sc.seed if seed is None else seed
+    return compare_chapter(sc, trials, seed, tests, rate=rate, turns=turns, repeats=repeats, path=path,
+                           chunk_size=chunk_size, progress=progress)
 
 
 def jjf1535_run(scenario: Scenario | str = "jjf2003", trials: int = 1000, seed: int | None = None,

@@ -206,7 +206,10 @@ def test_scenarios_lists_jjf1535_as_a_procedure_not_a_scenario_file(capsys):
     assert cli.main(["scenarios"]) == 0
     lines = capsys.readouterr().out.splitlines()
     (line,) = [line for line in lines if line.split()[0] == "jjf1535"]
-    here = len(lines) - 1 - len(cli.simulation.EXPERIMENTS)
-    assert line == lines[here]  # after the scenarios, before the experiments (plansim run vibration_g2)
+    first = len(lines) - len(cli.simulation.EXPERIMENTS) - len(cli.simulation.PROCEDURES)
+    assert line == lines[first]  # after the scenarios, the first procedure, before the experiments (vibration_g2)
+    assert [entry.split()[0] for entry in lines[first:first + len(cli.simulation.PROCEDURES)]] == list(
+        cli.simulation.PROCEDURES)
     assert "[procedure, not a scenario file: plansim run jjf1535 --unit SCENARIO] JJF 1535-2015" in line
-    assert all("[procedure" not in other for other in lines[:here] + lines[here + 1:])
+    last = first + len(cli.simulation.PROCEDURES)
+    assert all("[procedure" not in other for other in lines[:first] + lines[last:])

@@ -97,6 +97,22 @@ def add_procedure_option(p) -> None:
                         "repeats=5 --procedure maximum_rate=\"100 deg/s\" (repeatable; docs/jjf1535.md)")
 
 
+def checked_trials(args, default_trials: int) -> int:
+    """``--trials`` (default *default_trials*, >= 2), ``--seed`` (>= 0) and ``--plot`` (a figure suffix) of a built-in
+    Monte Carlo, checked before any work; returns the number of trials."""
+    from plansim.io.files import check_output_path
+    from plansim.report.plot import FIGURE_SUFFIXES
+
+    trials = default_trials if args.trials is None else args.trials
+    if trials < 2:
+        raise ValueError(f"--trials {trials}: must be >= 2 (the Monte Carlo's scatter needs two trials)")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    return trials
+
+
 def run_experiment(args, run, figure, as_json, as_text) -> int:
     """The tail of ``plansim run`` for a built-in experiment (``jjf1537``, ``vibration_g2``), once its options are
     checked: *run* () → result, timed; ``--plot`` written by *figure* (result, path, format) and committed with the

@@ -26,11 +26,13 @@ VALIDATE_CLAIMS_REFUSAL = (
     "'plansim run jjf1535 --claims claims.toml' (docs/jjf1535.md)")
 
 
-def _load_unit(args):
+def load_unit(args, procedures=PROCEDURES):
+    """The unit scenario of a procedure run (``--unit``, default :data:`DEFAULT_UNIT`, with ``--set``); a name
+    among *procedures* is refused (a procedure is not a unit)."""
     from plansim.io.scenario_file import load_scenario
 
     name = DEFAULT_UNIT if args.unit is None else args.unit
-    if name in PROCEDURES:
+    if name in procedures:
         raise ValueError(f"--unit {name!r}: {name} is a procedure, not a unit scenario; allowed: a built-in "
                          "scenario name (see 'plansim scenarios') or a TOML path")
     try:
@@ -73,7 +75,7 @@ def run_jjf1535(args, default_chunk_size: int) -> int:
         raise ValueError(f"--trials {args.trials}: must be >= 2 (the standard deviations need two trials)")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
-    unit = _load_unit(args)
+    unit = load_unit(args)
     settings = jjf1535_settings(args.procedure or ())
     procedure = settings.procedure()
     jjf1535_scenario(unit, procedure)  # refuses a unit the procedure would drive past its limits, before any work
@@ -137,7 +139,7 @@ def validate_jjf1535_command(args) -> int:
 
     if args.claims:
         raise ValueError(VALIDATE_CLAIMS_REFUSAL)
-    unit = _load_unit(args)
+    unit = load_unit(args)
     settings = jjf1535_settings(args.procedure or ())
     progress = validate_progress(f"plansim validate jjf1535 --unit {unit.name}", args.quiet or args.json)
     report = validate_jjf1535(unit, settings.procedure(), digits=args.digits, trials_per_block=args.trials_per_block,

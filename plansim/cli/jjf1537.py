@@ -20,10 +20,8 @@ DYNAMIC_TESTS = {
 
 def run_jjf1537_command(args, default_chunk_size: int) -> int:
     """``plansim run jjf1537``: every check first, then the Monte Carlo and the report."""
-    from plansim.cli.common import run_experiment
-    from plansim.io.files import check_output_path
+    from plansim.cli.common import checked_trials, run_experiment
     from plansim.report.jjf1537 import bode_figure, jjf1537_json, jjf1537_text
-    from plansim.report.plot import FIGURE_SUFFIXES
     from plansim.report.progress import stderr_progress
     from plansim.simulate.jjf1537 import DEFAULT_SEED, DEFAULT_TRIALS, Jjf1537Experiment, run_jjf1537, with_overrides
 
@@ -37,13 +35,7 @@ def run_jjf1537_command(args, default_chunk_size: int) -> int:
     if args.chunk_size != default_chunk_size:
         raise ValueError(f"--chunk-size {args.chunk_size}: not available with the test jjf1537 (the results do "
                          "not depend on its chunks)")
-    trials = DEFAULT_TRIALS if args.trials is None else args.trials
-    if trials < 2:
-        raise ValueError(f"--trials {trials}: must be >= 2 (the Monte Carlo's scatter needs two trials)")
-    if args.seed is not None and args.seed < 0:
-        raise ValueError(f"--seed {args.seed}: must be >= 0")
-    if args.plot is not None:
-        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
+    trials = checked_trials(args, DEFAULT_TRIALS)
     settings = with_overrides(Jjf1537Experiment(), args.set)
     seed = DEFAULT_SEED if args.seed is None else args.seed
 

@@ -6,8 +6,11 @@ import json
 import os
 import time
 
+from plansim.cli.chapter import PROCEDURES as CHAPTER_PROCEDURES
+from plansim.cli.chapter import run_chapter
 from plansim.cli.common import COMMANDS, add_procedure_option, add_set_option
-from plansim.cli.jjf1535 import DEFAULT_UNIT, PROCEDURES, run_jjf1535, validate_jjf1535_command
+from plansim.cli.jjf1535 import DEFAULT_UNIT, run_jjf1535, validate_jjf1535_command
+from plansim.cli.jjf1535 import PROCEDURES as JJF1535_PROCEDURES
 from plansim.cli.jjf1537 import DYNAMIC_TESTS, run_jjf1537_command
 from plansim.cli.vibration import EXPERIMENTS as VIBRATION_EXPERIMENTS
 from plansim.cli.vibration import run_vibration
@@ -19,6 +22,8 @@ from plansim.report.progress import end_progress_line
 DEFAULT_CHUNK_SIZE = 4096
 #: the built-in experiments (``plansim run NAME [--set KEY=VALUE]``), listed last by ``plansim scenarios``
 EXPERIMENTS = {**DYNAMIC_TESTS, **VIBRATION_EXPERIMENTS}
+#: the built-in procedures run on a unit scenario (``plansim run NAME --unit SCENARIO``)
+PROCEDURES = {**JJF1535_PROCEDURES, **CHAPTER_PROCEDURES}
 
 
 def _cmd_run(args) -> int:
@@ -31,7 +36,9 @@ def _cmd_run(args) -> int:
     from plansim.runner import run, run_summary
     from plansim.uncertainty import compare_with_appendix_a
 
-    if args.scenario in PROCEDURES:  # a built-in procedure run on a unit scenario, not a scenario file
+    if args.scenario in CHAPTER_PROCEDURES:  # the chapter's tests and JJF 2003 on the same units
+        return run_chapter(args, DEFAULT_CHUNK_SIZE, PROCEDURES)
+    if args.scenario in JJF1535_PROCEDURES:  # a built-in procedure run on a unit scenario, not a scenario file
         return run_jjf1535(args, DEFAULT_CHUNK_SIZE)
     for option, value in (("--procedure", args.procedure), ("--claims", args.claims)):
         if value:
@@ -161,7 +168,10 @@ def _cmd_validate(args) -> int:
             raise ValueError(f"{option} {value}: must be >= {minimum}")
     if args.seed is not None and args.seed < 0:
         raise ValueError(f"--seed {args.seed}: must be >= 0")
-    if args.scenario in PROCEDURES:  # a built-in procedure validated on a unit scenario
+    if args.scenario in CHAPTER_PROCEDURES:
+        raise ValueError(f"{args.scenario!r}: 'plansim validate' checks a GUM budget, and the chapter's procedures "
+                         "carry none; compare them with JJF 2003 by Monte Carlo: plansim run chapter --unit SCENARIO")
+    if args.scenario in JJF1535_PROCEDURES:  # a built-in procedure validated on a unit scenario
         return validate_jjf1535_command(args)
     if args.unit is not None:
         raise ValueError(f"--unit {args.unit!r}: only with a procedure ({', '.join(PROCEDURES)}: plansim validate "
@@ -223,24 +233,28 @@ def add_commands(sub) -> None:
                                    "'plansim run jjf1535 [--unit SCENARIO]': the JJF 1535-2015 procedure on a unit "
                                    "scenario, compared with its Appendix A; 'plansim run vibration_g2': the vibration "
                                    "paper's g² experiment; 'plansim run jjf1537': the JJF 1537-2015 "
-                                   "angular vibration test, a Monte Carlo (docs/dynamic.md)")
+                                   "angular vibration test, a Monte Carlo (docs/dynamic.md); 'plansim run chapter "
+                                   "[--unit SCENARIO]': the textbook chapter's procedures against JJF 2003 on the "
+                                   "same units (docs/chapter-procedures.md)")
     p.add_argument("scenario", nargs="?", default="jjf2003",
                    help="built-in scenario name (see 'plansim scenarios') or a TOML path; default jjf2003; or the "
-                        "procedure jjf1535, the experiment vibration_g2, or the dynamic test jjf1537")
+                        "procedure jjf1535 or chapter, the experiment vibration_g2, or the dynamic test jjf1537")
     p.add_argument("--unit", default=None, metavar="SCENARIO",
-                   help=f"with the procedure jjf1535: the scenario whose unit, noise, effects and laboratory it runs "
-                        f"on (built-in name or TOML path; default {DEFAULT_UNIT})")
+                   help=f"with the procedure jjf1535 or chapter: the scenario whose unit, noise, effects and "
+                        f"laboratory it runs on (built-in name or TOML path; default {DEFAULT_UNIT})")
     add_set_option(p)
     add_procedure_option(p)
     p.add_argument("--claims", default=None,
                    help="with the procedure jjf1535: a TOML file of a certificate's stated U per item "
                         "([jjf1535.ITEM] U = …, relative, k), judged against the Monte Carlo (docs/jjf1535.md)")
     p.add_argument("--trials", type=int, default=None,
-                   help="number of simulated calibrations (default: the scenario's; jjf1535: 1000; jjf1537: 500)")
+                   help="number of simulated calibrations (default: the scenario's; jjf1535, chapter: 1000; "
+                        "jjf1537: 500)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's, or the unit's)")
     p.add_argument("--out", default=None, help="write the results Dataset to this NetCDF file (.nc)")
     p.add_argument("--plot", default=None, help="write the Appendix A error histograms (.png, .pdf or .svg); "
-                   "vibration_g2: the PSDs and the compensated output; jjf1537: the Bode diagram")
+                   "vibration_g2: the PSDs and the compensated output; jjf1537: the Bode diagram; chapter: the rms "
+                   "errors by procedure")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
     p.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
                    help="trials per kernel call (results do not depend on it; memory grows with it)")
