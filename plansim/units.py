@@ -29,7 +29,7 @@ KINDS: dict[str, dict[str, float]] = {
     "angle": {"rad": 1.0, "deg": DEG, "arcmin": DEG / 60.0, "arcsec": ARCSEC},
     "angular_rate": {"rad/s": 1.0, "deg/s": DEG, "deg/h": DEG / HOUR},
     "acceleration": {"m/s^2": 1.0, "g": STANDARD_GRAVITY, "mg": MILLI_G, "ug": MICRO_G},
-    "time": {"s": 1.0, "min": 60.0, "h": HOUR},
+    "time": {"s": 1.0, "ms": 1e-3, "min": 60.0, "h": HOUR},
     "frequency": {"Hz": 1.0, "kHz": 1e3},
     "length": {"m": 1.0, "cm": 1e-2, "mm": 1e-3},
     "temperature": {"degC": 1.0},

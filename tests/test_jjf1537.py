@@ -206,7 +206,9 @@ def test_cli_json_and_plot(capsys, tmp_path):
     assert doc["monte_carlo"]["bandwidth_found"] == 3
     assert plot.stat().st_size > 10_000
     items = doc["vibration_shock"]
-    assert set(items["items"]) == set(ITEMS) and items["shock_waveform_simulated"] is False
+    assert set(items["items"]) == set(ITEMS) and items["shock_waveform_simulated"] is True
+    assert set(items["shock"]) == {"peak_truth", "peak_mean", "peak_std", "saturated", "not_settled", "shock_record",
+                                   "recovery_median", "recovery_max"}
     assert items["items"]["amplitude_nonlinearity"]["gum"] is None  # no GUM for a maximum: null, strict JSON
     assert items["items"]["bias_change_shock"]["truth"] == 0.0
 
@@ -216,7 +218,7 @@ def test_cli_text_and_bad_input(capsys):
     out, err = capsys.readouterr()
     assert out.startswith("plansim run jjf1537: seed 1537, 2 trials") and "-3 dB bandwidth: truth" in out
     assert "7.2.4 amplitude nonlinearity (ppm)" in out and "7.2.7 bias change, shock (deg/h)" in out
-    assert "the shock waveform is not simulated" in out
+    assert "shock: half-sine 50 g, 11 ms along the input axis" in out and "peak output" in out
     assert "2/2 trials" in err  # the progress line
     assert cli.main(["run", "jjf1537", "--set", "repeats=5"]) == 2
     assert "repeats: expected an integer >= 7" in capsys.readouterr().err

@@ -452,3 +452,50 @@ def mean_change(before, after) -> tuple[np.ndarray, np.ndarray]:
     change = a.mean(axis=-1) - b.mean(axis=-1)
     u = np.sqrt(a.var(axis=-1, ddof=1) / a.shape[-1] + b.var(axis=-1, ddof=1) / b.shape[-1])
     return change, u
+
+
+@dataclass(frozen=True)
+class ShockResponse:
+    """The output of one record across a shock (:func:`shock_response`), output unit and s."""
+
+    peak: float  # the largest |y − level before| in the record
+    saturated: bool  # a sample at the output's range
+    recovery_time: float  # from the pulse's start to the last sample outside the band; nan: not back by the end
+
+
+def shock_response(record, level_before: float, level_after: float, band: float, sample_rate: float,
+                   output_range: float) -> ShockResponse:
+    """The output across a shock: its peak departure from the level before, saturation, and the recovery time.
+
+    The recovery time is the time from the record's first sample (the pulse's start) to the end of the last
+    sample farther than *band* from *level_after* (the level the output settles to: the mean of the record
+    after the shock); nan when the record's last sample is still outside (the output had not settled when the
+    next record began: the settle time was too short). A laboratory chooses *band* from the noise at rest
+    (plansim: 4 × its standard deviation plus one quantisation step).
+
+    Parameters
+    ----------
+    record : (N,) array
+        The output from the pulse's start, output unit.
+    level_before, level_after : float
+        The output's level before the shock and after it, output unit.
+    band : float
+        > 0, output unit.
+    sample_rate : float
+        Hz.
+    output_range : float
+        The output's saturation level (> 0): a sample with |y| >= it is saturated.
+    """
+    y = np.asarray(record, dtype=float)
+    if y.ndim != 1 or y.size == 0 or not np.all(np.isfinite(y)):
+        raise ValueError(f"record: expected a non-empty 1-D array of finite outputs, got shape {y.shape}")
+    for name, value in (("band", band), ("sample_rate", sample_rate), ("output_range", output_range)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{name}: expected a finite number > 0, got {value!r}")
+    outside = np.flatnonzero(np.abs(y - level_after) > band)
+    if outside.size and outside[-1] == y.size - 1:
+        recovery = math.nan
+    else:
+        recovery = (outside[-1] + 1) / sample_rate if outside.size else 0.0
+    return ShockResponse(peak=float(np.max(np.abs(y - level_before))),
+                         saturated=bool(np.any(np.abs(y) >= output_range)), recovery_time=float(recovery))

@@ -120,7 +120,43 @@ def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias,
             if i < 0:
                 out[r, k] = math.nan
             else:
-                if even != 0.0 or odd != 0.0:
-                    v = v + v * v * (even + odd * v)
-                y = scale * v + bias + sigma * white[k - skip]
-                out[r, k] = quantise(y, output_range, step, inverse_step, output_range)
+                out[r, k] = _gyro_output(v, even, odd, scale, bias, sigma * white[k - skip], step, inverse_step,
+                                         output_range)
+
+
+@inline_jit
+def _gyro_output(v, even, odd, scale, bias, noise, step, inverse_step, output_range):
+    """The output of one sample: Q(S·g(v) + B + noise), g(v) = v + c₂v² + c₃v³ (:func:`sine_records`)."""
+    if even != 0.0 or odd != 0.0:
+        v = v + v * v * (even + odd * v)
+    return quantise(scale * v + bias + noise, output_range, step, inverse_step, output_range)
+
+
+@jit
+def input_records(b, a, states, inputs, first, scale, bias, sigma, step, output_range, key, streams, block, white,
+                  out, even=0.0, odd=0.0):
+    """Gyro records driven by one input common to every record: out[r, k] for sample index first + k ≥ 0.
+
+    As :func:`sine_records`, with the sensor's input (rad/s) given sample by sample, ``inputs[k]`` for sample
+    first + k, instead of a table's sinusoid: y = Q(S · g((H x)[i]) + B + σ w_r[i]), H continuing from
+    ``states[r]``. A half-sine shock reaches the gyro this way (:func:`plansim.simulate.jjf1537.shock_records`):
+    its input is the rate its g-sensitivity reads from the pulse's acceleration. Chunks of any size give the
+    same numbers (the state is carried, the white sequence indexed by i).
+
+    Parameters
+    ----------
+    inputs : ndarray, (n,)
+        x at sample first + k, rad/s.
+    first : int
+        The sample index of out[:, 0], >= 0.
+    Others
+        As :func:`sine_records`.
+    """
+    rows, n = out.shape
+    inverse_step = 1.0 / step if step > 0.0 else 0.0
+    for r in range(rows):
+        state = states[r]
+        white_blocks(key, streams[r], block, first, white[:n])
+        for k in range(n):
+            v = _df2t_step(b, a, state, inputs[k])
+            out[r, k] = _gyro_output(v, even, odd, scale, bias, sigma * white[k], step, inverse_step, output_range)

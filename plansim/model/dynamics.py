@@ -222,3 +222,31 @@ class SensorDynamics:
 
         return float(scipy.optimize.brentq(lambda f: abs(self.response(f)) - level, lo, hi, xtol=1e-300,
                                            rtol=1e-12))
+
+
+def half_sine(peak: float, duration: float, sample_rate: float, samples: int) -> np.ndarray:
+    """A half-sine shock pulse sampled from its start: a(t_k) = peak · sin(π t_k / duration) for
+    0 <= t_k < duration, 0 after; t_k = k / sample_rate, k = 0 … samples − 1.
+
+    The half-sine is the classical shock waveform of the shock-test standards (IEC 60068-2-27, GJB 150.18,
+    MIL-STD-810 method 516): a peak and a duration (e.g. 50 g, 11 ms). Its mean over the pulse is 2·peak/π and
+    its velocity change 2·peak·duration/π.
+
+    Parameters
+    ----------
+    peak : float
+        Peak acceleration, m/s² (any sign; 0: no pulse).
+    duration : float
+        s, > 0.
+    sample_rate : float
+        Hz, > 0.
+    samples : int
+        Samples to return (>= 0).
+    """
+    peak = one_number("peak", peak, "m/s^2")
+    duration = positive_number("duration", duration, "s")
+    sample_rate = positive_number("sample_rate", sample_rate, "Hz")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 0:
+        raise ValueError(f"samples: expected an integer >= 0, got {samples!r}")
+    t = np.arange(int(samples)) / sample_rate
+    return np.where(t < duration, peak * np.sin(np.pi * np.minimum(t, duration) / duration), 0.0)

@@ -32,6 +32,8 @@ MIN_REPEATS = 7
 AMPLITUDE_FRACTION = (0.10, 0.30)
 #: JJF 1537-2015 7.2.1.2 b): the sample rate exceeds this multiple of the bandwidth
 RATE_PER_BANDWIDTH = 20.0
+#: the fewest samples a half-sine shock pulse may have (plansim's: fewer do not draw its shape)
+MIN_PULSE_SAMPLES = 8
 
 
 def checked_repeats(repeats) -> int:
@@ -179,7 +181,8 @@ class VibrationShockSchedule:
     Per test: at ``frequency`` f, n = ``repeats`` records of whole cycles near ``record_time`` at each of the
     ``amplitudes`` A_k (7.2.4); then at rest for ``rest_time`` (before vibration), under vibration at the
     amplitude ``amplitude`` for ``vibration_time`` (7.2.5), at rest again (after vibration, 7.2.6), the shock
-    (not simulated as a waveform), at rest (after the shock, 7.2.7).
+    record (a half-sine pulse of ``shock_duration`` from its first sample, then ``shock_settle`` at rest), and at
+    rest (after the shock, 7.2.7), the filter's state carried through from the shock record.
 
     Attributes
     ----------
@@ -196,6 +199,9 @@ class VibrationShockSchedule:
     record_time, vibration_time, rest_time : float
         s; the first two rounded down to whole cycles (at least one), N = round(c f_s/f) samples: exactly whole
         cycles when c f_s/f is an integer (20 Hz at 4 kHz), as the closed forms of the tests assume.
+    shock_duration, shock_settle : float
+        s: the half-sine pulse (at least :data:`MIN_PULSE_SAMPLES` samples) and the time at rest after it before
+        the record after the shock.
     """
 
     frequency: float
@@ -207,11 +213,13 @@ class VibrationShockSchedule:
     record_time: float = 1.0
     vibration_time: float = 5.0
     rest_time: float = 5.0
+    shock_duration: float = 0.011
+    shock_settle: float = 1.0
 
     def __post_init__(self):
         for name, unit in (("frequency", "Hz"), ("amplitude", "rad/s"), ("gyro_range", "rad/s"),
                            ("sample_rate", "Hz"), ("record_time", "s"), ("vibration_time", "s"),
-                           ("rest_time", "s")):
+                           ("rest_time", "s"), ("shock_duration", "s"), ("shock_settle", "s")):
             object.__setattr__(self, name, positive_number(name, getattr(self, name), unit))
         try:
             A = np.array(self.amplitudes, dtype=float).ravel()
@@ -234,6 +242,10 @@ class VibrationShockSchedule:
         if min(self.samples(self.record_time), self.rest_samples()) < 4:
             raise ValueError(f"record_time, rest_time: {self.record_time!r} s and {self.rest_time!r} s give "
                              "fewer than 4 samples; allowed: longer records")
+        if self.pulse_samples() < MIN_PULSE_SAMPLES:
+            raise ValueError(f"shock_duration: {self.shock_duration!r} s gives {self.pulse_samples()} samples at "
+                             f"{self.sample_rate:g} Hz; the half-sine needs >= {MIN_PULSE_SAMPLES} (a longer pulse or "
+                             "a higher sample_rate)")
 
     def samples(self, duration: float) -> int:
         """N = round(c f_s/f) for c = max(1, ⌊duration · f⌋) whole cycles."""
@@ -243,3 +255,11 @@ class VibrationShockSchedule:
     def rest_samples(self) -> int:
         """round(rest_time · f_s): the samples of one record at rest."""
         return int(round(self.rest_time * self.sample_rate))
+
+    def pulse_samples(self) -> int:
+        """The samples t_k = k/f_s inside the half-sine, 0 <= t_k < shock_duration."""
+        return int(math.ceil(self.shock_duration * self.sample_rate * (1 - 1e-12)))
+
+    def shock_samples(self) -> int:
+        """The shock record: the pulse's samples and round(shock_settle · f_s) after it."""
+        return self.pulse_samples() + int(round(self.shock_settle * self.sample_rate))

@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.signal
+import scipy.stats
 
 from plansim.estimate.dynamic import (
     HALF_POWER,
@@ -63,12 +64,19 @@ from plansim.estimate.dynamic import (
     bandwidth_3db,
     frequency_response,
     mean_change,
+    shock_response,
     sine_fits,
     wrap_phase,
 )
-from plansim.kernels.dynamics import sine_records
+from plansim.kernels.dynamics import input_records, sine_records
 from plansim.kernels.random import root_key
-from plansim.model.dynamics import SENSOR_MODELS, SensorDynamics, one_number, static_nonlinearity_harmonics
+from plansim.model.dynamics import (
+    SENSOR_MODELS,
+    SensorDynamics,
+    half_sine,
+    one_number,
+    static_nonlinearity_harmonics,
+)
 from plansim.schedule.jjf1537 import (
     LINEARITY_POINTS,
     Jjf1537Schedule,
@@ -79,7 +87,7 @@ from plansim.schedule.jjf1537 import (
     linearity_amplitudes,
 )
 from plansim.simulate.overrides import apply_overrides
-from plansim.units import DEG
+from plansim.units import DEG, STANDARD_GRAVITY
 
 #: white numbers per block of a record's noise (fixed: the numbers never depend on the chunking)
 WHITE_BLOCK = 4096
@@ -121,10 +129,18 @@ FIELDS = {
     "rest_time": ("time", "7.2.6-7.2.7: each record at rest, e.g. '5 s'"),
     "vibration_bias_shift": ("angular_rate", "7.2.6: the output's bias change the vibration leaves; 0: none"),
     "shock_bias_shift": ("angular_rate", "7.2.7: the output's bias change the shock leaves; 0: none"),
+    "shock_peak": ("acceleration", "7.2.7: the half-sine shock's peak acceleration along the gyro's input axis, "
+                                   "e.g. '50 g'; 0: no pulse"),
+    "shock_duration": ("time", "7.2.7: the half-sine's duration, e.g. '11 ms'"),
+    "shock_settle": ("time", "7.2.7: from the pulse's start to the record after the shock, less the pulse, "
+                             "e.g. '1 s'"),
+    "g_sensitivity": ("rate_per_acceleration", "the gyro's output per acceleration along its input axis (what "
+                                               "the shock reaches it through), e.g. '0.01 deg/s/g'; 0: none"),
 }
 _CHOICES = {"model": SENSOR_MODELS, "grid": ("jjf1535", "jjf1537")}
 _MAY_BE_ZERO = ("gyro_arw", "quantisation")
-_ANY_SIGN = ("bias", "odd_nonlinearity", "even_nonlinearity", "vibration_bias_shift", "shock_bias_shift")
+_ANY_SIGN = ("bias", "odd_nonlinearity", "even_nonlinearity", "vibration_bias_shift", "shock_bias_shift", "shock_peak",
+             "g_sensitivity")
 
 
 @dataclass(frozen=True)
@@ -134,7 +150,9 @@ class Jjf1537Experiment:
     Defaults: a ±300 °/s digital MEMS gyro (output in rad/s), 16-bit output (step 600 °/s / 2¹⁶), ARW
     0.5 °/√h, bias 0.1 °/s, second-order dynamics f_n = 100 Hz, ζ = 0.7 (f_3dB = 101.0 Hz); the table at
     20 % of the range (60 °/s); JJF 1535 7.2.15.1 b)'s grid for an expected bandwidth of 100 Hz (10
-    points, 13.75–110 Hz); n = 7; 4 kHz; 1 s records.
+    points, 13.75–110 Hz); n = 7; 4 kHz; 1 s records; the shock of 7.2.7 a 50 g, 11 ms half-sine along the
+    input axis (a common shock-test pulse: the copy of JJF 1537 used here gives none), read through a
+    g-sensitivity of 0.01 °/s/g, the record after it 1 s after the pulse's start.
     """
 
     model: str = "second_order"
@@ -164,6 +182,10 @@ class Jjf1537Experiment:
     rest_time: float = 5.0
     vibration_bias_shift: float = 0.0             # output unit (rad/s)
     shock_bias_shift: float = 0.0                 # output unit (rad/s)
+    shock_peak: float = 50.0 * STANDARD_GRAVITY   # m/s²
+    shock_duration: float = 0.011                 # s
+    shock_settle: float = 1.0                     # s
+    g_sensitivity: float = 0.01 * DEG / STANDARD_GRAVITY  # rad/s per m/s²
     overrides: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
@@ -212,7 +234,8 @@ class Jjf1537Experiment:
             frequency=self.vibration_frequency, amplitudes=linearity_amplitudes(self.gyro_range, self.linearity_points),
             amplitude=amplitude_in_range(self.amplitude_fraction, self.gyro_range), gyro_range=self.gyro_range,
             repeats=self.repeats, sample_rate=self.sample_rate, record_time=self.record_time,
-            vibration_time=self.vibration_time, rest_time=self.rest_time)
+            vibration_time=self.vibration_time, rest_time=self.rest_time, shock_duration=self.shock_duration,
+            shock_settle=self.shock_settle)
 
     @property
     def noise_sigma(self) -> float:
@@ -398,10 +421,19 @@ def gum_uncertainties(settings: Jjf1537Experiment, response: np.ndarray, level: 
 
 #: the noise streams of the 7.2.4–7.2.7 records start here (the 7.2.1 records use 0 … trials·m·n − 1)
 ITEM_STREAMS = 2**40
+#: the noise streams of the shock records (one per trial), apart from every other record's
+SHOCK_STREAMS = ITEM_STREAMS + 2**39
 #: the records at rest of 7.2.6–7.2.7: before the vibration, after it, after the shock
 REST_RECORDS = ("before_vibration", "after_vibration", "after_shock")
 #: the figures of 7.2.4–7.2.7, in the report's order
 ITEMS = ("amplitude_nonlinearity", "vibration_output_change", "bias_change_vibration", "bias_change_shock")
+#: what the shock record shows, per trial: the peak output (its largest departure from the level before, output
+#: unit), saturation (0/1) and the recovery time from the pulse's start (s; longer than the shock record: the
+#: record after the shock began before the output settled; nan: not settled even by the end of that record)
+SHOCK_FIGURES = ("shock_peak_output", "shock_saturated", "shock_recovery_time")
+#: the band of the recovery time: z standard deviations of the output at rest plus one quantisation step, z such
+#: that white noise alone leaves the band somewhere in the shock record with this probability
+RECOVERY_FALSE_ALARM = 0.01
 #: the coverage factor of the intervals whose coverage the Monte Carlo counts
 COVERAGE_FACTOR = 2.0
 
@@ -421,7 +453,8 @@ def vibration_shock_truth(settings: Jjf1537Experiment) -> dict:
 
         γ = (3/4)|c₃'| |H|² max_k |A_k² − ⟨A²⟩| / |1 + (3/4) c₃' |H|² ⟨A²⟩|,
 
-    the output change under vibration S c₂'a²/2 (output unit), the bias changes the two shifts.
+    the output change under vibration S c₂'a²/2 (output unit), the bias changes the two shifts; and the shock
+    record's noise-free peak output ``shock_peak_output`` (:func:`shock_peak_truth`).
     """
     sch = settings.vibration_shock_schedule()
     gain = float(abs(settings.dynamics().response(sch.frequency)))
@@ -432,7 +465,44 @@ def vibration_shock_truth(settings: Jjf1537Experiment) -> dict:
     exact = np.abs(settings.scale_factor * fundamental)  # the Ē_k without noise
     return {"amplitude_nonlinearity": amplitude_nonlinearity(sch.amplitudes, exact),
             "vibration_output_change": float(settings.scale_factor * mean),
-            "bias_change_vibration": settings.vibration_bias_shift, "bias_change_shock": settings.shock_bias_shift}
+            "bias_change_vibration": settings.vibration_bias_shift, "bias_change_shock": settings.shock_bias_shift,
+            "shock_peak_output": shock_peak_truth(settings)}
+
+
+def shock_input(settings: Jjf1537Experiment) -> np.ndarray:
+    """The gyro's input across the shock record and the record after it, rad/s: the g-sensitivity times the
+    half-sine (:func:`plansim.model.dynamics.half_sine`), (shock samples + rest samples,)."""
+    sch = settings.vibration_shock_schedule()
+    total = sch.shock_samples() + sch.rest_samples()
+    return settings.g_sensitivity * half_sine(settings.shock_peak, sch.shock_duration, sch.sample_rate, total)
+
+
+def shock_filter(settings: Jjf1537Experiment) -> tuple[np.ndarray, np.ndarray]:
+    """(b, a) of the sensor's dynamics for the shock: :func:`discretise` prewarped at the half-sine's
+    fundamental 1/(2·duration) (45 Hz for 11 ms), where most of the pulse's energy lies."""
+    return discretise(settings.dynamics(), 0.5 / settings.shock_duration, settings.sample_rate)
+
+
+def shock_noise_free(settings: Jjf1537Experiment) -> np.ndarray:
+    """The shock record's output without noise or quantisation, less the level before the shock (output
+    unit): S·g((H x)) and the bias step after the pulse, saturated at the range. ``scipy.signal.lfilter`` on
+    :func:`shock_filter`'s coefficients: a check on the kernel as well as the truth."""
+    sch = settings.vibration_shock_schedule()
+    b, a = shock_filter(settings)
+    x = shock_input(settings)[: sch.shock_samples()]
+    v = scipy.signal.lfilter(b, a, x)
+    R = settings.gyro_range
+    v = v + v * v * (settings.even_nonlinearity / R + settings.odd_nonlinearity / R**2 * v)
+    level = settings.bias + settings.vibration_bias_shift
+    y = settings.scale_factor * v + level
+    y[sch.pulse_samples():] += settings.shock_bias_shift
+    limit = R * settings.scale_factor
+    return np.clip(y, -limit, limit) - level
+
+
+def shock_peak_truth(settings: Jjf1537Experiment) -> float:
+    """The shock record's largest departure from the level before it, noise-free (:func:`shock_noise_free`)."""
+    return float(np.max(np.abs(shock_noise_free(settings))))
 
 
 def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
@@ -477,10 +547,10 @@ def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
 
 def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chunk: int | None = None) -> dict:
     """The 7.2.4–7.2.7 records of the trials *trials* (T,), output unit: ``linearity`` (T, M, n, N) at the M
-    amplitudes, ``vibration`` (T, N_v), and ``rest`` (T, 3, N_r) before the vibration, after it (the bias
-    shifted by ``vibration_bias_shift``) and after the shock (shifted by both). The shock itself is not
-    simulated: its effect is the step of the bias. Every record has its own noise stream above
-    :data:`ITEM_STREAMS`; *chunk* as :func:`simulate_records`."""
+    amplitudes, ``vibration`` (T, N_v), ``rest`` (T, 3, N_r) before the vibration, after it (the bias
+    shifted by ``vibration_bias_shift``) and after the shock (shifted by both), and ``shock`` (T, N_s), the
+    record from the pulse's start (:func:`shock_records`; the record after the shock continues it). Every
+    record has its own noise stream above :data:`ITEM_STREAMS`; *chunk* as :func:`simulate_records`."""
     sch = settings.vibration_shock_schedule()
     trials = np.asarray(trials, dtype=np.int64).ravel()
     M, n = sch.amplitudes.size, sch.repeats
@@ -495,11 +565,58 @@ def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chu
                                         N, streams, chunk).reshape(trials.size, n, N)
     vibration = table_records(settings, seed, sch.frequency, sch.amplitude, phases[:, -1],
                               sch.samples(sch.vibration_time), base + M * n, chunk)
-    shifts = (0.0, settings.vibration_bias_shift, settings.vibration_bias_shift + settings.shock_bias_shift)
-    rest = np.stack([table_records(settings, seed, sch.frequency, 0.0, np.zeros(trials.size), sch.rest_samples(),
-                                   base + M * n + 1 + r, chunk, bias_shift=shift) for r, shift in enumerate(shifts)],
-                    axis=1)
-    return {"linearity": linearity, "vibration": vibration, "rest": rest}
+    rest = [table_records(settings, seed, sch.frequency, 0.0, np.zeros(trials.size), sch.rest_samples(),
+                          base + M * n + 1 + r, chunk, bias_shift=shift)
+            for r, shift in enumerate((0.0, settings.vibration_bias_shift))]
+    shock, after = shock_records(settings, seed, trials, base + M * n + 3, chunk)
+    return {"linearity": linearity, "vibration": vibration, "rest": np.stack(rest + [after], axis=1), "shock": shock}
+
+
+def shock_records(settings: Jjf1537Experiment, seed: int, trials, after_streams, chunk: int | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The shock record and the record at rest after it, (T, N_s) and (T, N_r), output unit.
+
+    The sensor is at rest (its filter state zero) when the pulse starts; its input is :func:`shock_input`
+    through :func:`shock_filter` (:func:`plansim.kernels.dynamics.input_records`); the bias is B +
+    ``vibration_bias_shift`` during the pulse and ``shock_bias_shift`` more from its end. The record after the
+    shock continues the filter's state, so a ringing that has not died out by then is in it; its noise is the
+    stream *after_streams* (T,), the shock record's :data:`SHOCK_STREAMS` + trial. Without a pulse (``shock_peak``
+    or ``g_sensitivity`` 0) the record after the shock is the record at rest it always was, number for number.
+    """
+    sch = settings.vibration_shock_schedule()
+    trials = np.asarray(trials, dtype=np.int64).ravel()
+    x = shock_input(settings)
+    b, a = shock_filter(settings)
+    states = np.zeros((trials.size, len(a) - 1))
+    pulse, total = sch.pulse_samples(), sch.shock_samples()
+    level = settings.bias + settings.vibration_bias_shift
+    shock = np.empty((trials.size, total))
+    after = np.empty((trials.size, sch.rest_samples()))
+    own = SHOCK_STREAMS + trials
+    for start, stop, first, streams, bias, out in (
+            (0, pulse, 0, own, level, shock[:, :pulse]),
+            (pulse, total, pulse, own, level + settings.shock_bias_shift, shock[:, pulse:]),
+            (total, x.size, 0, np.asarray(after_streams, dtype=np.int64), level + settings.shock_bias_shift, after)):
+        _driven_records(settings, seed, b, a, states, x[start:stop], first, streams, bias, out, chunk)
+    return shock, after
+
+
+def _driven_records(settings, seed, b, a, states, inputs, first, streams, bias, out, chunk) -> None:
+    """:func:`plansim.kernels.dynamics.input_records` over *out* (R, n) in chunks of *chunk* samples (None: one)."""
+    n = out.shape[1]
+    step = max(n, 1) if chunk is None else int(chunk)
+    if step < 1:
+        raise ValueError(f"chunk: expected an integer >= 1, got {chunk!r}")
+    white = np.empty(step)
+    key = root_key(seed)
+    R = settings.gyro_range
+    streams = np.ascontiguousarray(streams, dtype=np.int64).ravel()
+    for start in range(0, n, step):
+        stop = min(start + step, n)
+        input_records(b, a, states, np.ascontiguousarray(inputs[start:stop]), first + start, settings.scale_factor,
+                      bias, settings.noise_sigma, settings.quantisation, R * settings.scale_factor, key, streams,
+                      WHITE_BLOCK, white, out[:, start:stop], settings.even_nonlinearity / R,
+                      settings.odd_nonlinearity / R**2)
 
 
 def reduce_vibration_shock(settings: Jjf1537Experiment, records: dict) -> tuple[dict, dict]:
@@ -512,6 +629,12 @@ def reduce_vibration_shock(settings: Jjf1537Experiment, records: dict) -> tuple[
       mean at rest before it, by :func:`plansim.estimate.dynamic.mean_change`.
     - 7.2.6, 7.2.7: :func:`mean_change` from before to after the vibration, and from after the vibration
       to after the shock.
+    - the shock record: :func:`plansim.estimate.dynamic.shock_response` against the levels after the vibration
+      and after the shock over the shock record and the record after it together, the band z·s + q (s the
+      standard deviation of the record after the shock, q the quantisation step, z = Φ⁻¹(1 − α/(2N)) for their N
+      samples and α = :data:`RECOVERY_FALSE_ALARM`, so white noise alone reads a recovery time other than 0 in
+      about 1 % of trials): :data:`SHOCK_FIGURES`. A recovery time longer
+      than the shock record means the record after the shock began before the output had settled.
     """
     sch = settings.vibration_shock_schedule()
     dt = 1.0 / sch.sample_rate
@@ -526,9 +649,17 @@ def reduce_vibration_shock(settings: Jjf1537Experiment, records: dict) -> tuple[
     output_change, u_output = mean_change(rest[0], level)
     bias_vibration, u_vibration = mean_change(rest[0], rest[1])
     bias_shock, u_shock = mean_change(rest[1], rest[2])
-    values = (nonlinearity, output_change, bias_vibration, bias_shock)
+    limit = settings.gyro_range * settings.scale_factor
+    shock = records["shock"]
+    z = float(scipy.stats.norm.isf(0.5 * RECOVERY_FALSE_ALARM / (shock.size + rest[2].size)))
+    band = max(z * float(np.std(rest[2], ddof=1)) + settings.quantisation, 1e-12 * limit)
+    response = shock_response(np.concatenate([shock, rest[2]]), float(rest[1].mean()), float(rest[2].mean()), band,
+                              sch.sample_rate, limit)
+    values = (nonlinearity, output_change, bias_vibration, bias_shock, response.peak, response.saturated,
+              response.recovery_time)
     uncertainties = (math.nan, u_output, u_vibration, u_shock)
-    return ({k: float(v) for k, v in zip(ITEMS, values)}, {k: float(u) for k, u in zip(ITEMS, uncertainties)})
+    return ({k: float(v) for k, v in zip(ITEMS + SHOCK_FIGURES, values)},
+            {k: float(u) for k, u in zip(ITEMS, uncertainties)})
 
 
 @dataclass(frozen=True)
@@ -537,7 +668,8 @@ class VibrationShockResult:
 
     ``truth``, ``gum``: by item (:data:`ITEMS`), :func:`vibration_shock_truth` and
     :func:`vibration_shock_gum` (the nonlinearity's nan for a linear sensor: a maximum of absolute values);
-    ``estimates``, ``type_a``: (trials,) per item, the figure and its Type A u per trial.
+    ``estimates``, ``type_a``: (trials,) per item, the figure and its Type A u per trial (``estimates`` also
+    holds :data:`SHOCK_FIGURES`).
     """
 
     schedule: VibrationShockSchedule
@@ -561,6 +693,23 @@ class VibrationShockResult:
             }
         return out
 
+    def shock_summary(self) -> dict:
+        """The shock record over the trials: the peak output's ``peak_truth`` (noise-free), ``peak_mean``,
+        ``peak_std`` (output unit), ``saturated`` (trials with a sample at the range), ``not_settled``
+        (trials whose output was still outside the band when the record after the shock began: a recovery time
+        longer than the shock record, or none), and the recovery time's ``median`` and ``max`` over the trials
+        that have one (s; nan if none)."""
+        recovery = self.estimates["shock_recovery_time"]
+        record = self.schedule.shock_samples() / self.schedule.sample_rate
+        known = recovery[np.isfinite(recovery)]
+        peak = self.estimates["shock_peak_output"]
+        return {"peak_truth": float(self.truth["shock_peak_output"]), "peak_mean": float(peak.mean()),
+                "peak_std": float(peak.std(ddof=1)) if peak.size > 1 else math.nan,
+                "saturated": int(np.sum(self.estimates["shock_saturated"] > 0)),
+                "not_settled": int(np.sum(~(recovery <= record))), "shock_record": record,
+                "recovery_median": float(np.median(known)) if known.size else math.nan,
+                "recovery_max": float(np.max(known)) if known.size else math.nan}
+
 
 def run_vibration_shock(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT_TRIALS,
                         seed: int = DEFAULT_SEED, chunk_trials: int = 32) -> VibrationShockResult:
@@ -569,7 +718,7 @@ def run_vibration_shock(settings: Jjf1537Experiment | None = None, trials: int =
     The numbers depend on (settings, seed, trial) only, not on *chunk_trials*."""
     settings = Jjf1537Experiment() if settings is None else settings
     _check_run(seed, trials, chunk_trials)
-    estimates = {k: np.empty(trials) for k in ITEMS}
+    estimates = {k: np.empty(trials) for k in ITEMS + SHOCK_FIGURES}
     type_a = {k: np.empty(trials) for k in ITEMS}
     for first in range(0, trials, chunk_trials):
         _vibration_shock_block(settings, seed, np.arange(first, min(first + chunk_trials, trials)), estimates, type_a)
@@ -581,7 +730,9 @@ def _vibration_shock_block(settings, seed, block, estimates, type_a) -> None:
     for c, trial in enumerate(block):
         values, u = reduce_vibration_shock(settings, {k: v[c] for k, v in records.items()})
         for name in ITEMS:
-            estimates[name][trial], type_a[name][trial] = values[name], u[name]
+            type_a[name][trial] = u[name]
+        for name in ITEMS + SHOCK_FIGURES:
+            estimates[name][trial] = values[name]
 
 
 def _vibration_shock_result(settings, estimates, type_a) -> VibrationShockResult:
@@ -629,7 +780,7 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
     ratio_u = np.empty((trials, m))
     phase_u = np.empty((trials, m))
     A = schedule.amplitude
-    item_estimates = {k: np.empty(trials) for k in ITEMS}
+    item_estimates = {k: np.empty(trials) for k in ITEMS + SHOCK_FIGURES}
     item_type_a = {k: np.empty(trials) for k in ITEMS}
     for first in range(0, trials, chunk_trials):
         block = np.arange(first, min(first + chunk_trials, trials))
