@@ -154,7 +154,8 @@ def test_settings_read_units_and_refuse_a_pulse_too_short_to_draw():
     assert (s.shock_duration, s.shock_settle) == (pytest.approx(0.011), pytest.approx(0.2))
     assert s.shock_peak == pytest.approx(30 * STANDARD_GRAVITY) and s.g_sensitivity == pytest.approx(
         0.05 * DEG / STANDARD_GRAVITY)
-    with pytest.raises(ValueError, match="shock_duration: 0.001 s gives 4 samples at 4000 Hz; the half-sine needs >= 8"):
+    with pytest.raises(ValueError, match="shock_duration: 0.001 s gives 4 samples at 4000 Hz; the half-sine needs >= "
+                                         "8"):
         Jjf1537Experiment(**SHORT, shock_duration=0.001)
     with pytest.raises(ValueError, match="shock_settle"):
         with_overrides(Jjf1537Experiment(**SHORT), ["shock_settle=0 s"])
