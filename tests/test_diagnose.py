@@ -198,31 +198,37 @@ def test_a_refit_never_adds_components_that_together_alias_a_parameter():
     assert not _adds_rank(fit, kept, kept[0])
 
 
-def test_the_efficient_component_score_is_largest_for_the_true_component():
-    """Attribution compares each candidate's strongest component by its efficient 1-dof score (zᵀM⁺r)²/(zᵀM⁺z)
-    (plansim.diagnose.scores, "Attribution"). With the residual exactly one column z_a times a size (the
-    zero-noise identity) that score is size²·z_aᵀM⁺z_a, and by Cauchy–Schwarz in the M⁺ metric no other column
-    scores more, however closely aliased — here every component of the catalogue on a jjf2003 fit, the asymmetry
-    and the quadratic nonlinearity of the x gyro among them (their cosine 0.95)."""
-    from plansim.diagnose.scores import _Geometry
+def test_the_component_statistic_is_largest_for_the_true_component():
+    """Attribution compares each candidate's strongest component by its 1-dof statistic (plansim.diagnose.scores,
+    "Attribution"): the profile likelihood ratio with the component's channel's between-segment noise re-estimated
+    under it. With the residual exactly one column z_a times a size (the zero-noise identity) the true column
+    explains it whole: its ℓ₁ is the largest any column reaches (0, at σ² = 0), so among the columns of its channel,
+    which share ℓ₀, none scores more, however closely aliased — here every component of the catalogue on a jjf2003
+    fit, the asymmetry and the quadratic nonlinearity of the x gyro among them (their cosine 0.95); and, checked
+    here, none in another channel either."""
+    from plansim.diagnose.scores import _component_statistics, _Geometry
 
     scenario = load_scenario("jjf2003")
     fit = fit_recording(simulate_and_record(scenario, seed=3, trial=0), resolve_site(scenario=scenario),
                         scenario.turntable)
     g = _Geometry(fit)
-    columns = np.concatenate([sig.columns.reshape(-1, sig.columns.shape[-1]) for sig in signatures(fit)], axis=1)
+    sigs = signatures(fit)
+    columns = np.concatenate([sig.columns.reshape(-1, sig.columns.shape[-1]) for sig in sigs], axis=1)
+    raw = np.concatenate([sig.columns for sig in sigs], axis=-1)  # (S, 6, m)
     Z = g.project(g.W @ columns)
-    Z = Z[:, np.linalg.norm(Z, axis=0) > 1e-6 * np.linalg.norm(Z, axis=0).max()]
-    names = {s.effect: s for s in signatures(fit)}
+    keep = np.linalg.norm(Z, axis=0) > 1e-6 * np.linalg.norm(Z, axis=0).max()
+    Z = Z[:, keep]
+    channel = np.argmax(np.linalg.norm(raw, axis=0), axis=0)[keep]
+    names = {s.effect: s for s in sigs}
     a = g.project(g.W @ names["gyro_scale_asymmetry"].columns[:, :, 0].ravel())
     x2 = g.project(g.W @ names["gyro_scale_nonlinearity"].columns[:, :, 0].ravel())
     assert 0.9 < abs(g.cosine(a, x2)) < 0.99 and g.cosine(a, a) == pytest.approx(1.0)
     assert g.cosine(a, x2) == pytest.approx(g.cosine(x2, a))
+    empty = np.zeros((Z.shape[0], 0))
     for truth in (a, x2):
         g.r = 3.0 * truth  # the residual of an effect of size 3 alone
-        scores = g.efficient_scores(np.column_stack([truth, Z]))
-        assert scores[0] == pytest.approx(9.0 * float(truth @ g._pinv() @ truth), rel=1e-9)
-        assert np.nanmax(scores[1:]) <= scores[0] * (1 + 1e-9)
+        values, _ = _component_statistics(fit, g, np.column_stack([truth, Z]), np.concatenate([[0], channel]), empty)
+        assert values[0] > 0 and np.nanmax(values[1:]) <= values[0] * (1 + 1e-9)
 
 
 def test_the_attribution_says_how_reliably_the_schedule_tells_two_candidates_apart():
@@ -381,3 +387,29 @@ def test_the_learned_scenario_is_the_world_the_data_showed(tmp_path, capsys):
     assert main(["diagnose", str(path), "--alpha", "1.5"]) == 2
     assert "--alpha 1.5: must be between 0 and 1" in capsys.readouterr().err
     assert main(["diagnose", str(tmp_path / "missing.nc")]) == 2
+
+
+def test_a_step_or_change_that_explains_clearly_more_keeps_a_candidate_unnamed():
+    """explained_better compares like with like: a step's profile likelihood ratio with the candidate's strongest
+    component's, a change's efficient score with the component's efficient score; the family wins only when it is
+    significant and exceeds the component by more than its own null margin (what its best column gains on noise)."""
+    from types import SimpleNamespace
+
+    from plansim.diagnose.procedure import explained_better
+    from plansim.diagnose.scores import LackOfFit
+
+    best = SimpleNamespace(effect="gyro_scale_asymmetry", components=("x", "y", "z"),
+                           component_statistic=np.array([0.4, 12.1, 0.4]),
+                           component_efficient=np.array([0.5, 13.0, 0.5]))
+    change = {"statistic": 37.8, "p_value": 0.002, "parameter": "Kgyy"}
+    lof = LackOfFit(1.0, 1, 0.002, True, {}, 0.5, None, change, {"change": 20.0})
+    found = explained_better(best, lof, 0.0125)
+    assert found["family"] == "change" and found["component"] == "y" and found["statistic"] == 13.0
+    assert found["family_statistic"] == 37.8 and found["margin"] == 20.0
+    assert explained_better(best, LackOfFit(1.0, 1, 0.002, True, {}, 0.5, None, change, {"change": 25.0}),
+                            0.0125) is None  # 37.8 - 13.0 = 24.8: within the margin, a tie keeps the name
+    assert explained_better(best, LackOfFit(1.0, 1, 0.2, False, {}, 0.5, None, {**change, "p_value": 0.2},
+                                            {"change": 5.0}), 0.0125) is None  # not significant
+    step = {"statistic": 30.0, "p_value": 0.001, "channel": "gy"}
+    found = explained_better(best, LackOfFit(1.0, 1, 0.001, True, {}, 0.5, step, None, {"step": 10.0}), 0.0125)
+    assert found["family"] == "step" and found["statistic"] == 12.1  # the profile LR, as the step's

@@ -76,6 +76,9 @@ class Diagnosis:
     information: dict  # AIC and BIC of each model (information only)
     alpha: float
     attribution: tuple = ()  # per selection: the runner-up and how reliably the schedule tells them apart
+    #: a significant candidate that was not named because a step or a change in time explains the residual clearly
+    #: better (:func:`explained_better`): its effect, component and statistic, and the step or change
+    not_named: tuple = ()
 
 
 def _rms_per_channel(fit) -> dict:
@@ -328,6 +331,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     extra: dict = {}
     current = before
     by_effect = {s.effect: s for s in sigs}
+    not_named = []
+    lof_current = lof
     while True:
         open_ = [s for s in scores if s.identifiable and s.adjusted_p_value < a_select]
         if not open_:
@@ -339,6 +344,10 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         # held-out prediction error (it penalised the six-component nonlinearity against the three-component
         # asymmetry: 0–1 of 5 quadratic nonlinearities at 5× were named) compares like with like.
         best = max(open_, key=lambda c: (c.strongest_component(), -c.adjusted_p_value))
+        beaten = explained_better(best, lof_current, a_segment)
+        if beaten is not None:  # a step or a change in time explains it clearly better: leave it unexplained
+            not_named.append(beaten)
+            break
         signature = by_effect[best.effect]
         attribution.append({**_attribution(best, open_),
                             "time_alternative": time_alternative(current, best, signature)})
@@ -369,6 +378,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         by_effect.update({s.effect: s for s in remaining})
         null = null_residuals(current, null_draws, seed + len(selected))
         scores = score_candidates(current, remaining, alpha=a_select, null=null)
+        lof_current = lack_of_fit(current, alpha=a_segment, null=null)
         steps.append(scores)
     after = current
     lof_after = lack_of_fit(after, alpha=a_segment, null=null_residuals(after, null_draws, seed + 1000))
@@ -400,7 +410,35 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,
                      holdout=hold, steps=tuple(steps),
                      information={"before": _information(before), "after": _information(after)}, alpha=alpha,
-                     attribution=tuple(attribution))
+                     attribution=tuple(attribution), not_named=tuple(not_named))
+
+
+def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict | None:
+    """The lack of fit's step or change of a parameter in time that explains the residual clearly better than
+    candidate *best* does, or None.
+
+    The closed test names a significant candidate; but a feature outside the catalogue can make a candidate
+    significant through the part of its signature they share (a y gyro's scale factor that changes after the y
+    rate test moves the ω² test's y turn, which the y asymmetry also moves). Each family is compared with the
+    candidate's strongest component like with like — a step's profile likelihood ratio with the component's
+    (:func:`plansim.diagnose.scores._profile_likelihood_ratios`), a change's efficient score with the component's
+    efficient score — and the family wins when it is significant at *alpha* and its statistic exceeds the
+    component's by more than the family's own 1 − *alpha* null quantile (what the best of its many columns gains
+    on noise alone). A catalogue effect the schedule cannot tell from a change in time (the x asymmetry and Kgxx
+    changing between −5 and 0 °/s in jjf2003) ties with that change and keeps its name."""
+    values = np.asarray(best.component_statistic, dtype=float)
+    if not np.any(np.isfinite(values)):
+        return None
+    j = int(np.nanargmax(values))
+    for family, found in (("step", lof.step), ("change", lof.change)):
+        if found is None or not found["p_value"] < alpha or family not in lof.margins:
+            continue
+        mine = float(values[j] if family == "step" else best.component_efficient[j])
+        if found["statistic"] - mine > lof.margins[family]:
+            return {"effect": best.effect, "component": best.components[j], "statistic": mine, "family": family,
+                    "family_statistic": float(found["statistic"]), "margin": float(lof.margins[family]),
+                    "where": dict(found)}
+    return None
 
 
 def levels(alpha: float) -> dict:
@@ -459,6 +497,8 @@ def diagnosis_json(d: Diagnosis) -> dict:
             "attribution": [{k: (_number(v) if isinstance(v, float) else
                                  {kk: (_number(vv) if isinstance(vv, float) else vv) for kk, vv in v.items()}
                                  if isinstance(v, dict) else v) for k, v in a.items()} for a in d.attribution],
+            "not_named": [{k: (_number(v) if isinstance(v, float) else v) for k, v in item.items() if k != "where"}
+                          for item in d.not_named],
             "within_segment": {"alpha": d.within.alpha, "draws": d.within.draws,
                                "segments_tested": len(d.within.segments),
                                "smallest_adjusted_p_value": d.within.smallest_adjusted_p(),

@@ -13,19 +13,26 @@ regression of W·x on X, mapped to the 39 parameters through the fit's identifia
 of its standard uncertainty), and two candidates whose surviving subspaces coincide (every principal
 angle's cosine above 1 − :data:`ALIAS_TOLERANCE`) are aliased with each other.
 
-**Score test** (a Lagrange-multiplier test of "effect size zero" at the base fit, Rao 1948): with U_c an
-orthonormal basis of the candidate's surviving directions, the score vector s_c = U_cᵀ r_w has the exact
-covariance Σ_c = U_cᵀ P⊥ W V Wᵀ P⊥ U_c under the fitted noise (W weighs by the fit's working covariance,
-so it is not the identity), and T_c = s_cᵀ Σ_c⁻¹ s_c is χ²(rank_c) when the noise is Gaussian. The noise
-model is not iid: segment means carry bias instability that does not average down,
-quantisation that the noise does not dither and the table's per-setting errors, all in the fit's
-covariance V. So the p-values are not read off χ² alone: the **null is simulated** from the fitted model
-— e ~ N(0, V) (V = ``fit.covariance``, every input the fit knows, the between-segment noise estimated from
-the residuals included), whitened and residualised exactly as the data, r*_w = P⊥·W·e — and each
-candidate's analytic p is calibrated against it. The family-wise error over the catalogue is controlled
-by the single-step **min-p** adjustment of Westfall & Young (1993, Algorithm 2.5): p̃_c = P*(min_d p*_d ≤
-p_c), estimated as (1 + #{b: min_d p*_{d,b} ≤ p_c})/(B + 1). Holm (1979) on the analytic p-values is the
-documented fallback (``method="holm"``).
+**The candidates' test.** Every usable component of a candidate is a one-parameter alternative: its column in
+one channel's segment means (a gyro's asymmetry, a channel's drift, an accelerometer's K2 …). Its statistic is
+the **profile likelihood ratio** with that channel's between-segment noise re-estimated under the alternative
+(:func:`_profile_likelihood_ratios`, the step test's machinery below). The base fit estimates the between-segment
+noise from residuals that hold the effect, and takes much of a slow effect up: scored against that inflated
+noise (the previous version's score test, T_c = s_cᵀ Σ_c⁻¹ s_c ~ χ²(rank) at the base fit), a g²-sensitivity
+of the x gyro at 5× its noise-equivalent size was found in 2 of 8 jjf2003 recordings, and a drift at 20× in
+none. On a channel whose means' noise is an undithered quantiser's (:func:`undithered_channels`: V describes
+their scatter only roughly) the statistic is the efficient score (zᵀ M⁺ r_w)²/(zᵀ M⁺ z) under the fitted noise
+instead. A candidate's statistic is the largest of its components'. The noise model is not iid: segment means
+carry bias instability that does not average down, quantisation that the noise does not dither and the table's
+per-setting errors, all in the fit's covariance V. So the p-values are not read off χ²: the **null is
+simulated** from the fitted model — e ~ N(0, V) (V = ``fit.covariance``, every input the fit knows, the
+between-segment noise estimated from the residuals included), whitened and residualised exactly as the data,
+r*_w = P⊥·W·e — and every statistic is computed on each draw as on the data (the profile too), so each
+candidate's p is its statistic's rank among the draws. The family-wise error over the catalogue is controlled
+by the single-step **min-p** adjustment of Westfall & Young (1993, Algorithm 2.5): p̃_c = P*(min_d p*_d ≤ p_c),
+estimated as (1 + #{b: min_d p*_{d,b} ≤ p_c})/(B + 1). Holm (1979) on analytic p-values (each component's
+likelihood ratio as χ²(1), Bonferroni over the candidate's components) is the documented fallback
+(``method="holm"``).
 
 **Lack of fit** (segment level): L = ‖r_w‖² against the same simulated null, p = (1 + #{L*_b ≥ L})/(B + 1),
 overall and per channel (the channel's rows of r_w); and the largest **step** in one channel's level between two
@@ -40,17 +47,21 @@ changes little from one 30 s segment to the next. The two tests are held togethe
 
 **Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
 over the rate points of one axis are both even in ω). Which one the residual is attributed to is decided by each
-candidate's strongest single component: its efficient one-degree-of-freedom score (zᵀ M⁺ r_w)²/(zᵀ M⁺ z), z = P⊥ W x
-and M = P⊥ W V Wᵀ P⊥ — what one parameter of that effect explains of the residual, by generalised least squares
-under the fitted noise. It is the likelihood-ratio comparison of the one-parameter models: by Cauchy–Schwarz in
-the M⁺ metric the true component's expected statistic is the largest. The plain projection (uᵀ r_w)²/(uᵀ M u),
+candidate's strongest single component's statistic above — the likelihood-ratio comparison of the one-parameter
+models: the true column explains the residual best, so among the columns of its channel (which share the null
+model's likelihood) its statistic is the largest. (The efficient score (zᵀ M⁺ r_w)²/(zᵀ M⁺ z), z = P⊥ W x and
+M = P⊥ W V Wᵀ P⊥, is the same comparison with the nuisance held at the base fit's: by Cauchy–Schwarz in the M⁺
+metric the true component's is the largest.) The plain projection (uᵀ r_w)²/(uᵀ M u),
 u = z/‖z‖, is not (W is a working whitening, so M is not the identity): with it an injected x asymmetry was
 named a quadratic nonlinearity in 6 of 10 jjf2003 recordings at 5×, its x2 component scoring 24–30 against the
 asymmetry's 21. Unlike a p-value over the whole candidate, neither favours the candidate with fewer components (a
 six-component nonlinearity against a three-component asymmetry).
 
 The noise-equivalent size of a component is the size at which that component alone gives its one-degree-
-of-freedom score a non-centrality of 1: sqrt(uᵀ M u)/‖z‖, z = P⊥ W x_k, u = z/‖z‖, M = P⊥ W V Wᵀ P⊥.
+of-freedom efficient score a non-centrality of 1: sqrt(uᵀ M u)/‖z‖, z = P⊥ W x_k, u = z/‖z‖, M = P⊥ W V Wᵀ P⊥.
+It holds the nuisance at the base fit's, so it flatters an effect that slow noise can mimic: a linear drift over a
+jjf2003 run is found at 20× it, not at 5× or 10× — the between-segment noise, re-estimated under the alternative,
+takes a ramp up nearly as well as the ramp does.
 """
 
 from __future__ import annotations
@@ -107,6 +118,9 @@ class CandidateScore:
     component_statistic: np.ndarray = field(repr=False, default=None)
     #: effect -> cosine (M⁺ metric) between this candidate's strongest component and that candidate's
     cosine_with: dict = field(repr=False, default_factory=dict)
+    #: (m,) each usable component's efficient score (zᵀM⁺r_w)²/(zᵀM⁺z) under the fitted noise (the nuisance not
+    #: re-estimated): the statistic of the lack of fit's change of a parameter, to compare the two like with like
+    component_efficient: np.ndarray = field(repr=False, default=None)
 
     def strongest_component(self) -> float:
         """The largest one-degree-of-freedom score statistic of the candidate's usable components (0 if none)."""
@@ -132,6 +146,10 @@ class LackOfFit:
     #: the largest change of one parameter part-way through the run (:func:`change_columns`): its statistic, p,
     #: parameter, place and size (SI), or None
     change: dict | None = None
+    #: "step", "change" -> the 1 − α quantile of the family's largest statistic over the null draws: how much the
+    #: best of its many columns gains on noise alone (plansim.diagnose.procedure: whether it explains the residual
+    #: clearly better than a candidate)
+    margins: dict = field(repr=False, default_factory=dict)
 
 
 #: what would separate each effect from what it aliases with, when it is not identifiable
@@ -168,15 +186,6 @@ class _Geometry:
         #: P⊥ W V^{1/2}: a whitened residual's noise is this times a standard normal vector
         self.noise_map = self.project(self.W @ self.V_root)
 
-    def scorer(self, basis: np.ndarray) -> np.ndarray:
-        """(k, n) the map from a whitened residual to a candidate's standardised score vector: Σ^{-1/2}·Uᵀ, with
-        Σ = Uᵀ P⊥ W V Wᵀ P⊥ U the score's exact covariance under the fitted noise (W weighs by a working
-        covariance, so P⊥ W V Wᵀ P⊥ is not the identity), directions of no variance dropped."""
-        L = basis.T @ self.noise_map
-        values, vectors = np.linalg.eigh(L @ L.T)
-        keep = values > 1e-12 * max(values.max(), 1e-300)
-        return (vectors[:, keep] / np.sqrt(values[keep])).T @ basis.T
-
     def spread(self, U: np.ndarray) -> np.ndarray:
         """(m,) the null standard deviation of each column u of *U*'s plain score uᵀ r_w: √(uᵀ M u),
         M = P⊥ W V Wᵀ P⊥."""
@@ -197,15 +206,23 @@ class _Geometry:
         denominator = math.sqrt(max(float(a @ P @ a) * float(b @ P @ b), 0.0))
         return float(a @ P @ b) / denominator if denominator > 0 else math.nan
 
-    def efficient_scores(self, Z: np.ndarray) -> np.ndarray:
-        """(m,) each column z of *Z* (whitened, projected)'s own efficient 1-dof score statistic
-        (zᵀ M⁺ r_w)² / (zᵀ M⁺ z), M = P⊥ W V Wᵀ P⊥ the whitened residual's null covariance (GLS in that metric:
-        W is a working whitening, so M is not the identity and the plain projection uᵀ r_w is not efficient);
-        NaN where zᵀ M⁺ z vanishes."""
-        MZ = self._pinv() @ Z
-        information = np.sum(Z * MZ, axis=0)
-        ok = information > 0
-        return np.where(ok, (MZ.T @ self.r) ** 2 / np.where(ok, information, 1.0), np.nan)
+    def efficient(self, Z: np.ndarray, y: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Each column z of *Z* (whitened, projected): the cross term zᵀM⁺y ((m,) for y (n,), (m, B) for (n, B);
+        y the whitened residual by default) and the information zᵀM⁺z (m,), M = P⊥ W V Wᵀ P⊥; the efficient
+        1-dof score is cross²/information (GLS in that metric: W is a working whitening, so M is not the
+        identity)."""
+        PZ = self._pinv() @ Z
+        return PZ.T @ (self.r if y is None else y), np.sum(Z * PZ, axis=0)
+
+    def surviving(self, columns: np.ndarray, where: list):
+        """The columns (6S, K) whitened and projected, those the base model leaves more than
+        :data:`ALIAS_TOLERANCE` of, and their *where*; None if none survives."""
+        whitened = self.W @ columns
+        Z = self.project(whitened)
+        keep = np.linalg.norm(Z, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
+        if not np.any(keep):
+            return None
+        return Z[:, keep], [w for w, k in zip(where, keep) if k]
 
     def project(self, y: np.ndarray) -> np.ndarray:
         """P⊥ y along the first axis."""
@@ -215,6 +232,27 @@ class _Geometry:
         """(n, B) whitened residuals of data drawn from the fitted model's noise, e ~ N(0, V)."""
         rng = np.random.default_rng(seed)
         return self.noise_map @ rng.standard_normal((self.V_root.shape[1], draws))
+
+
+def _component_statistics(fit, g: _Geometry, Z: np.ndarray, channel: np.ndarray, null: np.ndarray):
+    """Each candidate component's 1-dof statistic, (K,) on the data and (K, B) on the null draws (module docstring,
+    "Score test"): the profile likelihood ratio with its channel's between-segment noise re-estimated under it
+    (:func:`_profile_likelihood_ratios`), or, on a channel whose means' noise is an undithered quantiser's
+    (:func:`undithered_channels`, where V describes the scatter only roughly and the step test is left out too),
+    the efficient score (zᵀM⁺r_w)²/(zᵀM⁺z) under the fitted noise."""
+    values = np.full(channel.size, np.nan)
+    null_values = np.full((channel.size, null.shape[1]), np.nan)
+    rough = np.isin(channel, sorted(undithered_channels(fit)))
+    if np.any(~rough):
+        k = np.flatnonzero(~rough)
+        values[k], null_values[k], _ = _profile_likelihood_ratios(fit, g, Z[:, k], channel[k], null)
+    if np.any(rough):
+        k = np.flatnonzero(rough)
+        cross, information = g.efficient(Z[:, k])
+        information = np.where(information > 0, information, np.inf)
+        values[k] = cross**2 / information
+        null_values[k] = g.efficient(Z[:, k], null)[0] ** 2 / information[:, None]
+    return values, null_values
 
 
 def _chi2_sf(statistic, dof) -> np.ndarray:
@@ -280,8 +318,6 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
         spread = g.spread(Z / np.where(surviving > 0, surviving, 1.0))
         nes = np.where(usable, spread / np.where(surviving > 0, surviving, 1.0), np.inf)
-        # each component alone: its efficient 1-dof score (zᵀ M⁺ r_w)² / (zᵀ M⁺ z)
-        component = np.where(usable, g.efficient_scores(Z), np.nan)
         if np.any(usable):
             u, s, _ = np.linalg.svd(Z[:, usable], full_matrices=False)
             basis = u[:, s > ALIAS_TOLERANCE * np.linalg.norm(Z[:, usable], axis=0).min()]
@@ -291,8 +327,7 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         aliased = () if not np.any(lost) else _aliases(
             fit, g, Wx[:, np.flatnonzero(lost)[np.argmin((surviving / np.maximum(norms, 1e-300))[lost])]])
         bases.append(basis)
-        strongest = int(np.nanargmax(np.where(usable, component, -np.inf))) if np.any(usable) else None
-        raw.append((sig, usable, nes, aliased, component, None if strongest is None else Z[:, strongest]))
+        raw.append((sig, usable, nes, aliased, Z))
     # candidate against candidate: surviving subspaces that coincide
     same = [set() for _ in sigs]
     for i in range(len(sigs)):
@@ -307,18 +342,40 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
             if inside_j:
                 same[j].add(sigs[i].effect)
     identifiable = [bases[i].shape[1] > 0 and not same[i] for i in range(len(sigs))]
+    # every usable component of an identifiable candidate alone: its 1-dof statistic on the data and on each null
+    # draw (_component_statistics: a profile likelihood ratio, or the efficient score on an undithered channel)
+    if null is None:
+        null = g.null_residuals(int(null_draws), seed) if method == "westfall_young" else np.zeros((g.r.size, 0))
+    B = null.shape[1]
+    tested = np.flatnonzero(identifiable)
+    owner, columns, channels = [], [], []
+    for i in tested:
+        sig, usable, _, _, Z = raw[i]
+        for j in np.flatnonzero(usable):
+            owner.append((i, j))
+            columns.append(Z[:, j])
+            channels.append(int(np.argmax(np.linalg.norm(sig.columns[:, :, j], axis=0))))
+    component_values = {}
+    null_of = {}
+    if owner:
+        values, null_values = _component_statistics(fit, g, np.column_stack(columns), np.array(channels), null)
+        for k, (i, j) in enumerate(owner):
+            component_values[(i, j)] = values[k]
+            null_of.setdefault(i, []).append(null_values[k])
     statistic = np.full(len(sigs), math.nan)
     dof = np.zeros(len(sigs), dtype=int)
     p = np.full(len(sigs), math.nan)
-    scorers = {}
-    for i, basis in enumerate(bases):
-        if identifiable[i]:
-            scorers[i] = g.scorer(basis)
-            statistic[i] = float(np.sum((scorers[i] @ g.r) ** 2))
-            dof[i] = scorers[i].shape[0]
-            p[i] = float(_chi2_sf(statistic[i], dof[i]))
+    candidate_null = {}
+    for i in tested:
+        mine = [component_values[(i, j)] for j in np.flatnonzero(raw[i][1])]
+        statistic[i] = float(max(mine))
+        dof[i] = len(mine)
+        if method == "holm":  # analytic: each component's likelihood ratio ~ χ²(1), Bonferroni over them
+            p[i] = float(min(1.0, dof[i] * _chi2_sf(statistic[i], 1)))
+        else:
+            candidate_null[i] = np.max(null_of[i], axis=0)
+            p[i] = float((1 + np.count_nonzero(candidate_null[i] >= statistic[i])) / (B + 1))
     adjusted = np.full(len(sigs), math.nan)
-    tested = np.flatnonzero(identifiable)
     if tested.size:
         if method == "holm":
             order = tested[np.argsort(p[tested])]
@@ -327,30 +384,46 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
                 running = max(running, min(1.0, (tested.size - rank) * p[i]))
                 adjusted[i] = running
         else:
-            if null is None:
-                null = g.null_residuals(int(null_draws), seed)
-            null_p = np.stack([_chi2_sf(np.sum((scorers[i] @ null) ** 2, axis=0), dof[i]) for i in tested])
-            min_p = null_p.min(axis=0)
-            B = null_p.shape[1]
+            min_p = np.min([_draw_p_values(candidate_null[i]) for i in tested], axis=0)
             for i in tested:
                 adjusted[i] = (1 + np.count_nonzero(min_p <= p[i])) / (B + 1)
+    component, efficient = [], []
+    directions = {}
+    for i, (sig, usable, _, _, Z) in enumerate(raw):
+        values = np.full(len(sig.components), np.nan)
+        for j in np.flatnonzero(usable):
+            values[j] = component_values.get((i, j), np.nan)
+        component.append(values)
+        cross, information = g.efficient(Z)
+        efficient.append(np.where(usable & (information > 0) & identifiable[i],
+                                  cross**2 / np.where(information > 0, information, 1.0), np.nan))
+        if identifiable[i] and np.any(np.isfinite(values)):
+            directions[i] = Z[:, int(np.nanargmax(values))]
     out = []
     # the cosine, in the M⁺ metric, between each pair of candidates' strongest components: how far the schedule
     # tells the two apart (procedure: the attribution's reliability)
-    directions = {i: r[5] for i, r in enumerate(raw) if r[5] is not None and identifiable[i]}
     cosines = [{} for _ in sigs]
     for i in directions:
         for j in directions:
             if i != j:
                 cosines[i][sigs[j].effect] = g.cosine(directions[i], directions[j])
-    for i, (sig, usable, nes, aliased, component, _) in enumerate(raw):
+    for i, (sig, usable, nes, aliased, _) in enumerate(raw):
         names = tuple(aliased) + tuple(sorted(same[i]))
         out.append(CandidateScore(sig.effect, bool(identifiable[i]), names,
                                   "" if identifiable[i] else SEPARATING.get(sig.effect, ""),
                                   float(statistic[i]), int(dof[i]), float(p[i]), float(adjusted[i]), nes,
-                                  sig.components, sig.unit, usable,
-                                  np.where(identifiable[i], component, np.nan), cosines[i]))
+                                  sig.components, sig.unit, usable, component[i], cosines[i], efficient[i]))
     return tuple(out)
+
+
+def undithered_channels(fit) -> set[int]:
+    """The channels whose segment means' predicted variance is mostly an undithered quantiser's (more than
+    :data:`UNDITHERED_SHARE`): their means sit on a few codes and V describes their scatter only roughly."""
+    noise = getattr(fit, "noise", None)
+    if noise is None:
+        return set()
+    return {c for c in range(6) if np.median(noise.quantisation_variance[:, c] / np.maximum(
+        noise.mean_variance[:, c], 1e-300)) > UNDITHERED_SHARE}
 
 
 def step_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
@@ -362,10 +435,9 @@ def step_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     order = np.argsort(times, kind="stable")
     rows = np.asarray(fit.fitted_rows, dtype=bool)
     columns, where = [], []
-    noise = getattr(fit, "noise", None)
+    excluded = undithered_channels(fit)
     for c in range(6):
-        if noise is not None and np.median(noise.quantisation_variance[:, c] / np.maximum(
-                noise.mean_variance[:, c], 1e-300)) > UNDITHERED_SHARE:
+        if c in excluded:
             continue  # its means' noise is an undithered quantiser's, which V describes only roughly
         for k in range(1, S):
             column = np.zeros((S, 6))
@@ -391,9 +463,28 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
     variance σ_c² correlated as exp(−|t_s − t_r|/τ_c) between segments) takes it up: scored against that
     inflated noise a step scores almost the same whatever its size (a linear_gaussian recording's p went from
     0.020 at 10× to 0.008 at 20× and 0.004 at 40× a segment mean's u). So the nuisance is re-estimated under each
-    alternative, as a likelihood-ratio test does. For channel c, with M₀ the whitened residual covariance without
-    c's between term and N_c(τ) = P⊥ W Σ_c(τ) Wᵀ P⊥ that term's shape, both diagonalised at once (T = M₀^{-1/2}
-    on its range, T N_c T = Q Λ Qᵀ), the whitened residual z = Qᵀ T r and a step column x = Qᵀ T P⊥ W s give
+    alternative, as a likelihood-ratio test does (:func:`_profile_likelihood_ratios`).
+
+    Returns
+    -------
+    (K,) statistics, (B,) the largest over columns of each null draw, (K,) each step's size at its maximum
+    (SI, the GLS estimate in the channel's own unit), and the (channel, before, after) of each kept column.
+    """
+    kept = g.surviving(columns, where)
+    if kept is None:
+        return None
+    WS, where = kept
+    statistic, null_statistic, size = _profile_likelihood_ratios(fit, g, WS, np.array([w[0] for w in where]), null)
+    return statistic, null_statistic.max(axis=0), size, where
+
+
+def _profile_likelihood_ratios(fit, g: _Geometry, WS: np.ndarray, channel: np.ndarray, null: np.ndarray):
+    """Each column's profile likelihood ratio with its channel's between-segment noise re-estimated under it, on
+    the data and on every null draw.
+
+    For channel c, with M₀ the whitened residual covariance without c's between term and N_c(τ) = P⊥ W Σ_c(τ) Wᵀ P⊥
+    that term's shape, both diagonalised at once (T = M₀^{-1/2} on its range, T N_c T = Q Λ Qᵀ), the whitened
+    residual z = Qᵀ T r and a column x = Qᵀ T P⊥ W s give
 
         ℓ₀(σ², τ) = −½ Σ_i [log(1 + σ²λ_i) + z_i²/(1 + σ²λ_i)],
         ℓ₁(σ², τ) = ℓ₀ + ½ (Σ w_i x_i z_i)² / Σ w_i x_i²,   w_i = 1/(1 + σ²λ_i),
@@ -401,22 +492,23 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
     and the statistic 2·(max ℓ₁ − max ℓ₀), both maximised over τ in
     :data:`plansim.fit.joint.BETWEEN_CORRELATION_TIMES` and σ² on :data:`STEP_PROFILE_GRID` — for the data and
     for each null draw alike, so the simulated null calibrates it whatever the grid. The other channels' between
-    terms stay as the fit estimated them.
+    terms stay as the fit estimated them. At σ² = 0 with no between term in c it is the efficient score.
+
+    Parameters
+    ----------
+    WS : (n, K) array
+        The columns, whitened and projected (P⊥ W s).
+    channel : (K,) int array
+        The channel whose between-segment noise each column's alternative re-estimates.
+    null : (n, B) array
 
     Returns
     -------
-    (K,) statistics, (B,) the largest over columns of each null draw, (K,) each step's size at its maximum
-    (SI, the GLS estimate in the channel's own unit), and the (channel, before, after) of each kept column.
+    (K,) statistics, (K, B) the same on each null draw, (K,) each column's size at its maximum (the GLS estimate
+    of its coefficient).
     """
     from plansim.fit.joint import BETWEEN_CORRELATION_TIMES, time_correlation
 
-    whitened = g.W @ columns
-    WS = g.project(whitened)
-    keep = np.linalg.norm(WS, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
-    if not np.any(keep):
-        return None
-    WS, where = WS[:, keep], [w for w, k in zip(where, keep) if k]
-    channel = np.array([w[0] for w in where])
     times = np.asarray(fit.segment_times, dtype=float)
     fitted = np.asarray(fit.fitted_rows, dtype=bool)
     slow = fit.between_noise
@@ -424,7 +516,7 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
     M = g.noise_map @ g.noise_map.T
     B = null.shape[1]
     statistic, size = np.full(channel.size, -np.inf), np.zeros(channel.size)
-    null_max = np.full(B, -np.inf)
+    null_statistic = np.full((channel.size, B), -np.inf)
     for c in np.unique(channel):
         cols = np.flatnonzero(channel == c)
         segments = np.flatnonzero(fitted[:, c])
@@ -465,8 +557,14 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
                 best1_null = np.maximum(best1_null, l1_null)
         statistic[cols] = 2.0 * (best1 - best0)
         size[cols] = best_size
-        null_max = np.maximum(null_max, np.max(2.0 * (best1_null - best0_null[None, :]), axis=0))
-    return statistic, null_max, size, where
+        null_statistic[cols] = 2.0 * (best1_null - best0_null[None, :])
+    return statistic, null_statistic, size
+
+
+def _draw_p_values(null_statistic: np.ndarray) -> np.ndarray:
+    """Each null draw's own p among the draws (its rank; larger statistics are rarer): (B,) from (B,)."""
+    B = null_statistic.size
+    return (B - np.argsort(np.argsort(null_statistic, kind="stable"), kind="stable")) / B
 
 
 #: the parameters whose change in time the lack of fit looks for (the biases' changes are the step test's)
@@ -485,9 +583,7 @@ def change_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     S = times.size
     order = np.argsort(times, kind="stable")
     rows = np.asarray(fit.fitted_rows, dtype=bool)
-    noise = getattr(fit, "noise", None)
-    excluded = {c for c in range(6) if noise is not None and np.median(
-        noise.quantisation_variance[:, c] / np.maximum(noise.mean_variance[:, c], 1e-300)) > UNDITHERED_SHARE}
+    excluded = undithered_channels(fit)
     design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(S, 6, -1)
     design[~rows] = 0.0
     identified = set(fit.identifiability.identified)
@@ -508,22 +604,18 @@ def change_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
 def _change_scores(g: _Geometry, columns: np.ndarray, where: list, null: np.ndarray):
     """Each change column's efficient 1-dof score (zᵀM⁺r_w)²/(zᵀM⁺z) on the data and the largest over columns of
     each null draw's; its size (zᵀM⁺r_w)/(zᵀM⁺z) (the parameter's change, SI); None if no column survives."""
-    whitened = g.W @ columns
-    Z = g.project(whitened)
-    keep = np.linalg.norm(Z, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
-    if not np.any(keep):
+    kept = g.surviving(columns, where)
+    if kept is None:
         return None
-    Z, where = Z[:, keep], [w for w, k in zip(where, keep) if k]
-    PZ = g._pinv() @ Z
-    information = np.sum(Z * PZ, axis=0)
+    Z, where = kept
+    cross, information = g.efficient(Z)
     ok = information > 0
-    Z, PZ, information = Z[:, ok], PZ[:, ok], information[ok]
+    Z, cross, information = Z[:, ok], cross[ok], information[ok]
     where = [w for w, k in zip(where, ok) if k]
     if not where:
         return None
-    cross = PZ.T @ g.r
     statistic = cross**2 / information
-    null_max = np.max((PZ.T @ null) ** 2 / information[:, None], axis=0)
+    null_max = np.max(g.efficient(Z, null)[0] ** 2 / information[:, None], axis=0)
     return statistic, null_max, cross / information, where
 
 
@@ -537,7 +629,7 @@ def _largest(fit, scores, null_scores, sizes, where, B: int, what) -> tuple[dict
              "between": [int(fit.used[before]), int(fit.used[after])],
              "labels": [fit.labels[before], fit.labels[after]],
              "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])), "size": float(sizes[best])}
-    return found, (B - np.argsort(np.argsort(null_scores, kind="stable"), kind="stable")) / B
+    return found, _draw_p_values(null_scores)
 
 
 def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
@@ -561,13 +653,15 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     step = change = None
     # each statistic's p against the simulated null, and each null draw's own p (its rank among the draws): the
     # family's p is the min-p over the statistics, against the min-p of the same draws
-    ranks = [(B - np.argsort(np.argsort(L_null, kind="stable"), kind="stable")) / B]
+    ranks = [_draw_p_values(L_null)]
     p_values = [p_omnibus]
+    margins = {}
     profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
     if profiled is not None:
         step, rank = _largest(fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
         ranks.append(rank)
         p_values.append(step["p_value"])
+        margins["step"] = float(np.quantile(profiled[1], 1 - alpha)) if B else math.inf
     # the largest change of one parameter part-way through the run (a scale factor, a cross-coupling, a g-term)
     columns, where = change_columns(fit)
     scored = _change_scores(g, columns, where, null) if columns.shape[1] else None
@@ -575,6 +669,7 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         change, rank = _largest(fit, *scored, B, lambda k: {"parameter": PARAMETER_NAMES[k]})
         ranks.append(rank)
         p_values.append(change["p_value"])
+        margins["change"] = float(np.quantile(scored[1], 1 - alpha)) if B else math.inf
     p = p_omnibus
     if len(p_values) > 1:
         p = (1 + np.count_nonzero(np.min(ranks, axis=0) <= min(p_values))) / (B + 1)
@@ -586,7 +681,7 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         Lc = float(np.sum(g.r[sel] ** 2))
         pc = (1 + np.count_nonzero(np.sum(null[sel] ** 2, axis=0) >= Lc)) / (B + 1)
         per_channel[name] = (Lc, int(sel.sum()), float(pc))
-    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change)
+    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change, margins)
 
 
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:

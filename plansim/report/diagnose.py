@@ -76,7 +76,12 @@ def diagnose_report(d) -> str:
                              f"them apart about {100 * t['probability_distinct']:.0f} % of the time"
                              + (" — this recording cannot say which" if t["cosine"] > 0.99 else ""))
     else:
-        lines.append("Found: no catalogue effect is significant.")
+        lines.append("Found: no catalogue effect is named.")
+    for item in d.not_named:
+        lines.append(f"  {item['effect']}[{item['component']}] was significant but is not named: the "
+                     f"{'step' if item['family'] == 'step' else 'change in time'} below explains the residual "
+                     f"clearly better (statistic {item['family_statistic']:.1f} against {item['statistic']:.1f}, "
+                     f"more than the {item['margin']:.1f} its best column gains on noise alone)")
     after = d.lack_of_fit_after
     if after.flagged:
         lines.append(f"UNEXPLAINED residual after the refit (p = {_p(after.p_value)}): not named after any "
