@@ -63,9 +63,9 @@ def add_commands(sub) -> None:
     p = sub.add_parser(
         "diagnose", help=COMMANDS["diagnose"],
         description="Fit a recording, test its residual for the effects of a catalogue (identifiability first; "
-                    "score tests with the family-wise false-alarm rate held at alpha by a null simulated from the "
-                    "fitted model), add the significant ones by closed testing, and report what remains and the "
-                    "error before and after (docs/closing-the-loop.md)")
+                    "likelihood-ratio tests with the family-wise false-alarm rate held at alpha by a null simulated "
+                    "from the fitted model), add the significant ones by closed testing, and report what remains and "
+                    "the error before and after (docs/closing-the-loop.md)")
     p.add_argument("recording", help="recording file (.nc, or the samples .csv beside its .segments.csv)")
     add_site_and_scenario_options(p)
     p.add_argument("--alpha", type=float, default=0.05, help="family-wise false-alarm rate (default 0.05)")

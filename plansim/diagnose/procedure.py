@@ -6,8 +6,8 @@
    and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, against
    a null simulated from the recording's own noise (:func:`plansim.diagnose.within.within_segment_tests`); each at
    α/4 (:data:`SEGMENT_LEVEL_SHARE`, :data:`WITHIN_SHARE`), so that "something is unexplained" keeps the level α/2.
-3. **Candidates** (:mod:`plansim.diagnose.catalogue`): identifiability first, then score tests with the family-wise
-   error over the catalogue held at α/2 (:data:`SELECTION_SHARE`) by the simulated min-p null
+3. **Candidates** (:mod:`plansim.diagnose.catalogue`): identifiability first, then likelihood-ratio tests with the
+   family-wise error over the catalogue held at α/2 (:data:`SELECTION_SHARE`) by the simulated min-p null
    (:func:`plansim.diagnose.scores.score_candidates`). The selections and the unexplained residual share α
    (Bonferroni over the two families): on a recording the base model describes, the probability that the
    diagnosis reports *anything* — a selection, a lack of fit or a within-segment finding — is ≤ α.

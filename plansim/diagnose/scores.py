@@ -1,4 +1,4 @@
-"""Which candidates a recording can tell apart, their score tests, and the lack of fit — with a simulated null.
+"""Which candidates a recording can tell apart, their likelihood-ratio tests, the lack of fit — with a simulated null.
 
 **Whitened residual.** The fit solves min ‖W·(m − D z)‖² (W the fit's whitening, D its design at the
 solution, :class:`plansim.fit.FitResult`), so its whitened residual is r_w = P⊥·W·m with P⊥ = I − X X⁺,
@@ -98,7 +98,7 @@ METHODS = ("westfall_young", "holm")
 
 @dataclass(frozen=True)
 class CandidateScore:
-    """One candidate's identifiability and score test (NaN statistics when not identifiable)."""
+    """One candidate's identifiability and likelihood-ratio test (NaN statistics when not identifiable)."""
 
     effect: str
     identifiable: bool
@@ -236,7 +236,7 @@ class _Geometry:
 
 def _component_statistics(fit, g: _Geometry, Z: np.ndarray, channel: np.ndarray, null: np.ndarray):
     """Each candidate component's 1-dof statistic, (K,) on the data and (K, B) on the null draws (module docstring,
-    "Score test"): the profile likelihood ratio with its channel's between-segment noise re-estimated under it
+    "The candidates' test"): the profile likelihood ratio with its channel's between-segment noise re-estimated under it
     (:func:`_profile_likelihood_ratios`), or, on a channel whose means' noise is an undithered quantiser's
     (:func:`undithered_channels`, where V describes the scatter only roughly and the step test is left out too),
     the efficient score (zᵀM⁺r_w)²/(zᵀM⁺z) under the fitted noise."""
@@ -276,7 +276,8 @@ def _aliases(fit, geometry: _Geometry, column: np.ndarray) -> tuple[str, ...]:
 
 def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
                      method: str = "westfall_young", null: np.ndarray | None = None) -> tuple[CandidateScore, ...]:
-    """Identifiability and score test of every candidate signature in *sigs* against *fit* (module docstring).
+    """Identifiability and likelihood-ratio test of every candidate signature in *sigs* against *fit* (module
+    docstring).
 
     Parameters
     ----------
