@@ -27,7 +27,8 @@ Figures (all per second of wall time, thread count reported):
   (135 000 samples, 45 segments), as ``plansim diagnose REC --scenario jjf2003`` runs it: the base fit, the
   within-segment tests, the simulated nulls (2000 draws), the candidates' likelihood-ratio tests and the
   before/after, warm (kernels compiled, modules imported); ``diagnose_effect_seconds`` the same for a recording
-  with a scale asymmetry on the x gyro of 10⁻³, which the diagnosis selects and refits (the diagnosis issue's target: ≤ 10 s warm).
+  with a scale asymmetry on the x gyro of 10⁻³, which the diagnosis selects and refits (the diagnosis issue's
+  target: ≤ 10 s warm).
 
 Method. The speed of these 2-core machines varies by up to 2× between identical runs (other
 work on the same host), so each throughput is the best of several rounds: the best round is the
