@@ -45,6 +45,7 @@ CONVERSIONS = [
     ("acceleration", "50 ug", 50e-6 * G0),
     ("acceleration", "9.8 m/s^2", 9.8),
     ("time", "30 s", 30.0),
+    ("time", "11 ms", 0.011),
     ("time", "2 min", 120.0),
     ("time", "1.5 h", 5400.0),
     ("frequency", "100 Hz", 100.0),
