@@ -454,3 +454,42 @@ def test_semicolons_and_decimal_commas_as_a_spreadsheet_exports_them(tmp_path, c
     (tmp_path / "bad.csv").write_text("\n".join(bad) + "\n")
     with pytest.raises(ValueError, match="line 6; expected a number"):
         import_log(tmp_path / "bad.csv", time_column="time")
+
+
+def test_space_separated_and_headerless_logs_as_imu_tk_and_matlab_write_them(tmp_path, capsys):
+    """imu_tk's logs and MATLAB's ``save -ascii`` separate columns by runs of spaces, and often write no header:
+    a space-separated log with a header reads as the comma one; a headerless one is named by column position (1
+    for the first), here in imu_tk's order time, ax, ay, az, gx, gy, gz, and gives the same samples. Without
+    --columns a headerless log is refused with how to name its columns; a lone numeric line of a logger's preamble
+    ("2024 11 27") is not taken for the first sample."""
+    t, x = synthetic_log()
+    write_synthetic(tmp_path / "commas.csv", t, x)
+    reference = import_log(tmp_path / "commas.csv", time_column="time")
+    rows = [f"  {a:.12g}   " + "  ".join(f"{v:.12g}" for v in r) for a, r in zip(t, x)]
+    (tmp_path / "spaces.txt").write_text("time   gx gy gz  ax ay az\n" + "\n".join(rows) + "\n")
+    spaced = import_log(tmp_path / "spaces.txt", time_column="time")
+    np.testing.assert_array_equal(spaced.recording.samples, reference.recording.samples)
+    assert spaced.table.has_header and spaced.table.header_line == 1
+
+    acc_first = np.column_stack([t, x[:, 3:], x[:, :3]])
+    np.savetxt(tmp_path / "imu_tk.txt", acc_first, fmt="%.12g")  # space-separated, no header
+    headerless = import_log(tmp_path / "imu_tk.txt", columns=("5", "6", "7", "2", "3", "4"), time_column="1")
+    np.testing.assert_array_equal(headerless.recording.samples, reference.recording.samples)
+    assert not headerless.table.has_header and headerless.table.first_line == 1
+    assert headerless.recording.schedule.segments == reference.recording.schedule.segments
+    assert main(["import", str(tmp_path / "imu_tk.txt"), "--out", str(tmp_path / "r.nc"), "--columns",
+                 "5,6,7,2,3,4", "--time", "1"]) == 0
+    assert "no header line: columns named by position" in capsys.readouterr().out
+    with pytest.raises(ValueError, match=r"column 'gx' is missing: the log has no header line \(line 1 is its first "
+                                         r"sample, 7 columns\); name the columns by their position"):
+        import_log(tmp_path / "imu_tk.txt", sample_rate=100.0)
+
+    text = (tmp_path / "imu_tk.txt").read_text()
+    (tmp_path / "dated.txt").write_text("IMU log\n2024 11 27\n" + text)
+    dated = import_log(tmp_path / "dated.txt", columns=("5", "6", "7", "2", "3", "4"), time_column="1")
+    np.testing.assert_array_equal(dated.recording.samples, reference.recording.samples)
+    assert dated.table.preamble == ("IMU log", "2024 11 27") and dated.table.first_line == 3
+    (tmp_path / "dated_header.csv").write_text("2024,11,27\n" + (tmp_path / "commas.csv").read_text())
+    with_header = import_log(tmp_path / "dated_header.csv", time_column="time")
+    np.testing.assert_array_equal(with_header.recording.samples, reference.recording.samples)
+    assert with_header.table.preamble == ("2024,11,27",) and with_header.table.header_line == 2

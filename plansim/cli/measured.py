@@ -39,14 +39,18 @@ def _add_import_command(sub) -> None:
                     "whose segment table (static poses, rotations, moves) is found from the data, for you to "
                     "review (docs/measured-data.md)")
     p.add_argument("log", help="the CSV log: a header line of column names (lines of a logger's own before it are "
-                               "skipped and reported), one row per sample")
+                               "skipped and reported), or none, then one row per sample; values separated by "
+                               "commas, semicolons, tabs or spaces")
     p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
-    p.add_argument("--time", default=None, metavar="COL", help="the time column (default: none; give --sample-rate)")
+    p.add_argument("--time", default=None, metavar="COL",
+                   help="the time column (default: none; give --sample-rate); in a log with no header line, its "
+                        "position (1 for the first column)")
     p.add_argument("--time-unit", default="s", choices=("s", "ms", "us", "ns", "samples"),
                    help="unit of the time column (samples: a sample counter, with --sample-rate); default s")
     p.add_argument("--columns", default=None, metavar="GX,GY,GZ,AX,AY,AZ",
                    help="the six channel columns in this order (default gx,gy,gz,ax,ay,az); other columns are "
-                        "then ignored")
+                        "then ignored. A log with no header line names them by position, 1 for the first (imu_tk's "
+                        "'time ax ay az gx gy gz': --columns 5,6,7,2,3,4 --time 1)")
     p.add_argument("--units", default=None,
                    help="the channels' units: gyro,accelerometer (e.g. deg/s,m/s^2) or one per channel; with "
                         "--scale, the unit the counts are per; default rad/s,m/s^2")

@@ -45,6 +45,8 @@ DEFAULT_COLUMNS = CHANNELS
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "samples": math.nan}
 #: the delimiters a log may use; the one that splits the header line into the most columns is taken
 DELIMITERS = (",", ";", "\t")
+#: the delimiter of a log whose columns are separated by runs of spaces (imu_tk, MATLAB's ``save -ascii``)
+WHITESPACE = "whitespace"
 #: a static span's mean specific force must be within this fraction of standard gravity (units check)
 GRAVITY_TOLERANCE = 0.3
 #: timing jitter (RMS) beyond this fraction of the sample period is a warning
@@ -95,6 +97,8 @@ class LogTable:
     preamble: tuple[str, ...] = ()
     header_line: int = 1  # the file line of the header (1-based)
     decimal_comma: bool = False  # some values were written with a decimal comma (";"- or tab-separated logs)
+    #: False: the log has no header line; its columns are named by their position, "1" for the first
+    has_header: bool = True
 
 
 @dataclass(frozen=True)
@@ -212,9 +216,11 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     with _text_file(target, where) as fh:
         header_line = 0
         header = None
+        has_header = True
         first = None  # the first line that is not a comment: the header, unless a preamble precedes it
+        previous = None  # the last line read that is not a comment
         preamble: list[str] = []
-        for line in fh:
+        for line in iter(fh.readline, ""):  # readline, not iteration: the look-ahead below may seek back
             header_line += 1
             stripped = line.strip()
             if not stripped:
@@ -226,6 +232,19 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                     header = uncommented
                     break
                 continue
+            if _all_numbers(stripped) and _next_row_alike(fh, stripped):
+                if previous is not None and _width(previous[1]) == _width(stripped):
+                    # the line before names as many columns: the header, though not the columns asked for
+                    header_line, header = previous
+                    preamble = preamble[:-1]
+                    break
+                # no header line: the first sample (a row of numbers followed by another of as many); the
+                # columns are named by their position, 1 for the first
+                has_header = False
+                header_line -= 1
+                header = line
+                break
+            previous = (header_line, line)
             if first is None:
                 first = (header_line, line)
             if set(wanted) <= set(_names(line)):
@@ -239,17 +258,21 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
             preamble = []
         if header is None:
             raise ValueError(f"{where}: no header line; expected a line of column names, then one row per sample")
-        if preamble:  # lines were read past the header; read again from just after it
+        if preamble or not has_header:  # lines were read past the header; read again from just after it
             fh.seek(0)
             for _ in range(header_line):
                 fh.readline()
         delimiter = _delimiter(header)
-        header_names = _names(header)
+        header_names = _names(header) if has_header else [str(k + 1) for k in range(len(_split(header, delimiter)))]
         duplicates = sorted({name for name in header_names if header_names.count(name) > 1})
         if duplicates:
             raise ValueError(f"{where}: column {duplicates[0]!r} appears more than once in the header "
                              f"(line {header_line})")
         missing = [name for name in wanted if name not in header_names]
+        if missing and not has_header:
+            raise ValueError(f"{where}: column {missing[0]!r} is missing: the log has no header line (line "
+                             f"{header_line + 1} is its first sample, {width_text(header_names)}); name the columns by "
+                             "their position, 1 for the first, e.g. --columns 2,3,4,5,6,7 --time 1")
         if missing:
             hint = "" if columns is not None else (" (name the six channel columns with --columns GX,GY,GZ,AX,AY,AZ)")
             raise ValueError(f"{where}: column {missing[0]!r} is missing; the header (line {header_line}) has "
@@ -267,7 +290,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         block: list[list[float]] = []
         lines: list[int] = []
         line_number = header_line
-        for row in csv.reader(fh, delimiter=delimiter):
+        for row in _rows(fh, delimiter):
             line_number += 1
             if not row or all(not cell.strip() for cell in row):
                 continue
@@ -311,17 +334,70 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     time = data[:, 6] if time_column is not None else None
     temperature = data[:, -1] if temperature_column is not None else None
     return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
-                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma)
+                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
+                    has_header)
 
 
 def _delimiter(line: str) -> str:
-    """The delimiter of a header line: the one of :data:`DELIMITERS` that splits it into the most fields."""
-    return max(DELIMITERS, key=lambda d: len(next(csv.reader([line], delimiter=d))))
+    """The delimiter of a line: the one of :data:`DELIMITERS` that splits it into the most fields, or
+    :data:`WHITESPACE` when none of them splits it and runs of spaces do."""
+    best = max(DELIMITERS, key=lambda d: len(next(csv.reader([line], delimiter=d))))
+    if len(next(csv.reader([line], delimiter=best))) == 1 and len(line.split()) > 1:
+        return WHITESPACE
+    return best
+
+
+def _split(line: str, delimiter: str) -> list[str]:
+    """The fields of one line at *delimiter* (:data:`WHITESPACE`: runs of spaces and tabs)."""
+    if delimiter == WHITESPACE:
+        return line.split()
+    return next(csv.reader([line], delimiter=delimiter))
+
+
+def _rows(fh, delimiter: str):
+    """The rows of the rest of an open log, each a list of fields."""
+    if delimiter != WHITESPACE:
+        yield from csv.reader(fh, delimiter=delimiter)
+        return
+    for line in fh:
+        yield line.split()
 
 
 def _names(line: str) -> list[str]:
     """The stripped fields of one line, split at its own delimiter."""
-    return [name.strip() for name in next(csv.reader([line], delimiter=_delimiter(line)))]
+    return [name.strip() for name in _split(line, _delimiter(line))]
+
+
+def _all_numbers(line: str) -> bool:
+    """Whether a line is a sample, not a header: at least two fields, every one a number."""
+    delimiter = _delimiter(line)
+    fields = _split(line, delimiter)
+    return len(fields) >= 2 and all(_is_number(f.strip(), delimiter) for f in fields)
+
+
+def _width(line: str) -> int:
+    """The number of fields of one line at its own delimiter."""
+    return len(_split(line, _delimiter(line)))
+
+
+def _next_row_alike(fh, line: str) -> bool:
+    """Whether the next line of *fh* that is not blank or a comment is a row of numbers as wide as *line* (or
+    there is none): a lone numeric line of a logger's preamble ("2024,11,27") is not taken for a sample."""
+    width = _width(line)
+    position = fh.tell()
+    try:
+        for following in iter(fh.readline, ""):
+            text = following.strip()
+            if text and not text.startswith("#"):
+                return _all_numbers(text) and _width(text) == width
+        return True
+    finally:
+        fh.seek(position)
+
+
+def width_text(names: list[str]) -> str:
+    """'N columns', for messages."""
+    return f"{len(names)} column{'s' if len(names) != 1 else ''}"
 
 
 def _is_number(text: str, delimiter: str = ",") -> bool:
@@ -511,6 +587,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "counts_per_unit": None if counts_per_unit is None else dict(zip(CHANNELS, counts_per_unit)),
         "zero_offset_counts": None if zero_counts is None else dict(zip(CHANNELS, zero_counts)),
         "preamble": list(table.preamble),
+        "header": table.has_header,
         "time_column": table.time_column,
         "time_unit": time_unit if table.time_column is not None else None,
         "detector": {
@@ -605,12 +682,15 @@ def format_summary(result: ImportResult) -> str:
             unit_text += " after subtracting " + ", ".join(f"{c:g}" for c in result.offset) + " counts (--offset)"
     lines.append("  channels: " + " ".join(f"{c}={n}" for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
                  + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
+    if not table.has_header:
+        lines.append(f"  no header line: columns named by position, 1 for the first (first sample on line "
+                     f"{table.first_line})")
     if table.decimal_comma:
         lines.append("  numbers with a decimal comma (0,123) read as such: the values are separated by ';' or tabs")
     if table.preamble:
         shown = "; ".join(table.preamble[:4]) + ("; …" if len(table.preamble) > 4 else "")
-        lines.append(f"  before the header (line {table.header_line}): {len(table.preamble)} line(s) skipped, not "
-                     f"read as data: {shown}")
+        where = f"the header (line {table.header_line})" if table.has_header else f"line {table.first_line}"
+        lines.append(f"  before {where}: {len(table.preamble)} line(s) skipped, not read as data: {shown}")
     if table.time is None:
         lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (given; no time column: gaps and jitter cannot be "
                      "seen)")
