@@ -12,6 +12,7 @@ from plansim.estimate.dynamic import (
     HALF_POWER,
     MINUS_3_DB,
     bandwidth_3db,
+    bandwidth_curve_fit,
     frequency_response,
     sine_fit,
     wrap_phase,
@@ -295,6 +296,64 @@ def test_bandwidth_rejects_bad_inputs_naming_the_argument():
     for args, error, message in cases:
         with pytest.raises(error, match=message):
             bandwidth_3db(*args)
+
+
+# ----------------------------------------------------------------------------- the curve fit of 7.2.15.2
+
+
+@pytest.mark.parametrize("zeta, expected_bandwidth", [(0.3, 140.0), (1.0 / math.sqrt(2.0), 100.0), (1.2, 60.0)])
+@pytest.mark.parametrize("level", [HALF_POWER, MINUS_3_DB])
+def test_the_curve_fit_reads_a_second_order_response_s_bandwidth_exactly(zeta, expected_bandwidth, level):
+    """JJF 1535 7.2.15.1 b)'s grid on a one-resonance response, normalised to its lowest point as eq. (9) does:
+    the fitted curve is the response itself, so its −3 dB point is the analytic one to 1e-9 Hz, at 1/√2 (the
+    closed form of plansim.model.dynamics) and at 10^(−3/20) (found independently here by Brent's method on |H|),
+    where the chord of bandwidth_3db is off by up to 1.4 Hz (ζ = 0.3)."""
+    from scipy.optimize import brentq
+
+    from plansim.schedule.jjf1537 import jjf1535_frequencies
+
+    f_n = 100.0
+    frequencies = jjf1535_frequencies(expected_bandwidth)
+    ratios = second_order_magnitude(frequencies, f_n, zeta)
+    ratios = ratios / ratios[0]
+    peak = f_n * math.sqrt(max(1.0 - 2.0 * zeta * zeta, 0.0))  # |H| is falling beyond its peak
+    expected = brentq(lambda f: float(second_order_magnitude(f, f_n, zeta)) - level, peak + 1e-9, 10 * f_n,
+                      xtol=1e-13)
+    if level == HALF_POWER:
+        assert expected == pytest.approx(second_order_bandwidth(f_n, zeta), abs=1e-9)
+    fit = bandwidth_curve_fit(frequencies, ratios, level)
+    assert fit.bandwidth == pytest.approx(expected, abs=1e-9)
+    assert (fit.natural_frequency, fit.damping) == pytest.approx((f_n, zeta), rel=1e-9)
+    assert fit.gain == pytest.approx(1.0 / second_order_magnitude(frequencies[:1], f_n, zeta)[0], rel=1e-9)
+    assert fit.residual_rms < 1e-12
+
+
+def test_the_curve_fit_s_sensitivities_are_its_derivatives():
+    """gradient = ∂f_3dB/∂K_i, checked against central differences of the whole fit (steps of 1e-6 in K)."""
+    frequencies = np.linspace(15.0, 130.0, 9)
+    ratios = second_order_magnitude(frequencies, 90.0, 0.55) * 1.02
+    fit = bandwidth_curve_fit(frequencies, ratios)
+    h = 1e-6
+    numeric = np.array([(bandwidth_curve_fit(frequencies, ratios + h * e).bandwidth
+                         - bandwidth_curve_fit(frequencies, ratios - h * e).bandwidth) / (2 * h)
+                        for e in np.eye(frequencies.size)])
+    np.testing.assert_allclose(fit.gradient, numeric, rtol=1e-4, atol=1e-4 * np.abs(numeric).max())
+
+
+def test_the_curve_fit_refuses_an_extrapolation_and_bad_inputs():
+    flat = np.ones(8)
+    with pytest.raises(ValueError, match="outside the measured band 10 to 80 Hz"):
+        bandwidth_curve_fit(np.linspace(10.0, 80.0, 8), flat * 0.999 + 1e-4 * np.arange(8))
+    cases = [
+        (([10.0, 20.0, 30.0], [1.0, 0.8, 0.5]), ValueError, "frequencies: expected at least 4"),
+        (([10.0, 20.0, 30.0, 40.0], [1.0, 0.8, 0.5]), ValueError, "expected at least 4|same length"),
+        (([10.0, 30.0, 20.0, 40.0], [1.0, 0.8, 0.5, 0.3]), ValueError, "strictly increasing"),
+        (([10.0, 20.0, 30.0, 40.0], [1.0, -0.8, 0.5, 0.3]), ValueError, "ratios: expected values >= 0"),
+        (([10.0, 20.0, 30.0, 40.0], [1.0, 0.8, 0.5, 0.3], 0.0), ValueError, "level: expected 0 < level < 1"),
+    ]
+    for args, error, message in cases:
+        with pytest.raises(error, match=message):
+            bandwidth_curve_fit(*args)
 
 
 # ----------------------------------------------------------------------------- the analytic response

@@ -14,7 +14,7 @@ import pytest
 import scipy.signal
 
 from plansim import cli
-from plansim.estimate.dynamic import amplitude_nonlinearity, mean_change, sine_fit, sine_fits
+from plansim.estimate.dynamic import amplitude_nonlinearity, bandwidth_curve_fit, mean_change, sine_fit, sine_fits
 from plansim.kernels.dynamics import iir_filter
 from plansim.model.dynamics import (
     SensorDynamics,
@@ -161,6 +161,11 @@ def test_zero_noise_identity(model):
         assert np.all(np.isnan(r.bandwidths))  # never falls: above the band
     else:
         np.testing.assert_allclose(r.bandwidths, r.noise_free_bandwidth, rtol=0, atol=1e-9)
+        # the K_i agree to 1e-9; the fit carries that through its sensitivities (|∂f/∂K| summed, Hz)
+        carried = 1e-9 * np.abs(bandwidth_curve_fit(r.schedule.frequencies, r.noise_free_ratio).gradient).sum()
+        np.testing.assert_allclose(r.bandwidths_fit, r.noise_free_bandwidth_fit, rtol=0, atol=carried)
+        if model == "second_order":  # the curve is the response: JJF 1535 7.2.15.2's reading is exact
+            assert r.noise_free_bandwidth_fit == pytest.approx(r.truth_bandwidth, abs=1e-9)
 
 
 def test_second_order_sensor_gives_its_response_within_the_mc_uncertainty_and_the_gum():
@@ -188,6 +193,25 @@ def test_second_order_sensor_gives_its_response_within_the_mc_uncertainty_and_th
     assert s["bandwidth_std"] / r.gum["bandwidth"] == pytest.approx(1.0, abs=tolerance)
 
 
+def test_the_curve_fit_removes_the_chord_s_bias_that_the_interpolation_leaves():
+    """ζ = 0.3 (f_3dB = 145.37 Hz) on JJF 1535 7.2.15.1 b)'s grid for an expected 140 Hz, 200 trials, seed 23.
+
+    The chord between the two points either side of the level misses the curved response by 1.41 Hz, about 240
+    of its own s: its MC mean sits on the noise-free procedure's value, not the truth. The second-order curve of
+    JJF 1535 7.2.15.2 fitted to the same K_i is unbiased: its MC mean is within 5 s/√T of the truth (a correct
+    estimator fails this with probability 5.7e-7 to first order), and its s matches its GUM u within
+    4/√(2(T − 1)) = 0.20 relative, as the ratios' do above."""
+    trials = 200
+    settings = Jjf1537Experiment(damping=0.3, expected_bandwidth=140.0, vibration_frequency=20.0)
+    r = run_jjf1537(settings, trials=trials, seed=23)
+    s = r.summary()
+    assert s["bandwidth_found"] == s["bandwidth_fit_found"] == trials
+    assert abs(s["bandwidth_mean"] - r.noise_free_bandwidth) <= 5.0 / math.sqrt(trials) * s["bandwidth_std"]
+    assert abs(s["bandwidth_bias"]) > 100.0 * s["bandwidth_std"]
+    assert abs(s["bandwidth_fit_bias"]) <= 5.0 / math.sqrt(trials) * s["bandwidth_fit_std"]
+    assert s["bandwidth_fit_std"] / r.gum["bandwidth_fit"] == pytest.approx(1.0, abs=4.0 / math.sqrt(2 * (trials - 1)))
+
+
 def test_cli_json_and_plot(capsys, tmp_path):
     plot = tmp_path / "bode.png"
     code = cli.main(["run", "jjf1537", "--trials", "3", "--seed", "5", "--json", "--quiet", "--plot", str(plot),
@@ -203,7 +227,9 @@ def test_cli_json_and_plot(capsys, tmp_path):
     assert doc["overrides"] == ["record_time=0.25 s"]
     assert len(doc["frequencies"]) == len(doc["monte_carlo"]["ratio_mean"]) == len(doc["gum"]["ratio"]) == 10
     assert doc["truth"]["bandwidth"] == pytest.approx(second_order_bandwidth(100.0, 0.7))
-    assert doc["monte_carlo"]["bandwidth_found"] == 3
+    assert doc["monte_carlo"]["bandwidth_found"] == 3 and doc["monte_carlo"]["bandwidth_fit_found"] == 3
+    assert doc["noise_free"]["bandwidth_fit"] == pytest.approx(doc["truth"]["bandwidth"], abs=1e-9)
+    assert doc["gum"]["bandwidth_fit"] > 0
     assert plot.stat().st_size > 10_000
     items = doc["vibration_shock"]
     assert set(items["items"]) == set(ITEMS) and items["shock_waveform_simulated"] is True

@@ -22,6 +22,7 @@ clause                          quantity                                        
 JJF 1537 7.2.1 eq. (6)          E_ij, φ_ij, C_ij of one record                      :func:`sine_fit`
 JJF 1537 7.2.1 eq. (7)–(9)      Ē_i, S_i, K_i; the phase response (7.2.3)           :func:`frequency_response`
 JJF 1535 3.7, 7.2.15.2          the −3 dB bandwidth                                 :func:`bandwidth_3db`
+JJF 1535 7.2.15.2               the −3 dB bandwidth of a curve fitted to K(f)       :func:`bandwidth_curve_fit`
 JJF 1537 7.2.4 (title only)     the amplitude nonlinearity                          :func:`amplitude_nonlinearity`
 JJF 1537 7.2.5–7.2.7 (titles)   a change of the mean output, with its Type A u      :func:`mean_change`
 ==============================  ==================================================  ===========================
@@ -353,6 +354,120 @@ def bandwidth_3db(frequencies, ratios, level: float = HALF_POWER) -> float:
         return float(f[0])
     f0, f1, K0, K1 = f[k - 1], f[k], K[k - 1], K[k]
     return float(f0 + (K0 - lev) * (f1 - f0) / (K0 - K1))
+
+
+#: the damping ratios the curve fit of :func:`bandwidth_curve_fit` starts from (the best fit of the three is kept)
+CURVE_FIT_STARTS = (0.2, 0.7, 1.5)
+
+
+@dataclass(frozen=True)
+class CurveFitBandwidth:
+    """The −3 dB bandwidth read from a second-order curve fitted to the amplitude response (JJF 1535 7.2.15.2).
+
+    ``bandwidth`` Hz; the fitted curve's ``gain`` c, ``natural_frequency`` f_n (Hz) and ``damping`` ζ;
+    ``residual_rms`` the r.m.s. of K_i − K̂(f_i); ``gradient`` (m,) ∂bandwidth/∂K_i (Hz per unit of K), the
+    fit's first-order sensitivity for the GUM.
+    """
+
+    bandwidth: float
+    gain: float
+    natural_frequency: float
+    damping: float
+    residual_rms: float
+    gradient: np.ndarray
+
+
+def _second_order_crossing(natural_frequency: float, damping: float, level: float) -> float:
+    """Where c/√((1 − x²)² + (2ζx)²) = level · c, x = f/f_n: x² = b + √(b² + 1/level² − 1), b = 1 − 2ζ², Hz
+    (one positive root, since 1/level² − 1 > 0; :func:`plansim.model.dynamics.second_order_bandwidth` at 1/√2)."""
+    b = 1.0 - 2.0 * damping * damping
+    return natural_frequency * math.sqrt(b + math.sqrt(b * b + 1.0 / (level * level) - 1.0))
+
+
+def bandwidth_curve_fit(frequencies, ratios, level: float = HALF_POWER) -> CurveFitBandwidth:
+    """The −3 dB bandwidth of a second-order curve fitted to the amplitude response (JJF 1535-2015 7.2.15.2).
+
+    7.2.15.2: "with frequency as abscissa and the gyro's scale factor as ordinate, fit a curve; the frequency
+    where the curve's scale factor has fallen by 3 dB is the gyro's working bandwidth". The specification does
+    not name the curve; here it is the one-resonance low-pass of :mod:`plansim.model.dynamics` with a free gain,
+
+        K̂(f) = c / √((1 − x²)² + (2ζx)²),        x = f/f_n,
+
+    fitted by unweighted least squares in (ln c, ln f_n, ln ζ) (``scipy.optimize.least_squares``, started from
+    ζ ∈ :data:`CURVE_FIT_STARTS` and f_n at the interpolated crossing, the best of the starts kept), and the
+    bandwidth is where K̂ has fallen to *level* × its zero-frequency value c:
+
+        f_3dB = f_n √(b + √(b² + 1/L² − 1)),        b = 1 − 2ζ²,  L = level,
+
+    which is :func:`plansim.model.dynamics.second_order_bandwidth` at L = 1/√2. Unlike the chord of
+    :func:`bandwidth_3db` it has no interpolation error for a one-resonance sensor; for a sensor that is not one
+    (JJF 1537's two resonances), the curve's misfit becomes a bias, which the Monte Carlo of
+    ``plansim run jjf1537`` shows. ``gradient`` is the fit's first-order sensitivity ∂f_3dB/∂K_i =
+    ∇_θ f_3dB · (JᵀJ)⁻¹Jᵀ (J the residuals' Jacobian in θ = ln c, ln f_n, ln ζ; exact where the curve fits the
+    data, first order otherwise).
+
+    Parameters
+    ----------
+    frequencies : (m,) array_like
+        f_i > 0, Hz, strictly increasing, m ≥ 4 (three parameters and one degree of freedom).
+    ratios : (m,) array_like
+        K_i ≥ 0 (JJF 1537-2015 eq. (9)).
+    level : float, optional
+        0 < level < 1, in K relative to the curve's zero-frequency value; 1/√2 by default.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named); the fit did not converge; or the fitted curve reaches the level outside the
+        measured band (f_1 to f_m: an extrapolation, which the specification's procedure does not ask for).
+    """
+    import scipy.optimize
+
+    f = checked_array("frequencies", frequencies, ndim=1, minimum=4)
+    K = checked_array("ratios", ratios, ndim=1, minimum=4)
+    if f.shape != K.shape:
+        raise ValueError(f"frequencies and ratios: expected the same length, got {f.size} and {K.size}")
+    if np.any(f <= 0) or not np.all(np.diff(f) > 0):
+        raise ValueError(f"frequencies: expected values > 0 Hz, strictly increasing, got {f.tolist()}")
+    if np.any(K < 0) or not np.any(K > 0):
+        raise ValueError(f"ratios: expected values >= 0, not all 0, got {K.tolist()}")
+    lev = one_number("level", level)
+    if not 0 < lev < 1:
+        raise ValueError(f"level: expected 0 < level < 1 (1/√2 for −3 dB), got {level!r}")
+
+    def curve(theta, x=f):
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # a flat response sends f_n to ∞
+            c, fn, zeta = np.exp(theta)
+            u = x / fn
+            return c / np.sqrt((1.0 - u * u) ** 2 + (2.0 * zeta * u) ** 2)
+
+    try:
+        start_fn = bandwidth_3db(f, K / K[0], lev)
+    except ValueError:
+        start_fn = float(f[-1])
+    best = None
+    for zeta0 in CURVE_FIT_STARTS:
+        theta0 = np.log([float(K[0]), start_fn, zeta0])
+        fit = scipy.optimize.least_squares(lambda th: curve(th) - K, theta0, method="lm", xtol=1e-15, ftol=1e-15,
+                                           gtol=1e-15, max_nfev=2000)
+        usable = fit.success and np.all(np.isfinite(fit.x)) and np.all(np.isfinite(np.exp(fit.x)))
+        if usable and np.isfinite(fit.cost) and (best is None or fit.cost < best.cost):
+            best = fit
+    if best is None:
+        raise ValueError(f"ratios: the second-order curve fit did not converge on {K.tolist()}")
+    c, fn, zeta = (float(v) for v in np.exp(best.x))
+    bandwidth = _second_order_crossing(fn, zeta, lev)
+    if not f[0] <= bandwidth <= f[-1]:
+        raise ValueError(f"ratios: the fitted curve (f_n = {fn:.6g} Hz, ζ = {zeta:.6g}) falls to the level {lev:.6g} "
+                         f"at {bandwidth:.6g} Hz, outside the measured band {f[0]:.6g} to {f[-1]:.6g} Hz")
+    # ∇_θ f_3dB by central differences of the closed form (θ = ln c, ln f_n, ln ζ; c does not enter)
+    h = 1e-6
+    grad_theta = np.array([0.0, bandwidth,  # ∂f_3dB/∂ln f_n = f_3dB
+                           (_second_order_crossing(fn, zeta * math.exp(h), lev)
+                            - _second_order_crossing(fn, zeta * math.exp(-h), lev)) / (2.0 * h)])
+    gradient = grad_theta @ np.linalg.pinv(best.jac)
+    return CurveFitBandwidth(bandwidth=bandwidth, gain=c, natural_frequency=fn, damping=zeta,
+                             residual_rms=float(np.sqrt(np.mean(best.fun**2))), gradient=gradient)
 
 
 @dataclass(frozen=True)

@@ -42,16 +42,22 @@ def jjf1537_json(result, elapsed: float, version: str) -> dict:
         "frequencies": _list(sch.frequencies),
         "truth": {"ratio": _list(result.truth_ratio), "phase": _list(result.truth_phase),
                   "bandwidth": _number(result.truth_bandwidth)},
-        "noise_free": {"ratio": _list(result.noise_free_ratio), "bandwidth": _number(result.noise_free_bandwidth)},
+        "noise_free": {"ratio": _list(result.noise_free_ratio), "bandwidth": _number(result.noise_free_bandwidth),
+                       "bandwidth_fit": _number(result.noise_free_bandwidth_fit)},
         "monte_carlo": {
             "ratio_mean": _list(summary["ratio_mean"]), "ratio_std": _list(summary["ratio_std"]),
             "ratio_bias": _list(summary["ratio_bias"]), "phase_mean": _list(summary["phase_mean"]),
             "phase_std": _list(summary["phase_std"]), "phase_bias": _list(summary["phase_bias"]),
             "bandwidth_mean": _number(summary["bandwidth_mean"]), "bandwidth_std": _number(summary["bandwidth_std"]),
             "bandwidth_bias": _number(summary["bandwidth_bias"]), "bandwidth_found": summary["bandwidth_found"],
+            "bandwidth_fit_mean": _number(summary["bandwidth_fit_mean"]),
+            "bandwidth_fit_std": _number(summary["bandwidth_fit_std"]),
+            "bandwidth_fit_bias": _number(summary["bandwidth_fit_bias"]),
+            "bandwidth_fit_found": summary["bandwidth_fit_found"],
         },
         "gum": {"ratio": _list(result.gum["ratio"]), "phase": _list(result.gum["phase"]),
-                "bandwidth": _number(result.gum["bandwidth"]), "amplitude": _list(result.gum["amplitude"])},
+                "bandwidth": _number(result.gum["bandwidth"]), "bandwidth_fit": _number(result.gum["bandwidth_fit"]),
+                "amplitude": _list(result.gum["amplitude"])},
         "type_a_mean": {"ratio": _list(result.type_a["ratio"]), "phase": _list(result.type_a["phase"])},
         "vibration_shock": _vibration_shock_json(result.vibration_shock),
     }
@@ -108,9 +114,19 @@ def jjf1537_text(result, elapsed: float) -> str:
             f"{result.noise_free_bandwidth:.4f} Hz; MC mean {summary['bandwidth_mean']:.4f} Hz "
             f"(bias {summary['bandwidth_bias']:+.4f} Hz), s {summary['bandwidth_std']:.4f} Hz, GUM u "
             f"{result.gum['bandwidth']:.4f} Hz; found in {summary['bandwidth_found']}/{result.trials} trials")
+    if summary["bandwidth_fit_found"] == 0:
+        fitted = ("  read from a second-order curve fitted to K (JJF 1535 7.2.15.2): the fitted curve does not fall "
+                  "through -3.01 dB inside the measured band in any trial")
+    else:
+        fitted = (
+            f"  read from a second-order curve fitted to K (JJF 1535 7.2.15.2): without noise "
+            f"{result.noise_free_bandwidth_fit:.4f} Hz; MC mean {summary['bandwidth_fit_mean']:.4f} Hz (bias "
+            f"{summary['bandwidth_fit_bias']:+.4f} Hz), s {summary['bandwidth_fit_std']:.4f} Hz, GUM u "
+            f"{result.gum['bandwidth_fit']:.4f} Hz; found in {summary['bandwidth_fit_found']}/{result.trials} trials")
     lines += [
         "",
-        bandwidth,
+        bandwidth + " (interpolated between the two points either side)",
+        fitted,
         "K = S_i/S_0 with S_0 read at the lowest frequency (JJF 1537 eq. (9)); bias against the analytic |H|, "
         "arg H",
     ]

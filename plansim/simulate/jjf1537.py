@@ -62,6 +62,7 @@ from plansim.estimate.dynamic import (
     HALF_POWER,
     amplitude_nonlinearity,
     bandwidth_3db,
+    bandwidth_curve_fit,
     frequency_response,
     mean_change,
     shock_response,
@@ -353,12 +354,17 @@ class Jjf1537Result:
     gum: dict
     type_a: dict
     vibration_shock: VibrationShockResult | None = None
+    #: (trials,) the bandwidth read from the second-order curve fitted to the K_i (JJF 1535 7.2.15.2,
+    #: :func:`plansim.estimate.dynamic.bandwidth_curve_fit`), nan where it is not found; and without noise
+    bandwidths_fit: np.ndarray = None
+    noise_free_bandwidth_fit: float = math.nan
 
     def summary(self) -> dict:
         """MC mean, standard deviation and bias against the analytic truth of the ratios, the phases (rad) and
         the bandwidth (Hz); the bandwidth's over the trials where it was found."""
         phase_error = wrap_phase(self.phases - self.truth_phase)
         found = self.bandwidths[np.isfinite(self.bandwidths)]
+        fitted = self.bandwidths_fit[np.isfinite(self.bandwidths_fit)]
         ddof = 1 if self.trials > 1 else 0
         return {
             "ratio_mean": self.ratios.mean(axis=0), "ratio_std": self.ratios.std(axis=0, ddof=ddof),
@@ -369,6 +375,10 @@ class Jjf1537Result:
             "bandwidth_std": float(found.std(ddof=1)) if found.size > 1 else math.nan,
             "bandwidth_bias": float(found.mean()) - self.truth_bandwidth if found.size else math.nan,
             "bandwidth_found": int(found.size),
+            "bandwidth_fit_mean": float(fitted.mean()) if fitted.size else math.nan,
+            "bandwidth_fit_std": float(fitted.std(ddof=1)) if fitted.size > 1 else math.nan,
+            "bandwidth_fit_bias": float(fitted.mean()) - self.truth_bandwidth if fitted.size else math.nan,
+            "bandwidth_fit_found": int(fitted.size),
         }
 
 
@@ -389,7 +399,9 @@ def gum_uncertainties(settings: Jjf1537Experiment, response: np.ndarray, level: 
     (K_{k−1} − L)/(K_{k−1} − K_k)², carried to the Ē_j (K_{k−1}, K_k and the reference Ē_1 share Ē_1) and
     summed in quadrature. *response* (m,) is |H(f_i)|, at which the sensitivities are evaluated (E_i =
     |S| A |H(f_i)|, K_i = |H(f_i)/H(f_1)|, the noise-free values); the bandwidth's is nan where the K_i do not
-    cross *level*.
+    cross *level*. The curve-fitted bandwidth's (``bandwidth_fit``) carries the fit's sensitivities ∂f/∂K_i
+    (:attr:`plansim.estimate.dynamic.CurveFitBandwidth.gradient`) to the Ē_j the same way; nan where the fitted
+    curve does not cross *level* inside the band.
     """
     schedule = settings.schedule()
     f = schedule.frequencies
@@ -412,11 +424,21 @@ def gum_uncertainties(settings: Jjf1537Experiment, response: np.ndarray, level: 
         grad_K = np.zeros(K.size)
         grad_K[k - 1] = df * (level - K[k]) / dK**2
         grad_K[k] = df * (K[k - 1] - level) / dK**2
-        # K_l = Ē_l/Ē_1: ∂K_l/∂Ē_l = 1/Ē_1 (l > 0), ∂K_l/∂Ē_1 = −K_l/Ē_1
-        grad_E = grad_K / E1
-        grad_E[0] = -float(np.dot(grad_K[1:], K[1:])) / E1
-        u_bw = float(np.sqrt(np.sum((grad_E * u_E) ** 2)))
-    return {"ratio": u_K, "phase": u_phase, "bandwidth": u_bw, "amplitude": u_E, "sigma": math.sqrt(sigma2)}
+        u_bw = _through_ratios(grad_K, K, E1, u_E)
+    try:
+        u_bw_fit = _through_ratios(bandwidth_curve_fit(f, K, level).gradient, K, E1, u_E)
+    except ValueError:
+        u_bw_fit = math.nan
+    return {"ratio": u_K, "phase": u_phase, "bandwidth": u_bw, "bandwidth_fit": u_bw_fit, "amplitude": u_E,
+            "sigma": math.sqrt(sigma2)}
+
+
+def _through_ratios(grad_K: np.ndarray, K: np.ndarray, E1: float, u_E: np.ndarray) -> float:
+    """√Σ_j (∂f/∂Ē_j u(Ē_j))² for f a function of the K_l = Ē_l/Ē_1: ∂K_l/∂Ē_l = 1/Ē_1 (l > 0) and
+    ∂K_l/∂Ē_1 = −K_l/Ē_1 (K_1 ≡ 1 carries nothing)."""
+    grad_E = grad_K / E1
+    grad_E[0] = -float(np.dot(grad_K[1:], K[1:])) / E1
+    return float(np.sqrt(np.sum((grad_E * u_E) ** 2)))
 
 
 #: the noise streams of the 7.2.4–7.2.7 records start here (the 7.2.1 records use 0 … trials·m·n − 1)
@@ -773,10 +795,15 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
         noise_free_bw = bandwidth_3db(freqs, noise_free)
     except ValueError:
         noise_free_bw = math.nan
+    try:
+        noise_free_bw_fit = bandwidth_curve_fit(freqs, noise_free).bandwidth
+    except ValueError:
+        noise_free_bw_fit = math.nan
 
     ratios = np.empty((trials, m))
     phases = np.empty((trials, m))
     bandwidths = np.full(trials, math.nan)
+    bandwidths_fit = np.full(trials, math.nan)
     ratio_u = np.empty((trials, m))
     phase_u = np.empty((trials, m))
     A = schedule.amplitude
@@ -805,6 +832,10 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
                 bandwidths[trial] = bandwidth_3db(freqs, response.ratios)
             except ValueError:
                 pass
+            try:  # JJF 1535 7.2.15.2's reading: a curve fitted to the scale factor against frequency
+                bandwidths_fit[trial] = bandwidth_curve_fit(freqs, response.ratios).bandwidth
+            except ValueError:
+                pass
         _vibration_shock_block(settings, seed, block, item_estimates, item_type_a)  # 7.2.4–7.2.7
         if progress is not None:
             progress(int(block[-1]) + 1, trials)
@@ -815,4 +846,5 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
         gum=gum_uncertainties(settings, truth_ratio),
         type_a={"ratio": ratio_u.mean(axis=0), "phase": phase_u.mean(axis=0)},
         vibration_shock=_vibration_shock_result(settings, item_estimates, item_type_a),
+        bandwidths_fit=bandwidths_fit, noise_free_bandwidth_fit=noise_free_bw_fit,
     )
