@@ -348,7 +348,7 @@ def test_the_curve_fit_refuses_an_extrapolation_and_bad_inputs():
         (([10.0, 20.0, 30.0], [1.0, 0.8, 0.5]), ValueError, "frequencies: expected at least 4"),
         (([10.0, 20.0, 30.0, 40.0], [1.0, 0.8, 0.5]), ValueError, "expected at least 4|same length"),
         (([10.0, 30.0, 20.0, 40.0], [1.0, 0.8, 0.5, 0.3]), ValueError, "strictly increasing"),
-        (([10.0, 20.0, 30.0, 40.0], [1.0, -0.8, 0.5, 0.3]), ValueError, "ratios: expected values >= 0"),
+        (([10.0, 20.0, 30.0, 40.0], [1.0, -0.8, 0.5, 0.3]), ValueError, "ratios: expected values ≥ 0"),
         (([10.0, 20.0, 30.0, 40.0], [1.0, 0.8, 0.5, 0.3], 0.0), ValueError, "level: expected 0 < level < 1"),
     ]
     for args, error, message in cases:

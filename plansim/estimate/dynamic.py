@@ -297,6 +297,23 @@ def frequency_response(frequencies, amplitudes, phases, input_amplitude, static_
                              ratio_std_of_mean=ratio_u, phase_std_of_mean=np.atleast_1d(phase_u))
 
 
+def _checked_response(frequencies, ratios, level, minimum: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """(f, K, level) of a bandwidth estimator, each checked: f > 0 Hz strictly increasing, K ≥ 0 of the same
+    length (at least *minimum*), 0 < level < 1; a bad one is a ValueError or TypeError naming it."""
+    f = checked_array("frequencies", frequencies, ndim=1, minimum=minimum)
+    K = checked_array("ratios", ratios, ndim=1, minimum=minimum)
+    if f.shape != K.shape:
+        raise ValueError(f"frequencies and ratios: expected the same length, got {f.size} and {K.size}")
+    if np.any(f <= 0) or not np.all(np.diff(f) > 0):
+        raise ValueError(f"frequencies: expected values > 0 Hz, strictly increasing, got {f.tolist()}")
+    if np.any(K < 0):
+        raise ValueError(f"ratios: expected values ≥ 0, got {K.tolist()}")
+    lev = one_number("level", level)
+    if not 0 < lev < 1:
+        raise ValueError(f"level: expected 0 < level < 1 (1/√2 for −3 dB), got {level!r}")
+    return f, K, lev
+
+
 def bandwidth_3db(frequencies, ratios, level: float = HALF_POWER) -> float:
     """The −3 dB bandwidth: where the amplitude response K(f) first falls through *level*, Hz.
 
@@ -331,17 +348,7 @@ def bandwidth_3db(frequencies, ratios, level: float = HALF_POWER) -> float:
         (already below it at the lowest: the bandwidth is below the measured band; never down to it: above),
         or a bad argument (named).
     """
-    f = checked_array("frequencies", frequencies, ndim=1, minimum=2)
-    K = checked_array("ratios", ratios, ndim=1, minimum=2)
-    if f.shape != K.shape:
-        raise ValueError(f"frequencies and ratios: expected the same length, got {f.size} and {K.size}")
-    if np.any(f <= 0) or not np.all(np.diff(f) > 0):
-        raise ValueError(f"frequencies: expected values > 0 Hz, strictly increasing, got {f.tolist()}")
-    if np.any(K < 0):
-        raise ValueError(f"ratios: expected values ≥ 0, got {K.tolist()}")
-    lev = one_number("level", level)
-    if not 0 < lev < 1:
-        raise ValueError(f"level: expected 0 < level < 1 (1/√2 for −3 dB), got {level!r}")
+    f, K, lev = _checked_response(frequencies, ratios, level, minimum=2)
     if K[0] < lev:
         raise ValueError(f"ratios: the response is already below the level {lev:.6g} at the lowest frequency "
                          f"{f[0]:.6g} Hz (K = {K[0]:.6g}); the bandwidth lies below the measured band")
@@ -423,17 +430,9 @@ def bandwidth_curve_fit(frequencies, ratios, level: float = HALF_POWER) -> Curve
     """
     import scipy.optimize
 
-    f = checked_array("frequencies", frequencies, ndim=1, minimum=4)
-    K = checked_array("ratios", ratios, ndim=1, minimum=4)
-    if f.shape != K.shape:
-        raise ValueError(f"frequencies and ratios: expected the same length, got {f.size} and {K.size}")
-    if np.any(f <= 0) or not np.all(np.diff(f) > 0):
-        raise ValueError(f"frequencies: expected values > 0 Hz, strictly increasing, got {f.tolist()}")
-    if np.any(K < 0) or not np.any(K > 0):
-        raise ValueError(f"ratios: expected values >= 0, not all 0, got {K.tolist()}")
-    lev = one_number("level", level)
-    if not 0 < lev < 1:
-        raise ValueError(f"level: expected 0 < level < 1 (1/√2 for −3 dB), got {level!r}")
+    f, K, lev = _checked_response(frequencies, ratios, level, minimum=4)
+    if not np.any(K > 0):
+        raise ValueError(f"ratios: expected values ≥ 0, not all 0, got {K.tolist()}")
 
     def curve(theta, x=f):
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # a flat response sends f_n to ∞

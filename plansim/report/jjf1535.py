@@ -15,6 +15,7 @@ import numpy as np
 
 from plansim.estimate.jjf1535_items import ITEMS
 from plansim.io.recording import plansim_version
+from plansim.simulate.overrides import split_item
 from plansim.uncertainty.jjf1535_monte_carlo import (
     ACQUISITION_BITS,
     POSITION_ACCURACY,
@@ -257,10 +258,7 @@ def parse_targets(items) -> dict:
     it (:data:`plansim.estimate.jjf1535_items.ITEMS`; ppm, deg/h, …), optionally followed by that unit."""
     out = {}
     for text in items:
-        name, sep, value = str(text).partition("=")
-        name, value = name.strip(), value.strip().strip("'\"")
-        if not sep or name not in ITEMS:
-            raise ValueError(f"--target {text!r}: expected ITEM=VALUE with ITEM one of {', '.join(ITEMS)}")
+        name, value = split_item(text, ITEMS, "--target")
         unit, scale = ITEMS[name][2], ITEMS[name][3]
         number, _, given = value.partition(" ")
         if given.strip() and given.strip() != unit:

@@ -13,6 +13,16 @@ import dataclasses
 from plansim.units import parse_quantity
 
 
+def split_item(item, keys, option: str) -> tuple[str, str]:
+    """``KEY=VALUE`` as (KEY, VALUE), both stripped and VALUE unquoted; a ValueError naming *option*, the item and
+    the allowed keys unless it is one with KEY in *keys*."""
+    key, sep, text = str(item).partition("=")
+    key, text = key.strip(), text.strip().strip("'\"")
+    if not sep or key not in keys:
+        raise ValueError(f"{option} {item!r}: expected KEY=VALUE with KEY one of {', '.join(keys)}")
+    return key, text
+
+
 def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), count_minimum: dict | None = None,
                     option: str = "--set"):
     """*settings* (a frozen dataclass with an ``overrides`` tuple) with ``KEY=VALUE`` strings applied.
@@ -44,10 +54,7 @@ def apply_overrides(settings, overrides, kinds: dict, *, words=("choice",), coun
     """
     changes = {}
     for item in overrides:
-        key, sep, text = str(item).partition("=")
-        key, text = key.strip(), text.strip().strip("'\"")
-        if not sep or key not in kinds:
-            raise ValueError(f"{option} {item!r}: expected KEY=VALUE with KEY one of {', '.join(kinds)}")
+        key, text = split_item(item, kinds, option)
         kind = kinds[key]
         if kind in words:
             changes[key] = text
