@@ -100,7 +100,8 @@ def test_the_cheapest_cell_meets_every_target_and_is_the_shortest():
 def test_targets_are_read_in_the_items_units():
     targets = parse_targets(["nonlinearity=100", "bias=5 deg/h"])
     assert targets["nonlinearity"] == pytest.approx(100e-6) and targets["bias"] == pytest.approx(5 * ITEMS["bias"][3])
-    for bad, message in (("nonlinearity=100 deg/h", "nonlinearity is in ppm"), ("linearity=1", "expected KEY=VALUE with KEY one of scale_factor"),
+    for bad, message in (("nonlinearity=100 deg/h", "nonlinearity is in ppm"),
+                         ("linearity=1", "expected KEY=VALUE with KEY one of scale_factor"),
                          ("bias=-1", "positive"), ("bias=x", "not a number")):
         with pytest.raises(ValueError, match=message):
             parse_targets([bad])

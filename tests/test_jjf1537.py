@@ -24,6 +24,7 @@ from plansim.model.dynamics import (
 )
 from plansim.schedule.jjf1537 import Jjf1537Schedule, VibrationShockSchedule, jjf1535_frequencies
 from plansim.simulate.jjf1537 import (
+    ITEM_TABLE_ERROR_STREAM,
     ITEMS,
     Jjf1537Experiment,
     discretise,
@@ -32,6 +33,7 @@ from plansim.simulate.jjf1537 import (
     run_vibration_shock,
     simulate_records,
     simulate_vibration_shock,
+    table_errors,
     with_overrides,
 )
 from plansim.units import DEG
@@ -212,6 +214,51 @@ def test_the_curve_fit_removes_the_chord_s_bias_that_the_interpolation_leaves():
     assert s["bandwidth_fit_std"] / r.gum["bandwidth_fit"] == pytest.approx(1.0, abs=4.0 / math.sqrt(2 * (trials - 1)))
 
 
+def test_the_table_s_errors_without_noise_reach_the_estimates_exactly():
+    """No noise, a linear sensor: with the table turning at A(1 + ε_i) and phase φ_in + δ_i while the lab reads A
+    and φ_in (:func:`table_errors`, once per frequency of a trial), eq. (7)–(9) give K_i = K_i⁰(1 + ε_i)/(1 + ε_1)
+    and Δφ_i = arg H(f_i) + δ_i, to 1e-9; 7.2.4's amplitude nonlinearity of the linear sensor is that of
+    S(1 + ε_k), max |ε_k − ε̄|/(1 + ε̄). Errors of 1 % and 1° make every term visible."""
+    s = Jjf1537Experiment(gyro_arw=0.0, quantisation=0.0, table_amplitude_error=0.01, table_phase_error=math.radians(1),
+                          **SHORT)
+    seed, trials = 4, 3
+    r = run_jjf1537(s, trials=trials, seed=seed)
+    m = r.schedule.frequencies.size
+    for t in range(trials):
+        eps, delta = table_errors(s, seed, t, m)
+        assert np.all(eps != 0) and np.all(delta != 0)
+        np.testing.assert_allclose(r.ratios[t], r.noise_free_ratio * (1 + eps) / (1 + eps[0]), rtol=0, atol=1e-9)
+        np.testing.assert_allclose(r.phases[t], r.truth_phase + delta, rtol=0, atol=1e-9)
+        k_eps = table_errors(s, seed, t, s.linearity_points, ITEM_TABLE_ERROR_STREAM)[0]
+        expected = np.max(np.abs(k_eps - k_eps.mean())) / (1 + k_eps.mean())
+        assert r.vibration_shock.estimates["amplitude_nonlinearity"][t] == pytest.approx(expected, abs=1e-9)
+    perfect = run_jjf1537(dataclasses.replace(s, table_amplitude_error=0.0, table_phase_error=0.0), trials=1,
+                          seed=seed)
+    np.testing.assert_allclose(perfect.ratios[0], r.noise_free_ratio, rtol=0, atol=1e-9)
+
+
+def test_the_table_s_errors_do_not_average_over_the_repeats_and_the_gum_carries_them():
+    """Table errors of 0.1 % and 0.05° (10 times the noise's part of u(K) and of u(Δφ) over n = 7), 200 trials,
+    seed 29: the MC standard deviations of K_i, Δφ_i and of both bandwidths match the GUM with the table's terms
+    within 4/√(2(T − 1)) = 0.20 relative (the relative standard error of a standard deviation, times 4), where the
+    GUM without them would be 3 to 10 times too small; the means stay on the noise-free values within 5 s/√T."""
+    trials = 200
+    s = Jjf1537Experiment(table_amplitude_error=1e-3, table_phase_error=math.radians(0.05), vibration_frequency=20.0)
+    r = run_jjf1537(s, trials=trials, seed=29)
+    summary = r.summary()
+    tolerance = 4.0 / math.sqrt(2 * (trials - 1))
+    np.testing.assert_allclose(summary["ratio_std"][1:] / r.gum["ratio"][1:], 1.0, atol=tolerance)
+    np.testing.assert_allclose(summary["phase_std"] / r.gum["phase"], 1.0, atol=tolerance)
+    assert summary["bandwidth_std"] / r.gum["bandwidth"] == pytest.approx(1.0, abs=tolerance)
+    assert summary["bandwidth_fit_std"] / r.gum["bandwidth_fit"] == pytest.approx(1.0, abs=tolerance)
+    noise_only = run_jjf1537(dataclasses.replace(s, table_amplitude_error=0.0, table_phase_error=0.0), trials=2,
+                             seed=29).gum
+    assert np.all(r.gum["ratio"][1:] > 3 * noise_only["ratio"][1:]) and np.all(r.gum["phase"] > 3 * noise_only["phase"])
+    se = 5.0 / math.sqrt(trials)
+    assert np.all(np.abs(summary["ratio_mean"] - r.noise_free_ratio)[1:] <= se * summary["ratio_std"][1:])
+    assert np.all(np.abs(summary["phase_bias"]) <= se * summary["phase_std"])
+
+
 def test_cli_json_and_plot(capsys, tmp_path):
     plot = tmp_path / "bode.png"
     code = cli.main(["run", "jjf1537", "--trials", "3", "--seed", "5", "--json", "--quiet", "--plot", str(plot),
@@ -230,6 +277,7 @@ def test_cli_json_and_plot(capsys, tmp_path):
     assert doc["monte_carlo"]["bandwidth_found"] == 3 and doc["monte_carlo"]["bandwidth_fit_found"] == 3
     assert doc["noise_free"]["bandwidth_fit"] == pytest.approx(doc["truth"]["bandwidth"], abs=1e-9)
     assert doc["gum"]["bandwidth_fit"] > 0
+    assert doc["settings"]["table_amplitude_error"] == 0.0 and doc["settings"]["table_phase_error"] == 0.0
     assert plot.stat().st_size > 10_000
     items = doc["vibration_shock"]
     assert set(items["items"]) == set(ITEMS) and items["shock_waveform_simulated"] is True

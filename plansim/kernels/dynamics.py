@@ -57,11 +57,11 @@ def iir_filter(b, a, x, state, out):
 
 
 @jit
-def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias, sigma, step, output_range,
+def sine_records(b, a, states, amplitudes, omega, phases, dt, first, scale, bias, sigma, step, output_range,
                  key, streams, block, white, out, even=0.0, odd=0.0):
     """Gyro records on an angular vibration table: out[r, k] for record r and sample index first + k.
 
-    The table's rate about the sensitive axis is ω_r(t) = A cos(Ω t + φ_r) at t = i·Δt for the sample index
+    The table's rate about the sensitive axis is ω_r(t) = A_r cos(Ω t + φ_r) at t = i·Δt for the sample index
     i = first + k (i < 0: the run-in before the record, whose output is filtered and then discarded). The
     gyro's output is
 
@@ -82,8 +82,10 @@ def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias,
         The discrete filter, a[0] = 1.
     states : ndarray, (R, p)
         One filter state per record, updated in place.
-    amplitude, omega : float
-        A (rad/s) and Ω = 2πf (rad/s).
+    amplitudes : ndarray, (R,)
+        A_r, rad/s: the table's actual rate amplitude of each record (a table's amplitude error included).
+    omega : float
+        Ω = 2πf (rad/s).
     phases : ndarray, (R,)
         φ_r, rad, the table's phase at i = 0.
     dt : float
@@ -116,7 +118,7 @@ def sine_records(b, a, states, amplitude, omega, phases, dt, first, scale, bias,
             white_blocks(key, streams[r], block, kept, white[:count])
         for k in range(n):
             i = first + k
-            v = _df2t_step(b, a, state, amplitude * math.cos(omega * (i * dt) + phases[r]))
+            v = _df2t_step(b, a, state, amplitudes[r] * math.cos(omega * (i * dt) + phases[r]))
             if i < 0:
                 out[r, k] = math.nan
             else:

@@ -38,6 +38,7 @@ def jjf1537_json(result, elapsed: float, version: str) -> dict:
             "even_nonlinearity": s.even_nonlinearity, "vibration_bias_shift": s.vibration_bias_shift,
             "shock_bias_shift": s.shock_bias_shift, "shock_peak": s.shock_peak, "shock_duration": s.shock_duration,
             "shock_settle": s.shock_settle, "g_sensitivity": s.g_sensitivity,
+            "table_amplitude_error": s.table_amplitude_error, "table_phase_error": s.table_phase_error,
         },
         "frequencies": _list(sch.frequencies),
         "truth": {"ratio": _list(result.truth_ratio), "phase": _list(result.truth_phase),
@@ -92,7 +93,10 @@ def jjf1537_text(result, elapsed: float) -> str:
         f"sensor: {model}; range {s.gyro_range / DEG:g} deg/s, ARW {s.gyro_arw / DEG * 60:g} deg/sqrt(h), "
         f"step {s.quantisation / DEG:.4g} deg/s",
         f"table: {sch.amplitude / DEG:g} deg/s amplitude, {sch.frequencies.size} frequencies ({s.grid} grid), "
-        f"n = {sch.repeats}, {sch.sample_rate:g} Hz, {sch.samples().min()}-{sch.samples().max()} samples per record",
+        f"n = {sch.repeats}, {sch.sample_rate:g} Hz, {sch.samples().min()}-{sch.samples().max()} samples per record; "
+        + (f"table errors {s.table_amplitude_error * 100:g} % in amplitude, {s.table_phase_error / DEG:g} deg in phase "
+           "(standard deviations, once per setting)" if s.table_amplitude_error or s.table_phase_error
+           else "a perfect table (--set table_amplitude_error=..., table_phase_error=...)"),
         "",
         "  f (Hz)   |H| truth   K noise-free   K MC mean   bias K      s(K) MC    u(K) GUM   "
         "phase truth (deg)   bias (deg)   s MC (deg)   u GUM (deg)",

@@ -137,9 +137,14 @@ FIELDS = {
                              "e.g. '1 s'"),
     "g_sensitivity": ("rate_per_acceleration", "the gyro's output per acceleration along its input axis (what "
                                                "the shock reaches it through), e.g. '0.01 deg/s/g'; 0: none"),
+    "table_amplitude_error": ("dimensionless", "the table's rate amplitude error, relative standard deviation, drawn "
+                                               "once per frequency (7.2.1) and amplitude (7.2.4) of each trial, "
+                                               "e.g. '0.5 %'; 0: none (default)"),
+    "table_phase_error": ("angle", "the table's phase error against its reference signal, standard deviation, drawn "
+                                   "once per frequency of each trial, e.g. '0.2 deg'; 0: none (default)"),
 }
 _CHOICES = {"model": SENSOR_MODELS, "grid": ("jjf1535", "jjf1537")}
-_MAY_BE_ZERO = ("gyro_arw", "quantisation")
+_MAY_BE_ZERO = ("gyro_arw", "quantisation", "table_amplitude_error", "table_phase_error")
 _ANY_SIGN = ("bias", "odd_nonlinearity", "even_nonlinearity", "vibration_bias_shift", "shock_bias_shift", "shock_peak",
              "g_sensitivity")
 
@@ -187,6 +192,8 @@ class Jjf1537Experiment:
     shock_duration: float = 0.011                 # s
     shock_settle: float = 1.0                     # s
     g_sensitivity: float = 0.01 * DEG / STANDARD_GRAVITY  # rad/s per m/s²
+    table_amplitude_error: float = 0.0            # relative standard deviation
+    table_phase_error: float = 0.0                # rad, standard deviation
     overrides: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
@@ -277,12 +284,29 @@ def table_phases(seed: int, trial: int, shape: tuple[int, int]) -> np.ndarray:
     return np.random.default_rng([int(seed), int(trial)]).uniform(-math.pi, math.pi, shape)
 
 
+#: the substreams of the table's errors, apart from :func:`table_phases`' (7.2.1) and :func:`item_phases`' (7.2.4)
+TABLE_ERROR_STREAM, ITEM_TABLE_ERROR_STREAM = 1, 2
+
+
+def table_errors(settings: Jjf1537Experiment, seed: int, trial: int, count: int, stream: int = TABLE_ERROR_STREAM
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """(ε, δ), each (count,): the table's relative amplitude errors ε ~ N(0, ``table_amplitude_error``²) and phase
+    errors δ ~ N(0, ``table_phase_error``²) (rad) of trial *trial*, one per setting (a frequency of 7.2.1, an
+    amplitude of 7.2.4), from ``default_rng([seed, trial, stream])``. The table turns at A(1 + ε) and phase φ_in + δ
+    while the lab reads A and φ_in: an error that acts once per setting, so the n repeats do not average it down.
+    Exactly 0 when the settings have none (the records are then those of a perfect table, number for number)."""
+    draws = np.random.default_rng([int(seed), int(trial), int(stream)]).standard_normal((2, count))
+    return settings.table_amplitude_error * draws[0], settings.table_phase_error * draws[1]
+
+
 def simulate_records(settings: Jjf1537Experiment, seed: int, index: int, trials, chunk: int | None = None,
-                     phases: np.ndarray | None = None) -> np.ndarray:
+                     phases: np.ndarray | None = None, amplitude_errors: np.ndarray | None = None) -> np.ndarray:
     """The records at the frequency number *index* for the trials *trials*: (len(trials), n, N_i), output unit.
 
     *chunk*: samples per kernel call along time (None: the run-in and the record in one call); the result
-    does not depend on it. *phases*: (len(trials), n) table phases (default: :func:`table_phases`).
+    does not depend on it. *phases*: (len(trials), n) the table's actual phases (default: :func:`table_phases`);
+    *amplitude_errors*: (len(trials),) the table's relative amplitude error at this frequency in each trial
+    (default 0: the table turns at the schedule's amplitude).
     """
     schedule = settings.schedule()
     trials = np.asarray(trials, dtype=np.int64).ravel()
@@ -290,19 +314,23 @@ def simulate_records(settings: Jjf1537Experiment, seed: int, index: int, trials,
     if phases is None:
         phases = np.stack([table_phases(seed, t, (m, n))[index] for t in trials])
     streams = ((trials[:, None] * m + index) * n + np.arange(n)[None, :]).ravel().astype(np.int64)
-    out = table_records(settings, seed, float(schedule.frequencies[index]), schedule.amplitude,
+    errors = np.zeros(trials.size) if amplitude_errors is None else np.asarray(amplitude_errors, dtype=float)
+    amplitudes = np.repeat(schedule.amplitude * (1.0 + errors), n)
+    out = table_records(settings, seed, float(schedule.frequencies[index]), amplitudes,
                         np.ascontiguousarray(phases).ravel(), int(schedule.samples()[index]), streams, chunk=chunk)
     return out.reshape(trials.size, n, -1)
 
 
-def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, amplitude: float, phases, samples: int,
+def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, amplitude, phases, samples: int,
                   streams, chunk: int | None = None, bias_shift: float = 0.0) -> np.ndarray:
     """One record per stream (R,) of *samples* samples: the table at *frequency* (Hz) and rate *amplitude*
-    (rad/s; 0: at rest) with the phases *phases* (R,), through the sensor of *settings* after its run-in
-    (:func:`plansim.kernels.dynamics.sine_records`), the output bias B + *bias_shift* (output unit, as B).
-    (R, samples), output unit; *chunk* as :func:`simulate_records` (the numbers do not depend on it)."""
+    (rad/s, one for all or (R,) one per record; 0: at rest) with the phases *phases* (R,), through the sensor of
+    *settings* after its run-in (:func:`plansim.kernels.dynamics.sine_records`), the output bias B + *bias_shift*
+    (output unit, as B). (R, samples), output unit; *chunk* as :func:`simulate_records` (the numbers do not depend
+    on it)."""
     streams = np.ascontiguousarray(streams, dtype=np.int64).ravel()
-    if amplitude == 0.0:  # at rest: the dynamics pass nothing
+    amplitudes = np.ascontiguousarray(np.broadcast_to(np.asarray(amplitude, dtype=float), streams.shape))
+    if not np.any(amplitudes):  # at rest: the dynamics pass nothing
         b, a, lead = np.ones(1), np.ones(1), 0
     else:
         b, a = discretise(settings.dynamics(), frequency, settings.sample_rate)
@@ -319,7 +347,7 @@ def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, ampl
     even, odd = settings.even_nonlinearity / R, settings.odd_nonlinearity / R**2
     for start in range(0, lead + samples, step):
         stop = min(start + step, lead + samples)
-        sine_records(b, a, states, amplitude, 2.0 * math.pi * frequency,
+        sine_records(b, a, states, amplitudes, 2.0 * math.pi * frequency,
                      np.ascontiguousarray(phases, dtype=float).ravel(), 1.0 / settings.sample_rate, start - lead,
                      settings.scale_factor, settings.bias + bias_shift,
                      settings.noise_sigma, settings.quantisation, R * settings.scale_factor, key, streams,
@@ -388,11 +416,13 @@ def gum_uncertainties(settings: Jjf1537Experiment, response: np.ndarray, level: 
     Over (nearly) whole cycles of N_i samples with white noise of variance σ² = σ_w² + q²/12 (the ARW's
     white noise and the quantiser's, uniform), the fitted amplitude has var(E) = 2σ²/N_i and the phase
     var(φ) = 2σ²/(N_i E_i²) (:func:`plansim.estimate.dynamic.sine_fit`); the n repeats' means
-    Ē_i (eq. (7)) have these over n, independent between frequencies. Then, with E_i = S A K_i and S_0
-    read at the lowest frequency (K_i = Ē_i/Ē_1, eq. (8)–(9)),
+    Ē_i (eq. (7)) have these over n, independent between frequencies. The table's errors act once per
+    frequency and do not average over the repeats: u²(Ē_i) gains (Ē_i ε_A)² and u²(Δφ_i) gains δ_φ²
+    (ε_A, δ_φ the ``table_amplitude_error`` and ``table_phase_error``, :func:`table_errors`). Then, with
+    E_i = S A K_i and S_0 read at the lowest frequency (K_i = Ē_i/Ē_1, eq. (8)–(9)),
 
         u²(K_i) = u²(Ē_i)/Ē_1² + K_i² u²(Ē_1)/Ē_1²   (i > 1; 0 at i = 1),
-        u²(Δφ_i) = 2σ²/(n N_i E_i²),
+        u²(Δφ_i) = 2σ²/(n N_i E_i²) + δ_φ²,
 
     and the interpolated bandwidth f = f_{k−1} + (K_{k−1} − L)(f_k − f_{k−1})/(K_{k−1} − K_k) has the
     sensitivities ∂f/∂K_{k−1} = (f_k − f_{k−1})(L − K_k)/(K_{k−1} − K_k)², ∂f/∂K_k = (f_k − f_{k−1})
@@ -411,11 +441,12 @@ def gum_uncertainties(settings: Jjf1537Experiment, response: np.ndarray, level: 
     N = schedule.samples()
     sigma2 = settings.noise_sigma**2 + settings.quantisation**2 / 12.0
     E = abs(settings.scale_factor) * schedule.amplitude * gain  # Ē_i
-    u_E = np.sqrt(2.0 * sigma2 / (N * n))                          # u(Ē_i)
+    # u(Ē_i): the noise over n records, and the table's amplitude error, once per frequency
+    u_E = np.sqrt(2.0 * sigma2 / (N * n) + (E * settings.table_amplitude_error) ** 2)
     E1 = E[0]
     u_K = np.sqrt(u_E**2 / E1**2 + K**2 * u_E[0] ** 2 / E1**2)
     u_K[0] = 0.0
-    u_phase = np.sqrt(2.0 * sigma2 / (n * N * E**2))
+    u_phase = np.sqrt(2.0 * sigma2 / (n * N * E**2) + settings.table_phase_error**2)
     u_bw = math.nan
     below = np.flatnonzero(K <= level)
     if K[0] >= level and below.size and below[0] > 0:
@@ -537,9 +568,10 @@ def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
     The amplitude nonlinearity γ = |S_k* − S̄|/S̄ (k* where |S_k − S̄| is largest), evaluated at the noise-free
     S_k: with d_j = S_j − S̄ and s* the sign of d_k*,
 
-        ∂γ/∂S_j = s* [(δ_jk* − 1/M)/S̄ − d_k*/(M S̄²)],        u(S_j) = √(2σ²/(nN))/A_j
+        ∂γ/∂S_j = s* [(δ_jk* − 1/M)/S̄ − d_k*/(M S̄²)],        u²(S_j) = 2σ²/(nN A_j²) + (S_j ε_A)²
 
-    (var(E) = 2σ²/N per record, n records), summed in quadrature. nan when γ is not differentiable there: a
+    (var(E) = 2σ²/N per record, n records; ε_A the table's relative amplitude error, once per amplitude), summed
+    in quadrature. nan when γ is not differentiable there: a
     linear sensor (every d_j = 0) or two amplitudes tied for the maximum. It holds while the noise does not
     move the maximum to another amplitude (the runner-up several u below).
     """
@@ -560,7 +592,8 @@ def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
         grad = -np.full(M, 1.0 / M) / mean - d[k] / (M * mean**2)
         grad[k] += 1.0 / mean
         grad *= math.copysign(1.0, d[k])
-        u_S = math.sqrt(2.0 * sigma**2 / (sch.repeats * sch.samples(sch.record_time))) / sch.amplitudes
+        u_S = np.sqrt(2.0 * sigma**2 / (sch.repeats * sch.samples(sch.record_time)) / sch.amplitudes**2
+                      + (S * settings.table_amplitude_error) ** 2)
         u_nonlinearity = float(np.sqrt(np.sum((grad * u_S) ** 2)))
     return {"amplitude_nonlinearity": u_nonlinearity,
             "vibration_output_change": sigma * math.sqrt(1.0 / sch.samples(sch.vibration_time) + 1.0 / rest),
@@ -581,9 +614,11 @@ def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chu
     phases = np.stack([item_phases(seed, t, M * n + 1) for t in trials])  # (T, M n + 1)
     N = sch.samples(sch.record_time)
     linearity = np.empty((trials.size, M, n, N))
+    eps = np.stack([table_errors(settings, seed, t, M, ITEM_TABLE_ERROR_STREAM)[0] for t in trials])  # (T, M)
     for k, A in enumerate(sch.amplitudes):
         streams = (base[:, None] + k * n + np.arange(n)[None, :]).ravel()
-        linearity[:, k] = table_records(settings, seed, sch.frequency, float(A), phases[:, k * n:(k + 1) * n],
+        amplitudes = np.repeat(float(A) * (1.0 + eps[:, k]), n)  # the table's amplitude error at A_k (7.2.4)
+        linearity[:, k] = table_records(settings, seed, sch.frequency, amplitudes, phases[:, k * n:(k + 1) * n],
                                         N, streams, chunk).reshape(trials.size, n, N)
     vibration = table_records(settings, seed, sch.frequency, sch.amplitude, phases[:, -1],
                               sch.samples(sch.vibration_time), base + M * n, chunk)
@@ -811,11 +846,15 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
     item_type_a = {k: np.empty(trials) for k in ITEMS}
     for first in range(0, trials, chunk_trials):
         block = np.arange(first, min(first + chunk_trials, trials))
-        table = np.stack([table_phases(seed, t, (m, n)) for t in block])  # (c, m, n)
+        table = np.stack([table_phases(seed, t, (m, n)) for t in block])  # (c, m, n): what the lab reads
+        errors = [table_errors(settings, seed, t, m) for t in block]
+        eps = np.stack([e[0] for e in errors])                              # (c, m) amplitude, relative
+        delta = np.stack([e[1] for e in errors])                            # (c, m) phase, rad
         E = np.empty((block.size, m, n))
         phi = np.empty((block.size, m, n))
         for i in range(m):
-            records = simulate_records(settings, seed, i, block, phases=table[:, i, :])
+            records = simulate_records(settings, seed, i, block, phases=table[:, i, :] + delta[:, i, None],
+                                       amplitude_errors=eps[:, i])
             t = np.arange(records.shape[-1]) * schedule.interval
             for c in range(block.size):  # one trial's n records at a time: the same numbers whatever the chunk
                 fits = sine_fits(t, records[c], freqs[i])  # JJF 1537-2015 eq. (6), per record
