@@ -284,8 +284,9 @@ def table_phases(seed: int, trial: int, shape: tuple[int, int]) -> np.ndarray:
     return np.random.default_rng([int(seed), int(trial)]).uniform(-math.pi, math.pi, shape)
 
 
-#: the substreams of the table's errors, apart from :func:`table_phases`' (7.2.1) and :func:`item_phases`' (7.2.4)
-TABLE_ERROR_STREAM, ITEM_TABLE_ERROR_STREAM = 1, 2
+#: the substreams of the table's errors, apart from :func:`table_phases`' ([seed, trial]) and :func:`item_phases`'
+#: ([seed, trial, 1])
+TABLE_ERROR_STREAM, ITEM_TABLE_ERROR_STREAM = 2, 3
 
 
 def table_errors(settings: Jjf1537Experiment, seed: int, trial: int, count: int, stream: int = TABLE_ERROR_STREAM
