@@ -23,16 +23,13 @@ from plansim.model.dynamics import (
     static_nonlinearity_harmonics,
 )
 from plansim.schedule.jjf1537 import Jjf1537Schedule, VibrationShockSchedule, jjf1535_frequencies
-from plansim.simulate.jjf1537 import (
+from plansim.simulate.jjf1537 import run_jjf1537, simulate_records
+from plansim.simulate.jjf1537_items import ITEMS, run_vibration_shock, simulate_vibration_shock
+from plansim.simulate.vibration_table import (
     ITEM_TABLE_ERROR_STREAM,
-    ITEMS,
     Jjf1537Experiment,
     discretise,
     run_in_samples,
-    run_jjf1537,
-    run_vibration_shock,
-    simulate_records,
-    simulate_vibration_shock,
     table_errors,
     with_overrides,
 )

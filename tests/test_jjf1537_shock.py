@@ -1,6 +1,7 @@
 """JJF 1537-2015 7.2.7's shock as a waveform: the half-sine pulse (plansim.model.dynamics.half_sine), the records
-driven through the sensor's dynamics (plansim.kernels.dynamics.input_records, plansim.simulate.jjf1537.shock_records)
-and what the shock record shows (plansim.estimate.dynamic.shock_response): peak, saturation, recovery time."""
+driven through the sensor's dynamics (plansim.kernels.dynamics.input_records,
+plansim.simulate.jjf1537_items.shock_records) and what the shock record shows
+(plansim.estimate.dynamic.shock_response): peak, saturation, recovery time."""
 
 from __future__ import annotations
 
@@ -12,19 +13,17 @@ import scipy.signal
 
 from plansim.estimate.dynamic import shock_response
 from plansim.model.dynamics import half_sine
-from plansim.simulate.jjf1537 import (
+from plansim.simulate.jjf1537_items import (
     ITEM_STREAMS,
     REST_RECORDS,
-    Jjf1537Experiment,
     run_vibration_shock,
     shock_filter,
     shock_input,
     shock_noise_free,
     shock_records,
     simulate_vibration_shock,
-    table_records,
-    with_overrides,
 )
+from plansim.simulate.vibration_table import Jjf1537Experiment, table_records, with_overrides
 from plansim.units import DEG, STANDARD_GRAVITY
 
 #: short records: the tests look at the shock, not at 7.2.4–7.2.6

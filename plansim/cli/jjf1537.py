@@ -3,8 +3,8 @@ items 7.2.4–7.2.7 (amplitude nonlinearity, output change under vibration, bias
 shock), simulated as a Monte Carlo and reduced (docs/dynamic.md).
 
 Like ``vibration_g2`` it is built in, not a scenario file: its settings are
-:class:`plansim.simulate.jjf1537.Jjf1537Experiment`, changed with ``--set KEY=VALUE``
-(:data:`plansim.simulate.jjf1537.FIELDS`).
+:class:`plansim.simulate.vibration_table.Jjf1537Experiment`, changed with ``--set KEY=VALUE``
+(:data:`plansim.simulate.vibration_table.FIELDS`).
 """
 
 from __future__ import annotations
@@ -23,7 +23,8 @@ def run_jjf1537_command(args, default_chunk_size: int) -> int:
     from plansim.cli.common import checked_trials, run_experiment
     from plansim.report.jjf1537 import bode_figure, jjf1537_json, jjf1537_text
     from plansim.report.progress import stderr_progress
-    from plansim.simulate.jjf1537 import DEFAULT_SEED, DEFAULT_TRIALS, Jjf1537Experiment, run_jjf1537, with_overrides
+    from plansim.simulate.jjf1537 import run_jjf1537
+    from plansim.simulate.vibration_table import DEFAULT_SEED, DEFAULT_TRIALS, Jjf1537Experiment, with_overrides
 
     for option, value in (("--out", args.out), ("--unit", args.unit)):
         if value is not None:

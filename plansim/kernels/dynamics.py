@@ -1,7 +1,7 @@
 """The sensor's dynamics on the sample path: an IIR filter, and the gyro records of an angular vibration table.
 
 A discrete transfer function H(z) = (b₀ + b₁z⁻¹ + … + b_p z⁻ᵖ)/(1 + a₁z⁻¹ + … + a_p z⁻ᵖ) (a₀ = 1; the
-coefficients come from :mod:`plansim.simulate.jjf1537`, which discretises the continuous model of
+coefficients come from :mod:`plansim.simulate.vibration_table`, which discretises the continuous model of
 :mod:`plansim.model.dynamics`) is run in the transposed direct form II, the form of
 ``scipy.signal.lfilter``:
 
@@ -141,7 +141,7 @@ def input_records(b, a, states, inputs, first, scale, bias, sigma, step, output_
 
     As :func:`sine_records`, with the sensor's input (rad/s) given sample by sample, ``inputs[k]`` for sample
     first + k, instead of a table's sinusoid: y = Q(S · g((H x)[i]) + B + σ w_r[i]), H continuing from
-    ``states[r]``. A half-sine shock reaches the gyro this way (:func:`plansim.simulate.jjf1537.shock_records`):
+    ``states[r]``. A half-sine shock reaches the gyro this way (:func:`plansim.simulate.jjf1537_items.shock_records`):
     its input is the rate its g-sensitivity reads from the pulse's acceleration. Chunks of any size give the
     same numbers (the state is carried, the white sequence indexed by i).
 

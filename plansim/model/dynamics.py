@@ -21,7 +21,7 @@ so f_3dB = f_n for ζ = 1/√2 (the Butterworth response, |H| = 1/√(1 + x⁴))
 
 JJF 1537-2015 eq. (3)'s two-resonance form is :func:`two_resonance_response`, and :class:`SensorDynamics`
 holds one of the three models (flat, one resonance, two) with its H(s) as polynomials for the simulator
-(:mod:`plansim.simulate.jjf1537` discretises them) and its bandwidth. These are the truth the estimators of
+(:mod:`plansim.simulate.vibration_table` discretises them) and its bandwidth. These are the truth the estimators of
 :mod:`plansim.estimate.dynamic` are tested against.
 """
 
