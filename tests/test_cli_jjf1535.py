@@ -48,7 +48,7 @@ def test_the_text_report_groups_the_items_as_the_certificate_with_their_units(ca
     code, out, err = _run(capsys, "--trials", str(TRIALS), "--seed", str(SEED), "--quiet")
     assert code == 0 and err == ""
     assert f"scenario 'jjf2003': {TRIALS} trials, seed {SEED}, segment path" in out.splitlines()[0]
-    titles = [title for title, _names in GROUPS] + ["Not simulated"]
+    titles = [title for title, _names in GROUPS] + ["Not in this Monte Carlo"]
     starts = [out.index(f"\n{title}\n") for title in titles]
     assert starts == sorted(starts), "the groups are out of order"
     sections = dict(zip(titles, [out[a:b] for a, b in zip(starts, starts[1:] + [len(out)])]))
@@ -64,9 +64,9 @@ def test_the_text_report_groups_the_items_as_the_certificate_with_their_units(ca
     assert "reported figure: mean" in bias  # the bias stability has no true value
     assert "angle random walk" in bias and "deg/sqrt(h)" in bias
     assert "reported figure: mean" in sections["Threshold, resolution, warm-up time"]  # a tested rate, its scatter
-    assert "  bandwidth " in sections["Not simulated"]
+    assert "  bandwidth " in sections["Not in this Monte Carlo"]
     for item in ("threshold", "resolution", "warm-up time", "bias repeatability", "SF repeatability"):
-        assert f"  {item} " not in sections["Not simulated"]
+        assert f"  {item} " not in sections["Not in this Monte Carlo"]
     assert len(NOT_SIMULATED) == 1
 
 

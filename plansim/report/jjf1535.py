@@ -66,7 +66,7 @@ SI_UNITS = {
     "s": "s",
 }
 
-#: the certificate's items plansim does not simulate: (item, clause, why)
+#: the certificate's items this Monte Carlo does not simulate: (item, clause, where they are, or why not)
 NOT_SIMULATED = (
     ("bandwidth", "7.2.15", "a dynamic test on an angular vibration table, simulated by its own Monte Carlo: "
                             "'plansim run jjf1537' (its default grid is 7.2.15.1 b)'s; the bandwidth interpolated and "
@@ -186,7 +186,7 @@ def items_table(rows: list[dict], arw: tuple[float, float] | None = None) -> str
                          f"{_g(simulated / ARW_SCALE, 5):>10s} one session (trial 0), eq. (21)-(26): "
                          f"reported {_g(reported / ARW_SCALE, 4)} "
                          "(not in the Monte Carlo: it needs every sample)")
-    lines += ["", "Not simulated"]
+    lines += ["", "Not in this Monte Carlo"]
     lines += [f"  {item:30s} {clause:14s} {reason}" for item, clause, reason in NOT_SIMULATED]
     return "\n".join(lines)
 
