@@ -24,7 +24,14 @@ from plansim.model.dynamics import (
 )
 from plansim.schedule.jjf1537 import Jjf1537Schedule, VibrationShockSchedule, jjf1535_frequencies
 from plansim.simulate.jjf1537 import run_jjf1537, simulate_records
-from plansim.simulate.jjf1537_items import ITEMS, run_vibration_shock, simulate_vibration_shock
+from plansim.simulate.jjf1537_items import (
+    ITEMS,
+    drift_covariance,
+    drift_intervals,
+    drift_offsets,
+    run_vibration_shock,
+    simulate_vibration_shock,
+)
 from plansim.simulate.vibration_table import (
     ITEM_TABLE_ERROR_STREAM,
     Jjf1537Experiment,
@@ -470,3 +477,49 @@ def test_items_monte_carlo_against_the_truth_and_the_coverage_of_their_uncertain
         assert fig["coverage"] == pytest.approx(p, abs=4.0 * math.sqrt(p * (1 - p) / trials)), name
         assert fig["type_a_mean"] / fig["gum"] == pytest.approx(1.0, rel=0.02), name
     assert summary["bias_change_shock"]["truth"] == pytest.approx(-50 * DEG / 3600)
+
+
+def test_the_drift_covariance_is_that_of_a_rate_random_walk_s_record_means():
+    """Cov(b̄_i, b̄_j) of a rate random walk S K W(t) averaged over the five records, against a midpoint quadrature
+    of (1/(T_i T_j)) ∫∫ min(s, t) (400 × 400 points per pair: error < 1e-4 relative); a record's own variance is
+    S²K²(a + T/3) exactly."""
+    s = Jjf1537Experiment(**SHORT_ITEMS, gyro_rrw=1e-3, scale_factor=1.3)
+    C = drift_covariance(s)
+    iv = drift_intervals(s)
+    K2 = (1.3 * 1e-3) ** 2
+    for i in range(5):
+        a, b = iv[i]
+        assert C[i, i] == pytest.approx(K2 * (a + (b - a) / 3.0), rel=1e-12)
+        for j in range(5):
+            u = iv[i, 0] + (np.arange(400) + 0.5) / 400 * (iv[i, 1] - iv[i, 0])
+            v = iv[j, 0] + (np.arange(400) + 0.5) / 400 * (iv[j, 1] - iv[j, 0])
+            assert C[i, j] == pytest.approx(K2 * np.minimum.outer(u, v).mean(), rel=1e-4), (i, j)
+    np.testing.assert_array_equal(drift_offsets(dataclasses.replace(s, gyro_rrw=0.0), 3, 0), np.zeros(5))
+
+
+def test_a_drifting_bias_reaches_the_records_means_exactly_without_noise():
+    """No white noise, no quantiser: each record at rest reads B + its shift + its drawn mean drift, exactly."""
+    s = Jjf1537Experiment(**SHORT_ITEMS, gyro_arw=0.0, quantisation=0.0, gyro_rrw=1e-3, vibration_bias_shift=2e-4,
+                          shock_peak=0.0)
+    records = simulate_vibration_shock(s, 5, [0, 1])
+    for t in range(2):
+        drift = drift_offsets(s, 5, t)
+        expected = s.bias + np.array([drift[0], 2e-4 + drift[2], 2e-4 + drift[4]])
+        np.testing.assert_allclose(records["rest"][t].mean(axis=-1), expected, rtol=0, atol=1e-15)
+        np.testing.assert_allclose(records["rest"][t].std(axis=-1), 0.0, atol=1e-15)
+
+
+def test_a_drifting_bias_widens_the_bias_changes_beyond_their_type_a_u():
+    """A rate random walk of 2000 °/h/√h across 5 s records (mean-drift sd ≈ 5 times the records' white noise on
+    the changes), 200 trials, seed 13: the MC standard deviations of the three changes of mean match the GUM with
+    the drift within 4/√(2(T − 1)) = 0.20 relative, while the records' own Type A u (which cannot see a drift
+    between records) covers the bias change across the vibration in well under the nominal 95 % (below 60 %:
+    with u_A/u ≈ 0.2, P(|e| ≤ 2u_A) ≈ 0.31)."""
+    trials = 200
+    s = Jjf1537Experiment(**SHORT_ITEMS, linearity_points=3, gyro_rrw=2000 * DEG / 3600 / 60)
+    summary = run_vibration_shock(s, trials=trials, seed=13).summary()
+    for name in ITEMS[1:]:
+        fig = summary[name]
+        assert fig["std"] / fig["gum"] == pytest.approx(1.0, abs=4.0 / math.sqrt(2 * (trials - 1))), name
+        assert fig["gum"] > 3 * fig["type_a_mean"], name
+    assert summary["bias_change_vibration"]["coverage"] < 0.6

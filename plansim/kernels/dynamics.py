@@ -57,7 +57,7 @@ def iir_filter(b, a, x, state, out):
 
 
 @jit
-def sine_records(b, a, states, amplitudes, omega, phases, dt, first, scale, bias, sigma, step, output_range,
+def sine_records(b, a, states, amplitudes, omega, phases, dt, first, scale, biases, sigma, step, output_range,
                  key, streams, block, white, out, even=0.0, odd=0.0):
     """Gyro records on an angular vibration table: out[r, k] for record r and sample index first + k.
 
@@ -65,11 +65,11 @@ def sine_records(b, a, states, amplitudes, omega, phases, dt, first, scale, bias
     i = first + k (i < 0: the run-in before the record, whose output is filtered and then discarded). The
     gyro's output is
 
-        y = Q(S · g((H ω)[i]) + B + σ w_r[i]),        g(v) = v + c₂ v² + c₃ v³,
+        y = Q(S · g((H ω)[i]) + B_r + σ w_r[i]),        g(v) = v + c₂ v² + c₃ v³,
 
     H the filter (b, a) continuing from ``states[r]``, g the static amplitude nonlinearity after the dynamics
     (c₂ = *even*, c₃ = *odd*, in (rad/s)⁻¹ and (rad/s)⁻²; both 0 by default: the linear sensor), S the scale
-    factor, B the bias, w_r the standard
+    factor, B_r the bias of record r, w_r the standard
     normal sequence of stream ``streams[r]`` (drawn block by block, :func:`plansim.kernels.vibration.white_blocks`,
     so w_r[i] depends only on (key, stream, i)), and Q the saturation at ± *output_range* and the quantiser of
     step *step* (:func:`plansim.kernels.quantiser.quantise`; step 0: none). Samples with i < 0 are written as
@@ -92,8 +92,10 @@ def sine_records(b, a, states, amplitudes, omega, phases, dt, first, scale, bias
         Δt, s.
     first : int
         The sample index of out[:, 0] (negative in the run-in).
-    scale, bias, sigma, step, output_range : float
-        S (output unit per rad/s), B and σ (output unit), the quantisation step (0: none) and the range.
+    scale, sigma, step, output_range : float
+        S (output unit per rad/s), σ (output unit), the quantisation step (0: none) and the range.
+    biases : ndarray, (R,)
+        B_r, output unit: each record's bias (a drift between records included).
     even, odd : float
         c₂, c₃ of g (above), 0 for a linear sensor.
     key : ndarray of uint64, (4,)
@@ -122,7 +124,7 @@ def sine_records(b, a, states, amplitudes, omega, phases, dt, first, scale, bias
             if i < 0:
                 out[r, k] = math.nan
             else:
-                out[r, k] = _gyro_output(v, even, odd, scale, bias, sigma * white[k - skip], step, inverse_step,
+                out[r, k] = _gyro_output(v, even, odd, scale, biases[r], sigma * white[k - skip], step, inverse_step,
                                          output_range)
 
 
@@ -135,12 +137,12 @@ def _gyro_output(v, even, odd, scale, bias, noise, step, inverse_step, output_ra
 
 
 @jit
-def input_records(b, a, states, inputs, first, scale, bias, sigma, step, output_range, key, streams, block, white,
+def input_records(b, a, states, inputs, first, scale, biases, sigma, step, output_range, key, streams, block, white,
                   out, even=0.0, odd=0.0):
     """Gyro records driven by one input common to every record: out[r, k] for sample index first + k ≥ 0.
 
     As :func:`sine_records`, with the sensor's input (rad/s) given sample by sample, ``inputs[k]`` for sample
-    first + k, instead of a table's sinusoid: y = Q(S · g((H x)[i]) + B + σ w_r[i]), H continuing from
+    first + k, instead of a table's sinusoid: y = Q(S · g((H x)[i]) + B_r + σ w_r[i]), H continuing from
     ``states[r]``. A half-sine shock reaches the gyro this way (:func:`plansim.simulate.jjf1537_items.shock_records`):
     its input is the rate its g-sensitivity reads from the pulse's acceleration. Chunks of any size give the
     same numbers (the state is carried, the white sequence indexed by i).
@@ -161,4 +163,5 @@ def input_records(b, a, states, inputs, first, scale, bias, sigma, step, output_
         white_blocks(key, streams[r], block, first, white[:n])
         for k in range(n):
             v = _df2t_step(b, a, state, inputs[k])
-            out[r, k] = _gyro_output(v, even, odd, scale, bias, sigma * white[k], step, inverse_step, output_range)
+            out[r, k] = _gyro_output(v, even, odd, scale, biases[r], sigma * white[k], step, inverse_step,
+                                     output_range)

@@ -39,6 +39,7 @@ def jjf1537_json(result, elapsed: float, version: str) -> dict:
             "shock_bias_shift": s.shock_bias_shift, "shock_peak": s.shock_peak, "shock_duration": s.shock_duration,
             "shock_settle": s.shock_settle, "g_sensitivity": s.g_sensitivity,
             "table_amplitude_error": s.table_amplitude_error, "table_phase_error": s.table_phase_error,
+            "gyro_rrw": s.gyro_rrw,
         },
         "frequencies": _list(sch.frequencies),
         "truth": {"ratio": _list(result.truth_ratio), "phase": _list(result.truth_phase),
@@ -159,7 +160,9 @@ def _vibration_shock_text(result) -> list[str]:
         f"{sch.samples(sch.vibration_time)} samples; 3 records at rest of {sch.rest_samples()} samples",
         f"sensor: odd nonlinearity c3 {s.odd_nonlinearity:g}, even c2 {s.even_nonlinearity:g} (g(v) = v + c2 v^2/R "
         f"+ c3 v^3/R^2); bias shift after vibration {s.vibration_bias_shift / DEG * 3600:g} deg/h, after the "
-        f"shock {s.shock_bias_shift / DEG * 3600:g} deg/h",
+        f"shock {s.shock_bias_shift / DEG * 3600:g} deg/h; "
+        + (f"the bias drifts as a rate random walk of {s.gyro_rrw / DEG * 3600 * 60:g} deg/h/sqrt(h) (the Type A u "
+           "of the records does not see it; the GUM does)" if s.gyro_rrw else "no drift (--set gyro_rrw=...)"),
         f"shock: half-sine {s.shock_peak / STANDARD_GRAVITY:g} g, {1e3 * s.shock_duration:g} ms along the input "
         f"axis, read through a g-sensitivity of {s.g_sensitivity / DEG * STANDARD_GRAVITY:g} deg/s/g; the record "
         f"after it starts {shock['shock_record']:g} s after the pulse's start",

@@ -65,6 +65,52 @@ def item_phases(seed: int, trial: int, count: int) -> np.ndarray:
     return np.random.default_rng([int(seed), int(trial), 1]).uniform(-math.pi, math.pi, count)
 
 
+#: the records the bias's rate random walk runs through, in time order, and its substream (apart from the others)
+DRIFT_RECORDS = ("before_vibration", "vibration", "after_vibration", "shock", "after_shock")
+DRIFT_STREAM = 4
+
+
+def drift_intervals(settings: Jjf1537Experiment) -> np.ndarray:
+    """(5, 2) the start and end (s) of the records of :data:`DRIFT_RECORDS`, one after the other from 0."""
+    sch = settings.vibration_shock_schedule()
+    lengths = np.array([sch.rest_samples(), sch.samples(sch.vibration_time), sch.rest_samples(),
+                        sch.shock_samples(), sch.rest_samples()]) / sch.sample_rate
+    ends = np.cumsum(lengths)
+    return np.column_stack([ends - lengths, ends])
+
+
+def drift_covariance(settings: Jjf1537Experiment) -> np.ndarray:
+    """(5, 5) the covariance of the records' mean drift, output unit²: a rate random walk b(t) = S K W(t) (W a
+    standard Wiener process from the first record's start, K = ``gyro_rrw``) averaged over each record [a_i, b_i],
+
+        Cov(b̄_i, b̄_j) = S²K²/(T_i T_j) ∫∫ min(s, t) ds dt over [a_i, b_i] × [a_j, b_j],
+
+    in closed form from F(x, y) = ∫_0^x ∫_0^y min(s, t) ds dt = m²M/2 − m³/6 (m = min(x, y), M = max(x, y)) by
+    inclusion–exclusion. A record's own variance is S²K²(a + T/3) (a its start)."""
+    iv = drift_intervals(settings)
+
+    def F(x, y):
+        m, M = np.minimum(x, y), np.maximum(x, y)
+        return m * m * M / 2.0 - m**3 / 6.0
+
+    a, b = iv[:, 0][:, None], iv[:, 1][:, None]
+    c, d = iv[:, 0][None, :], iv[:, 1][None, :]
+    integral = F(b, d) - F(a, d) - F(b, c) + F(a, c)
+    T = iv[:, 1] - iv[:, 0]
+    return (settings.scale_factor * settings.gyro_rrw) ** 2 * integral / np.outer(T, T)
+
+
+def drift_offsets(settings: Jjf1537Experiment, seed: int, trial: int) -> np.ndarray:
+    """(5,) the mean drift of each record of :data:`DRIFT_RECORDS` in trial *trial* (output unit), drawn from
+    :func:`drift_covariance` with ``default_rng([seed, trial, DRIFT_STREAM])``; exactly 0 without a random walk.
+    The walk enters each record as this mean, held over the record: the items read record means, whose joint
+    distribution is then exactly a rate random walk's (its shape within a record is not simulated)."""
+    if settings.gyro_rrw == 0.0:
+        return np.zeros(len(DRIFT_RECORDS))
+    z = np.random.default_rng([int(seed), int(trial), DRIFT_STREAM]).standard_normal(len(DRIFT_RECORDS))
+    return np.linalg.cholesky(drift_covariance(settings)) @ z
+
+
 def vibration_shock_truth(settings: Jjf1537Experiment) -> dict:
     """The figures of 7.2.4–7.2.7 of the simulated sensor, in closed form (docs/dynamic.md).
 
@@ -131,7 +177,9 @@ def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
 
     The three changes of mean (output unit): σ√(1/N₁ + 1/N₂) with σ² = σ_w² + q²/12 (the white noise's and the
     quantiser's), N the two records' samples; the vibration record's mean is its sine fit's C, var(C) = σ²/N
-    over whole cycles.
+    over whole cycles; and, with a rate random walk, Var(b̄_j − b̄_i) of the two records' mean drift
+    (:func:`drift_covariance`) added: S²K²(T_i/3 + g + T_j/3) for records T_i and T_j apart by g, which the
+    records' own scatter (their Type A u) never shows.
 
     The amplitude nonlinearity γ = |S_k* − S̄|/S̄ (k* where |S_k − S̄| is largest), evaluated at the noise-free
     S_k: with d_j = S_j − S̄ and s* the sign of d_k*,
@@ -163,9 +211,16 @@ def vibration_shock_gum(settings: Jjf1537Experiment) -> dict:
         u_S = np.sqrt(2.0 * sigma**2 / (sch.repeats * sch.samples(sch.record_time)) / sch.amplitudes**2
                       + (S * settings.table_amplitude_error) ** 2)
         u_nonlinearity = float(np.sqrt(np.sum((grad * u_S) ** 2)))
+    C = drift_covariance(settings)  # the rate random walk's record means, DRIFT_RECORDS order
+
+    def drifted(i: int, j: int) -> float:  # Var(b̄_j − b̄_i)
+        return float(C[i, i] + C[j, j] - 2.0 * C[i, j])
+
     return {"amplitude_nonlinearity": u_nonlinearity,
-            "vibration_output_change": sigma * math.sqrt(1.0 / sch.samples(sch.vibration_time) + 1.0 / rest),
-            "bias_change_vibration": sigma * math.sqrt(2.0 / rest), "bias_change_shock": sigma * math.sqrt(2.0 / rest)}
+            "vibration_output_change": math.sqrt(sigma**2 * (1.0 / sch.samples(sch.vibration_time) + 1.0 / rest)
+                                                 + drifted(0, 1)),
+            "bias_change_vibration": math.sqrt(sigma**2 * 2.0 / rest + drifted(0, 2)),
+            "bias_change_shock": math.sqrt(sigma**2 * 2.0 / rest + drifted(2, 4))}
 
 
 def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chunk: int | None = None) -> dict:
@@ -189,17 +244,18 @@ def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chu
         amplitudes = np.repeat(float(A) * (1.0 + eps[:, k]), n)  # the table's amplitude error at A_k (7.2.4)
         linearity[:, k] = table_records(settings, seed, sch.frequency, amplitudes, phases[:, k * n:(k + 1) * n],
                                         N, streams, chunk).reshape(trials.size, n, N)
+    drift = np.stack([drift_offsets(settings, seed, t) for t in trials])  # (T, 5), DRIFT_RECORDS
     vibration = table_records(settings, seed, sch.frequency, sch.amplitude, phases[:, -1],
-                              sch.samples(sch.vibration_time), base + M * n, chunk)
+                              sch.samples(sch.vibration_time), base + M * n, chunk, bias_shift=drift[:, 1])
     rest = [table_records(settings, seed, sch.frequency, 0.0, np.zeros(trials.size), sch.rest_samples(),
-                          base + M * n + 1 + r, chunk, bias_shift=shift)
-            for r, shift in enumerate((0.0, settings.vibration_bias_shift))]
-    shock, after = shock_records(settings, seed, trials, base + M * n + 3, chunk)
+                          base + M * n + 1 + r, chunk, bias_shift=shift + drift[:, column])
+            for r, (shift, column) in enumerate(((0.0, 0), (settings.vibration_bias_shift, 2)))]
+    shock, after = shock_records(settings, seed, trials, base + M * n + 3, chunk, drift=drift[:, 3:])
     return {"linearity": linearity, "vibration": vibration, "rest": np.stack(rest + [after], axis=1), "shock": shock}
 
 
-def shock_records(settings: Jjf1537Experiment, seed: int, trials, after_streams, chunk: int | None = None
-                  ) -> tuple[np.ndarray, np.ndarray]:
+def shock_records(settings: Jjf1537Experiment, seed: int, trials, after_streams, chunk: int | None = None,
+                  drift: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The shock record and the record at rest after it, (T, N_s) and (T, N_r), output unit.
 
     The sensor is at rest (its filter state zero) when the pulse starts; its input is :func:`shock_input`
@@ -208,6 +264,8 @@ def shock_records(settings: Jjf1537Experiment, seed: int, trials, after_streams,
     shock continues the filter's state, so a ringing that has not died out by then is in it; its noise is the
     stream *after_streams* (T,), the shock record's :data:`SHOCK_STREAMS` + trial. Without a pulse (``shock_peak``
     or ``g_sensitivity`` 0) the record after the shock is the record at rest it always was, number for number.
+    *drift*: (T, 2) the bias's mean drift over the shock record and over the record after it (:func:`drift_offsets`;
+    default none).
     """
     sch = settings.vibration_shock_schedule()
     trials = np.asarray(trials, dtype=np.int64).ravel()
@@ -216,19 +274,22 @@ def shock_records(settings: Jjf1537Experiment, seed: int, trials, after_streams,
     states = np.zeros((trials.size, len(a) - 1))
     pulse, total = sch.pulse_samples(), sch.shock_samples()
     level = settings.bias + settings.vibration_bias_shift
+    drift = np.zeros((trials.size, 2)) if drift is None else np.asarray(drift, dtype=float)
     shock = np.empty((trials.size, total))
     after = np.empty((trials.size, sch.rest_samples()))
     own = SHOCK_STREAMS + trials
     for start, stop, first, streams, bias, out in (
-            (0, pulse, 0, own, level, shock[:, :pulse]),
-            (pulse, total, pulse, own, level + settings.shock_bias_shift, shock[:, pulse:]),
-            (total, x.size, 0, np.asarray(after_streams, dtype=np.int64), level + settings.shock_bias_shift, after)):
+            (0, pulse, 0, own, level + drift[:, 0], shock[:, :pulse]),
+            (pulse, total, pulse, own, level + settings.shock_bias_shift + drift[:, 0], shock[:, pulse:]),
+            (total, x.size, 0, np.asarray(after_streams, dtype=np.int64),
+             level + settings.shock_bias_shift + drift[:, 1], after)):
         _driven_records(settings, seed, b, a, states, x[start:stop], first, streams, bias, out, chunk)
     return shock, after
 
 
 def _driven_records(settings, seed, b, a, states, inputs, first, streams, bias, out, chunk) -> None:
-    """:func:`plansim.kernels.dynamics.input_records` over *out* (R, n) in chunks of *chunk* samples (None: one)."""
+    """:func:`plansim.kernels.dynamics.input_records` over *out* (R, n) in chunks of *chunk* samples (None: one);
+    *bias* the output's bias, one for all records or (R,) one per record."""
     n = out.shape[1]
     step = max(n, 1) if chunk is None else int(chunk)
     if step < 1:
@@ -237,10 +298,11 @@ def _driven_records(settings, seed, b, a, states, inputs, first, streams, bias, 
     key = root_key(seed)
     R = settings.gyro_range
     streams = np.ascontiguousarray(streams, dtype=np.int64).ravel()
+    biases = np.ascontiguousarray(np.broadcast_to(np.asarray(bias, dtype=float), streams.shape))
     for start in range(0, n, step):
         stop = min(start + step, n)
         input_records(b, a, states, np.ascontiguousarray(inputs[start:stop]), first + start, settings.scale_factor,
-                      bias, settings.noise_sigma, settings.quantisation, R * settings.scale_factor, key, streams,
+                      biases, settings.noise_sigma, settings.quantisation, R * settings.scale_factor, key, streams,
                       WHITE_BLOCK, white, out[:, start:stop], settings.even_nonlinearity / R,
                       settings.odd_nonlinearity / R**2)
 

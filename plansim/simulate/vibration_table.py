@@ -111,11 +111,13 @@ FIELDS = {
     "table_amplitude_error": ("dimensionless", "the table's rate amplitude error, relative standard deviation, drawn "
                                                "once per frequency (7.2.1) and amplitude (7.2.4) of each trial, "
                                                "e.g. '0.5 %'; 0: none (default)"),
+    "gyro_rrw": ("rate_random_walk", "7.2.5-7.2.7: the bias's rate random walk across the records at rest, vibration "
+                                     "and shock, e.g. '10 deg/h/sqrt(h)'; 0: none (default)"),
     "table_phase_error": ("angle", "the table's phase error against its reference signal, standard deviation, drawn "
                                    "once per frequency of each trial, e.g. '0.2 deg'; 0: none (default)"),
 }
 _CHOICES = {"model": SENSOR_MODELS, "grid": ("jjf1535", "jjf1537")}
-_MAY_BE_ZERO = ("gyro_arw", "quantisation", "table_amplitude_error", "table_phase_error")
+_MAY_BE_ZERO = ("gyro_arw", "quantisation", "table_amplitude_error", "table_phase_error", "gyro_rrw")
 _ANY_SIGN = ("bias", "odd_nonlinearity", "even_nonlinearity", "vibration_bias_shift", "shock_bias_shift", "shock_peak",
              "g_sensitivity")
 
@@ -165,6 +167,7 @@ class Jjf1537Experiment:
     g_sensitivity: float = 0.01 * DEG / STANDARD_GRAVITY  # rad/s per m/s²
     table_amplitude_error: float = 0.0            # relative standard deviation
     table_phase_error: float = 0.0                # rad, standard deviation
+    gyro_rrw: float = 0.0                         # rad/s/√s, the bias's rate random walk (7.2.5–7.2.7)
     overrides: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
@@ -272,14 +275,15 @@ def table_errors(settings: Jjf1537Experiment, seed: int, trial: int, count: int,
 
 
 def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, amplitude, phases, samples: int,
-                  streams, chunk: int | None = None, bias_shift: float = 0.0) -> np.ndarray:
-    """One record per stream (R,) of *samples* samples: the table at *frequency* (Hz) and rate *amplitude*
-    (rad/s, one for all or (R,) one per record; 0: at rest) with the phases *phases* (R,), through the sensor of
-    *settings* after its run-in (:func:`plansim.kernels.dynamics.sine_records`), the output bias B + *bias_shift*
-    (output unit, as B). (R, samples), output unit; *chunk*: samples per kernel call along time (None: the run-in
-    and the record in one call); the numbers do not depend on it."""
+                  streams, chunk: int | None = None, bias_shift=0.0) -> np.ndarray:
+    """One record per stream (R,) of *samples* samples: the table at *frequency* (Hz) and rate *amplitude* (rad/s, one
+    for all or (R,) one per record; 0: at rest) with the phases *phases* (R,), through the sensor of *settings*
+    after its run-in (:func:`plansim.kernels.dynamics.sine_records`), the output bias B + *bias_shift* (output
+    unit, as B; one for all or (R,) one per record). (R, samples), output unit; *chunk*: samples per kernel call
+    along time (None: the run-in and the record in one call); the numbers do not depend on it."""
     streams = np.ascontiguousarray(streams, dtype=np.int64).ravel()
     amplitudes = np.ascontiguousarray(np.broadcast_to(np.asarray(amplitude, dtype=float), streams.shape))
+    biases = settings.bias + np.ascontiguousarray(np.broadcast_to(np.asarray(bias_shift, dtype=float), streams.shape))
     if not np.any(amplitudes):  # at rest: the dynamics pass nothing
         b, a, lead = np.ones(1), np.ones(1), 0
     else:
@@ -299,7 +303,7 @@ def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, ampl
         stop = min(start + step, lead + samples)
         sine_records(b, a, states, amplitudes, 2.0 * math.pi * frequency,
                      np.ascontiguousarray(phases, dtype=float).ravel(), 1.0 / settings.sample_rate, start - lead,
-                     settings.scale_factor, settings.bias + bias_shift,
+                     settings.scale_factor, biases,
                      settings.noise_sigma, settings.quantisation, R * settings.scale_factor, key, streams,
                      WHITE_BLOCK, white, out[:, start:stop], even, odd)
     return out[:, lead:]
