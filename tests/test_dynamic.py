@@ -379,5 +379,7 @@ def test_the_analytic_response_rejects_bad_parameters_naming_them():
         second_order_phase([1.0], 10.0, -0.1)
     with pytest.raises(TypeError, match="damping: expected one number"):
         second_order_bandwidth(10.0, "0.7")
+    with pytest.raises(ValueError, match="level: expected 0 < level < 1"):
+        second_order_bandwidth(10.0, 0.7, 1.0)
     with pytest.raises(ValueError, match="frequencies: expected finite values ≥ 0 Hz"):
         second_order_response([-1.0], 10.0, 0.7)

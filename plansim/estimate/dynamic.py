@@ -48,7 +48,7 @@ import numpy as np
 import scipy.linalg
 
 from plansim.estimate.jjf1535 import checked_array
-from plansim.model.dynamics import one_number, positive_number
+from plansim.model.dynamics import one_number, positive_number, second_order_bandwidth
 
 #: |H| = 1/√2 = −3.0103 dB, the half-power point: the default level of :func:`bandwidth_3db`
 HALF_POWER = 1.0 / math.sqrt(2.0)
@@ -384,13 +384,6 @@ class CurveFitBandwidth:
     gradient: np.ndarray
 
 
-def _second_order_crossing(natural_frequency: float, damping: float, level: float) -> float:
-    """Where c/√((1 − x²)² + (2ζx)²) = level · c, x = f/f_n: x² = b + √(b² + 1/level² − 1), b = 1 − 2ζ², Hz
-    (one positive root, since 1/level² − 1 > 0; :func:`plansim.model.dynamics.second_order_bandwidth` at 1/√2)."""
-    b = 1.0 - 2.0 * damping * damping
-    return natural_frequency * math.sqrt(b + math.sqrt(b * b + 1.0 / (level * level) - 1.0))
-
-
 def bandwidth_curve_fit(frequencies, ratios, level: float = HALF_POWER) -> CurveFitBandwidth:
     """The −3 dB bandwidth of a second-order curve fitted to the amplitude response (JJF 1535-2015 7.2.15.2).
 
@@ -406,7 +399,7 @@ def bandwidth_curve_fit(frequencies, ratios, level: float = HALF_POWER) -> Curve
 
         f_3dB = f_n √(b + √(b² + 1/L² − 1)),        b = 1 − 2ζ²,  L = level,
 
-    which is :func:`plansim.model.dynamics.second_order_bandwidth` at L = 1/√2. Unlike the chord of
+    (:func:`plansim.model.dynamics.second_order_bandwidth` with the level). Unlike the chord of
     :func:`bandwidth_3db` it has no interpolation error for a one-resonance sensor; for a sensor that is not one
     (JJF 1537's two resonances), the curve's misfit becomes a bias, which the Monte Carlo of
     ``plansim run jjf1537`` shows. ``gradient`` is the fit's first-order sensitivity ∂f_3dB/∂K_i =
@@ -455,15 +448,15 @@ def bandwidth_curve_fit(frequencies, ratios, level: float = HALF_POWER) -> Curve
     if best is None:
         raise ValueError(f"ratios: the second-order curve fit did not converge on {K.tolist()}")
     c, fn, zeta = (float(v) for v in np.exp(best.x))
-    bandwidth = _second_order_crossing(fn, zeta, lev)
+    bandwidth = second_order_bandwidth(fn, zeta, lev)
     if not f[0] <= bandwidth <= f[-1]:
         raise ValueError(f"ratios: the fitted curve (f_n = {fn:.6g} Hz, ζ = {zeta:.6g}) falls to the level {lev:.6g} "
                          f"at {bandwidth:.6g} Hz, outside the measured band {f[0]:.6g} to {f[-1]:.6g} Hz")
     # ∇_θ f_3dB by central differences of the closed form (θ = ln c, ln f_n, ln ζ; c does not enter)
     h = 1e-6
     grad_theta = np.array([0.0, bandwidth,  # ∂f_3dB/∂ln f_n = f_3dB
-                           (_second_order_crossing(fn, zeta * math.exp(h), lev)
-                            - _second_order_crossing(fn, zeta * math.exp(-h), lev)) / (2.0 * h)])
+                           (second_order_bandwidth(fn, zeta * math.exp(h), lev)
+                            - second_order_bandwidth(fn, zeta * math.exp(-h), lev)) / (2.0 * h)])
     gradient = grad_theta @ np.linalg.pinv(best.jac)
     return CurveFitBandwidth(bandwidth=bandwidth, gain=c, natural_frequency=fn, damping=zeta,
                              residual_rms=float(np.sqrt(np.mean(best.fun**2))), gradient=gradient)

@@ -103,16 +103,23 @@ def second_order_phase(frequencies, natural_frequency: float, damping: float) ->
     return -np.arctan2(2.0 * zeta * x, 1.0 - x * x)
 
 
-def second_order_bandwidth(natural_frequency: float, damping: float) -> float:
-    """The frequency where |H| = 1/√2 (−3.01 dB): f_n·√(1 − 2ζ² + √((1 − 2ζ²)² + 1)), Hz.
+def second_order_bandwidth(natural_frequency: float, damping: float, level: float | None = None) -> float:
+    """The frequency where |H| falls to *level*: f_n·√(b + √(b² + 1/level² − 1)), b = 1 − 2ζ², Hz.
 
-    From |H|⁻² = (1 − x²)² + 4ζ²x² = 2, a quadratic in x² with one positive root. It is the only
-    frequency where |H| = 1/√2 on the way down (for ζ < 1/√2 the response first rises above 1 at the
-    resonance), so it is the bandwidth of JJF 1535-2015 3.7. ζ = 1/√2 gives f_n.
+    From |H|⁻² = (1 − x²)² + 4ζ²x² = 1/level², a quadratic in x² with one positive root (1/level² − 1 > 0). It is
+    the only frequency where |H| = level on the way down (for ζ < 1/√2 the response first rises above 1 at the
+    resonance), so at the default, 1/√2 (−3.01 dB, half power: 1/level² − 1 = 1 exactly), it is the bandwidth of
+    JJF 1535-2015 3.7: f_n √(1 − 2ζ² + √((1 − 2ζ²)² + 1)). ζ = 1/√2 gives f_n.
     """
     f_n = positive_number("natural_frequency", natural_frequency)
     b = 1.0 - 2.0 * positive_number("damping", damping) ** 2
-    return f_n * math.sqrt(b + math.sqrt(b * b + 1.0))
+    excess = 1.0
+    if level is not None:
+        lev = one_number("level", level)
+        if not 0 < lev < 1:
+            raise ValueError(f"level: expected 0 < level < 1 (None: 1/√2, half power), got {level!r}")
+        excess = 1.0 / (lev * lev) - 1.0
+    return f_n * math.sqrt(b + math.sqrt(b * b + excess))
 
 
 def two_resonance_response(frequencies, sense_frequency: float, sense_damping: float, drive_frequency: float,
