@@ -494,7 +494,7 @@ def test_the_drift_covariance_is_that_of_a_rate_random_walk_s_record_means():
             u = iv[i, 0] + (np.arange(400) + 0.5) / 400 * (iv[i, 1] - iv[i, 0])
             v = iv[j, 0] + (np.arange(400) + 0.5) / 400 * (iv[j, 1] - iv[j, 0])
             assert C[i, j] == pytest.approx(K2 * np.minimum.outer(u, v).mean(), rel=1e-4), (i, j)
-    np.testing.assert_array_equal(drift_offsets(dataclasses.replace(s, gyro_rrw=0.0), 3, 0), np.zeros(5))
+    np.testing.assert_array_equal(drift_offsets(dataclasses.replace(s, gyro_rrw=0.0), 3, [0]), np.zeros((1, 5)))
 
 
 def test_a_drifting_bias_reaches_the_records_means_exactly_without_noise():
@@ -502,8 +502,7 @@ def test_a_drifting_bias_reaches_the_records_means_exactly_without_noise():
     s = Jjf1537Experiment(**SHORT_ITEMS, gyro_arw=0.0, quantisation=0.0, gyro_rrw=1e-3, vibration_bias_shift=2e-4,
                           shock_peak=0.0)
     records = simulate_vibration_shock(s, 5, [0, 1])
-    for t in range(2):
-        drift = drift_offsets(s, 5, t)
+    for t, drift in enumerate(drift_offsets(s, 5, [0, 1])):
         expected = s.bias + np.array([drift[0], 2e-4 + drift[2], 2e-4 + drift[4]])
         np.testing.assert_allclose(records["rest"][t].mean(axis=-1), expected, rtol=0, atol=1e-15)
         np.testing.assert_allclose(records["rest"][t].std(axis=-1), 0.0, atol=1e-15)

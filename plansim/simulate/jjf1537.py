@@ -38,7 +38,7 @@ from plansim.simulate.vibration_table import (
     DEFAULT_SEED,
     DEFAULT_TRIALS,
     Jjf1537Experiment,
-    _check_run,
+    check_run,
     table_errors,
     table_phases,
     table_records,
@@ -193,7 +193,7 @@ def run_jjf1537(settings: Jjf1537Experiment | None = None, trials: int = DEFAULT
     called as progress(done, total) in trials.
     """
     settings = Jjf1537Experiment() if settings is None else settings
-    _check_run(seed, trials, chunk_trials)
+    check_run(seed, trials, chunk_trials)
     schedule = settings.schedule()
     dynamics = settings.dynamics()
     freqs = schedule.frequencies

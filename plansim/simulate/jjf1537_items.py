@@ -31,10 +31,12 @@ from plansim.schedule.jjf1537 import VibrationShockSchedule
 from plansim.simulate.vibration_table import (
     DEFAULT_SEED,
     DEFAULT_TRIALS,
+    DRIFT_STREAM,
+    ITEM_PHASE_STREAM,
     ITEM_TABLE_ERROR_STREAM,
     WHITE_BLOCK,
     Jjf1537Experiment,
-    _check_run,
+    check_run,
     discretise,
     table_errors,
     table_records,
@@ -61,13 +63,12 @@ COVERAGE_FACTOR = 2.0
 
 def item_phases(seed: int, trial: int, count: int) -> np.ndarray:
     """The table phases of trial *trial*'s 7.2.4 and 7.2.5 records, uniform on [−π, π), from
-    ``default_rng([seed, trial, 1])`` (a generator apart from :func:`table_phases`')."""
-    return np.random.default_rng([int(seed), int(trial), 1]).uniform(-math.pi, math.pi, count)
+    ``default_rng([seed, trial, ITEM_PHASE_STREAM])`` (:data:`plansim.simulate.vibration_table.ITEM_PHASE_STREAM`)."""
+    return np.random.default_rng([int(seed), int(trial), ITEM_PHASE_STREAM]).uniform(-math.pi, math.pi, count)
 
 
-#: the records the bias's rate random walk runs through, in time order, and its substream (apart from the others)
+#: the records the bias's rate random walk runs through, in time order
 DRIFT_RECORDS = ("before_vibration", "vibration", "after_vibration", "shock", "after_shock")
-DRIFT_STREAM = 4
 
 
 def drift_intervals(settings: Jjf1537Experiment) -> np.ndarray:
@@ -100,15 +101,19 @@ def drift_covariance(settings: Jjf1537Experiment) -> np.ndarray:
     return (settings.scale_factor * settings.gyro_rrw) ** 2 * integral / np.outer(T, T)
 
 
-def drift_offsets(settings: Jjf1537Experiment, seed: int, trial: int) -> np.ndarray:
-    """(5,) the mean drift of each record of :data:`DRIFT_RECORDS` in trial *trial* (output unit), drawn from
-    :func:`drift_covariance` with ``default_rng([seed, trial, DRIFT_STREAM])``; exactly 0 without a random walk.
-    The walk enters each record as this mean, held over the record: the items read record means, whose joint
-    distribution is then exactly a rate random walk's (its shape within a record is not simulated)."""
+def drift_offsets(settings: Jjf1537Experiment, seed: int, trials) -> np.ndarray:
+    """(T, 5) the mean drift of each record of :data:`DRIFT_RECORDS` in each of the trials *trials* (T,), output
+    unit, drawn from :func:`drift_covariance` (factored once) with ``default_rng([seed, trial, DRIFT_STREAM])``;
+    exactly 0 without a random walk. The walk enters each record as this mean, held over the record: the items
+    read record means, whose joint distribution is then exactly a rate random walk's (its shape within a record
+    is not simulated)."""
+    trials = np.asarray(trials, dtype=np.int64).ravel()
     if settings.gyro_rrw == 0.0:
-        return np.zeros(len(DRIFT_RECORDS))
-    z = np.random.default_rng([int(seed), int(trial), DRIFT_STREAM]).standard_normal(len(DRIFT_RECORDS))
-    return np.linalg.cholesky(drift_covariance(settings)) @ z
+        return np.zeros((trials.size, len(DRIFT_RECORDS)))
+    factor = np.linalg.cholesky(drift_covariance(settings))
+    z = np.stack([np.random.default_rng([int(seed), int(t), DRIFT_STREAM]).standard_normal(len(DRIFT_RECORDS))
+                  for t in trials])
+    return z @ factor.T
 
 
 def vibration_shock_truth(settings: Jjf1537Experiment) -> dict:
@@ -244,7 +249,7 @@ def simulate_vibration_shock(settings: Jjf1537Experiment, seed: int, trials, chu
         amplitudes = np.repeat(float(A) * (1.0 + eps[:, k]), n)  # the table's amplitude error at A_k (7.2.4)
         linearity[:, k] = table_records(settings, seed, sch.frequency, amplitudes, phases[:, k * n:(k + 1) * n],
                                         N, streams, chunk).reshape(trials.size, n, N)
-    drift = np.stack([drift_offsets(settings, seed, t) for t in trials])  # (T, 5), DRIFT_RECORDS
+    drift = drift_offsets(settings, seed, trials)  # (T, 5), DRIFT_RECORDS
     vibration = table_records(settings, seed, sch.frequency, sch.amplitude, phases[:, -1],
                               sch.samples(sch.vibration_time), base + M * n, chunk, bias_shift=drift[:, 1])
     rest = [table_records(settings, seed, sch.frequency, 0.0, np.zeros(trials.size), sch.rest_samples(),
@@ -405,7 +410,7 @@ def run_vibration_shock(settings: Jjf1537Experiment | None = None, trials: int =
     7.2.1–7.2.3): *trials* trials simulated (:func:`simulate_vibration_shock`) and reduced
     (:func:`reduce_vibration_shock`). The numbers depend on (settings, seed, trial) only, not on *chunk_trials*."""
     settings = Jjf1537Experiment() if settings is None else settings
-    _check_run(seed, trials, chunk_trials)
+    check_run(seed, trials, chunk_trials)
     estimates = {k: np.empty(trials) for k in ITEMS + SHOCK_FIGURES}
     type_a = {k: np.empty(trials) for k in ITEMS}
     for first in range(0, trials, chunk_trials):

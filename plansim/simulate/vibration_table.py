@@ -258,9 +258,12 @@ def table_phases(seed: int, trial: int, shape: tuple[int, int]) -> np.ndarray:
     return np.random.default_rng([int(seed), int(trial)]).uniform(-math.pi, math.pi, shape)
 
 
-#: the substreams of the table's errors, apart from :func:`table_phases`' ([seed, trial]) and
-#: :func:`plansim.simulate.jjf1537_items.item_phases`' ([seed, trial, 1])
-TABLE_ERROR_STREAM, ITEM_TABLE_ERROR_STREAM = 2, 3
+#: the random substreams of a trial, ``default_rng([seed, trial, stream])``, one table for every draw of the test so
+#: that no two share one: 7.2.4's and 7.2.5's table phases (:func:`plansim.simulate.jjf1537_items.item_phases`), the
+#: table's errors of 7.2.1 and of 7.2.4 (:func:`table_errors`), the bias's drift
+#: (:func:`plansim.simulate.jjf1537_items.drift_offsets`); 7.2.1's table phases use ``[seed, trial]``
+#: (:func:`table_phases`)
+ITEM_PHASE_STREAM, TABLE_ERROR_STREAM, ITEM_TABLE_ERROR_STREAM, DRIFT_STREAM = 1, 2, 3, 4
 
 
 def table_errors(settings: Jjf1537Experiment, seed: int, trial: int, count: int, stream: int = TABLE_ERROR_STREAM
@@ -309,7 +312,8 @@ def table_records(settings: Jjf1537Experiment, seed: int, frequency: float, ampl
     return out[:, lead:]
 
 
-def _check_run(seed, trials, chunk_trials) -> None:
+def check_run(seed, trials, chunk_trials) -> None:
+    """A run's seed (>= 0), trials and chunk_trials (>= 1), each a ValueError naming it."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
