@@ -271,8 +271,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         missing = [name for name in wanted if name not in header_names]
         if missing and not has_header:
             raise ValueError(f"{where}: column {missing[0]!r} is missing: the log has no header line (line "
-                             f"{header_line + 1} is its first sample, {width_text(header_names)}); name the columns by "
-                             "their position, 1 for the first, e.g. --columns 2,3,4,5,6,7 --time 1")
+                             f"{header_line + 1} is its first sample, {len(header_names)} columns); name the columns "
+                             "by their position, 1 for the first, e.g. --columns 2,3,4,5,6,7 --time 1")
         if missing:
             hint = "" if columns is not None else (" (name the six channel columns with --columns GX,GY,GZ,AX,AY,AZ)")
             raise ValueError(f"{where}: column {missing[0]!r} is missing; the header (line {header_line}) has "
@@ -393,11 +393,6 @@ def _next_row_alike(fh, line: str) -> bool:
         return True
     finally:
         fh.seek(position)
-
-
-def width_text(names: list[str]) -> str:
-    """'N columns', for messages."""
-    return f"{len(names)} column{'s' if len(names) != 1 else ''}"
 
 
 def _is_number(text: str, delimiter: str = ",") -> bool:
