@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from plansim.fit.model import nominal_parameters
 from plansim.kernels.layout import (
     CHANNELS,
     EFF_ACCEL_SECOND_ORDER,
@@ -59,30 +60,38 @@ class Signature:
     #: gyro's asymmetry seen in static poses through 15 °/h), which, as in the fit's identifiability, does not
     #: count; None: 1 for every component
     designed: np.ndarray | None = None
+    #: (S, 6, m) the columns of an ideal sensor (the nominal parameters, :func:`plansim.fit.model.nominal_parameters`)
+    #: in the same poses: what the schedule's geometry excites, the same for every recording of one schedule (the
+    #: excitation test reads it, so that a component reached only through the fitted cross-couplings does not
+    #: flip between recordings); None: :attr:`columns`
+    geometry: np.ndarray | None = None
 
     def groups(self) -> np.ndarray:
         return np.zeros(len(self.components), dtype=int) if self.unit_groups is None else np.asarray(self.unit_groups)
 
 
-def _kernel_columns(fit, argument: str, entries) -> tuple[np.ndarray, np.ndarray]:
-    """Columns (S, 6, m) of the kernel's effect array *argument* at each (row, column) of *entries*, and (m,) the
-    part of each that the designed excitation gives (:attr:`Signature.designed`)."""
-    model, theta, tilts = fit.model, fit.theta, fit.nuisance
-    draws = model.draws(theta, tilts)
+def _kernel_columns(fit, argument: str, entries) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Columns (S, 6, m) of the kernel's effect array *argument* at each (row, column) of *entries* at the fit's
+    solution, (m,) the part of each that the designed excitation gives (:attr:`Signature.designed`), and (S, 6, m)
+    the same columns for an ideal sensor in the same poses (:attr:`Signature.geometry`)."""
+    model, tilts = fit.model, fit.nuisance
     no_earth = np.zeros(3)
-    base = model.averaged(draws, effects=None)[0]
-    base_designed = model.averaged(draws, earth_enu=no_earth, effects=None)[0]
-    out, designed = [], []
-    for index in entries:
-        effects = model.effect_arguments()
-        effects[argument][index] += STEP
-        column = (model.averaged(draws, effects={argument: effects[argument]})[0] - base) / STEP
-        without = (model.averaged(draws, earth_enu=no_earth, effects={argument: effects[argument]})[0]
-                   - base_designed) / STEP
-        out.append(column)
-        norm = float(np.linalg.norm(column))
-        designed.append(float(np.linalg.norm(without)) / norm if norm > 0 else 0.0)
-    return np.stack(out, axis=-1), np.array(designed)
+    out, designed, geometry = [], [], []
+    for theta, columns in ((fit.theta, out), (nominal_parameters(), geometry)):
+        draws = model.draws(theta, tilts)
+        base = model.averaged(draws, effects=None)[0]
+        base_designed = model.averaged(draws, earth_enu=no_earth, effects=None)[0]
+        for index in entries:
+            effects = model.effect_arguments()
+            effects[argument][index] += STEP
+            column = (model.averaged(draws, effects={argument: effects[argument]})[0] - base) / STEP
+            columns.append(column)
+            if columns is out:
+                without = (model.averaged(draws, earth_enu=no_earth, effects={argument: effects[argument]})[0]
+                           - base_designed) / STEP
+                norm = float(np.linalg.norm(column))
+                designed.append(float(np.linalg.norm(without)) / norm if norm > 0 else 0.0)
+    return np.stack(out, axis=-1), np.array(designed), np.stack(geometry, axis=-1)
 
 
 def signatures(fit) -> tuple[Signature, ...]:
@@ -98,19 +107,21 @@ def signatures(fit) -> tuple[Signature, ...]:
     out = [
         Signature("gyro_scale_asymmetry", tuple(AXES), "1", asymmetry[0], "gyro_asymmetry",
                   "the scale factor differs between positive and negative rates: (K+ − K−)/K per gyro",
-                  designed=asymmetry[1]),
+                  designed=asymmetry[1], geometry=asymmetry[2]),
         Signature("gyro_scale_nonlinearity", tuple(f"{a}2" for a in AXES) + tuple(f"{a}3" for a in AXES),
                   "1/(rad/s) (x2 y2 z2), 1/(rad/s)^2 (x3 y3 z3)",
                   np.concatenate([quadratic[0], cubic[0]], axis=-1),
                   "gyro_nonlinearity_quadratic, gyro_nonlinearity_cubic",
                   "the gyro output has terms in ω² and ω³ of its own rate", (0, 0, 0, 1, 1, 1),
-                  designed=np.concatenate([quadratic[1], cubic[1]])),
+                  designed=np.concatenate([quadratic[1], cubic[1]]),
+                  geometry=np.concatenate([quadratic[2], cubic[2]], axis=-1)),
         Signature("gyro_g2_sensitivity", tuple(f"{i}{j}" for i in AXES for j in AXES), "rad/s/(m/s^2)^2",
                   g2[0], "gyro_g2_sensitivity",
                   "the gyro output has terms in products of the specific-force components (g²-sensitivity)",
-                  designed=g2[1]),
+                  designed=g2[1], geometry=g2[2]),
         Signature("accel_quadratic", tuple(AXES), "1/(m/s^2)", k2[0], "accel_second_order",
-                  "the accelerometer output has a term K2·f² in its own specific force", designed=k2[1]),
+                  "the accelerometer output has a term K2·f² in its own specific force", designed=k2[1],
+                  geometry=k2[2]),
     ]
     times = np.asarray(fit.segment_times, dtype=float)
     drift = np.zeros((S, 6, 6))
@@ -121,7 +132,9 @@ def signatures(fit) -> tuple[Signature, ...]:
     lever = _kernel_columns(fit, "lever", [(i, k) for i in range(3) for k in range(3)])
     out.append(Signature("lever_arm", tuple(f"{i}{k}" for i in AXES for k in AXES), "m", lever[0], "accel_lever_arm",
                          "accelerometer i sits off the turning axis: the centripetal acceleration ω×(ω×r)",
-                         designed=lever[1]))
+                         designed=lever[1], geometry=lever[2]))
     for signature in out:  # rows the fit does not fit (a hand turn's accelerometers) carry no signature
         signature.columns[~fit.fitted_rows] = 0.0
+        if signature.geometry is not None:
+            signature.geometry[~fit.fitted_rows] = 0.0
     return tuple(out)

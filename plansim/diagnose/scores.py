@@ -11,7 +11,10 @@ fraction ‖P⊥ W x‖/‖W x‖ is taken on the singular directions of P⊥·W
 p-value and is never selected. Its ``aliased_with`` lists the parameters that would absorb it (the
 regression of W·x on X, mapped to the 39 parameters through the fit's identifiability basis, each in units
 of its standard uncertainty), and two candidates whose surviving subspaces coincide (every principal
-angle's cosine above 1 − :data:`ALIAS_TOLERANCE`) are aliased with each other.
+angle's cosine above 1 − :data:`ALIAS_TOLERANCE`) are aliased with each other. Before that, a component whose
+column is below :data:`EXCITATION_TOLERANCE` of the largest in its unit group *for an ideal sensor in the same
+poses* (:attr:`plansim.diagnose.catalogue.Signature.geometry`) is not excited: a property of the schedule, not of
+one recording's noise or fitted cross-couplings.
 
 **The candidates' test.** Every usable component of a candidate is a one-parameter alternative: its column in
 one channel's segment means (a gyro's asymmetry, a channel's drift, an accelerometer's K2 …). Its statistic is
@@ -78,9 +81,9 @@ from plansim.model.parameters import PARAMETER_NAMES
 #: a candidate direction is aliased with the base model (or another candidate) when less than this fraction of
 #: its whitened norm survives the projection (or its principal angle's cosine exceeds 1 − this)
 ALIAS_TOLERANCE = 1e-3
-#: a component is not excited by the schedule when its whitened column is below this fraction of the candidate's
-#: largest (a second-order path only, such as a lever arm across an accelerometer's own axis through Ka's
-#: cross-couplings)
+#: a component is not excited by the schedule when its column for an ideal sensor is below this fraction of the
+#: largest in its unit group (a second-order path only, such as a lever arm across an accelerometer's own axis
+#: through Ka's cross-couplings)
 EXCITATION_TOLERANCE = 1e-2
 #: a component whose column the designed excitation (table rates, gravity) gives less than this part of, the rest
 #: being the Earth rate's, counts as not excited: the fit's rule for the 39 parameters (docs/fitting.md,
@@ -306,12 +309,15 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         Z = g.project(Wx)
         norms = np.linalg.norm(Wx, axis=0)
         surviving = np.linalg.norm(Z, axis=0)
-        # a component the schedule hardly excites (its whitened column a tiny fraction of the candidate's largest,
-        # e.g. an accelerometer's lever arm across its own axis, seen only through Ka's cross-couplings) counts
-        # as not excited; one whose column the base model spans counts as aliased
+        # a component the schedule hardly excites (its column a tiny fraction of the largest in its unit group, for
+        # an ideal sensor in the same poses: e.g. an accelerometer's lever arm across its own axis, seen only
+        # through Ka's fitted cross-couplings) counts as not excited — decided on the schedule's geometry, so the
+        # same for every recording of one schedule; one whose column the base model spans counts as aliased
         groups = sig.groups()
-        largest = np.array([norms[groups == grp].max() for grp in groups])
-        excited = norms > EXCITATION_TOLERANCE * np.maximum(largest, 1e-300)
+        ideal = sig.columns if sig.geometry is None else sig.geometry
+        geometry = np.linalg.norm(ideal.reshape(-1, ideal.shape[-1])[g.rows], axis=0)
+        largest = np.array([geometry[groups == grp].max() for grp in groups])
+        excited = geometry > EXCITATION_TOLERANCE * np.maximum(largest, 1e-300)
         if sig.designed is not None:  # reached by the Earth rate alone: true, and of no use (docs/fitting.md)
             excited &= sig.designed > EARTH_ONLY_TOLERANCE
         usable = excited & (surviving > ALIAS_TOLERANCE * np.maximum(norms, 1e-300))
