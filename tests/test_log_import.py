@@ -357,6 +357,31 @@ def test_flawed_logs_import_with_named_warnings(tmp_path):
     assert {w.name for w in result.warnings} == {"jitter", "sample_rate_mismatch"}
 
 
+def test_a_time_column_in_another_unit_and_a_dead_channel_are_named(tmp_path, capsys):
+    """Two mistakes a log from another lab makes (found by feeding plansim such logs): a time column in ms read as
+    seconds (100 Hz reads as 0.1 Hz, every pose 100 times too long) is a warning that names the unit that gives a
+    usual rate; a channel that reads one value in every row (dead, disconnected, a wrong column) is a warning at
+    import, and plansim fit refuses it, naming it, instead of weighing its exact means as exact (a singular fit,
+    which failed or not from one run to the next with the BLAS's threads)."""
+    t, x = synthetic_log(seconds_rest=6.0)
+    log = tmp_path / "log.csv"
+    write_synthetic(log, t * 1000.0, x)
+    result = import_log(log, time_column="time")
+    warning = {w.name: w.message for w in result.warnings}["unusual_sample_rate"]
+    assert "0.1 Hz" in warning and "--time-unit ms (100 Hz)" in warning
+    assert "unusual_sample_rate" not in {w.name for w in import_log(log, time_column="time", time_unit="ms").warnings}
+    dead = x.copy()
+    dead[:, 1] = 0.0
+    write_synthetic(log, t, dead)
+    result = import_log(log, time_column="time")
+    assert "channel gy (gy) reads 0 in every one of the" in {w.name: w.message for w in result.warnings}[
+        "constant_channel"]
+    path = tmp_path / "dead.nc"
+    write_recording(result.recording, path)
+    assert main(["fit", str(path)]) == 2
+    assert "channel gy reads 0 rad/s in every one of its" in capsys.readouterr().err
+
+
 def test_unit_and_scale_parsing():
     assert parse_units(None) == ("rad/s",) * 3 + ("m/s^2",) * 3
     assert parse_units("deg/s,g") == ("deg/s",) * 3 + ("g",) * 3

@@ -42,6 +42,7 @@ from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import find_transitions, fit_moves
 from plansim.fit.noise import NoiseEstimate, estimate_noise, quantisation_harmonics
 from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
+from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.schedule.segments import Schedule
 from plansim.uncertainty.metrology.propagation import combine
@@ -599,6 +600,24 @@ def recording_noise(recording, stated_white=None, stated_step=None, noisier: boo
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)
+def _refuse_constant_channels(recording) -> None:
+    """A ``ValueError`` naming each channel that reads one value in every sample of the recording.
+
+    A sensor's output changes between poses at rest (gravity, the Earth rate, its noise) and in every turn: a
+    channel that never does is dead, disconnected or a wrong column, and its zero scatter would weigh its segment
+    means as exact (a singular fit)."""
+    samples = np.asarray(recording.samples, dtype=float)
+    if samples.shape[0] < 2:
+        return
+    constant = [c for c in range(6) if np.ptp(samples[:, c]) == 0]
+    if constant:
+        raise ValueError("recording: " + "; ".join(
+            f"channel {CHANNELS[c]} reads {samples[0, c]:.6g} {'rad/s' if c < 3 else 'm/s^2'} in every one of its "
+            f"{samples.shape[0]} samples" for c in constant)
+            + ": a dead or disconnected sensor, or a wrong column (plansim import --columns); a channel that never "
+              "changes cannot be fitted")
+
+
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
@@ -662,6 +681,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     if not used:
         raise ValueError("recording: no segment can be fitted; "
                          f"{len(unused)} segment(s) not used: " + "; ".join(f"{k}: {r}" for k, r in unused.items()))
+    _refuse_constant_channels(recording)
     used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
     if all(s.orientation != "known" for s in used_schedule.segments):
         # no segment on a table: its grade has nothing to act on (the hand placement is fitted instead)

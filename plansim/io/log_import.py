@@ -62,7 +62,11 @@ _BLOCK_ROWS = 65536
 DEFAULT_TEMPERATURE = 20.0
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
-                 "unclosed_motion", "held_pose")
+                 "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel")
+#: a sample rate from the time column outside this range (Hz) is a warning: an IMU log is sampled at 1 Hz to 100 kHz,
+#: and a rate outside it is most often a time column in another unit than --time-unit says (ms read as s: 1000 Hz
+#: reads as 1 Hz)
+PLAUSIBLE_SAMPLE_RATE = (1.0, 1e5)
 
 
 @dataclass(frozen=True)
@@ -528,6 +532,25 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
             "samples" and abs(timing.estimated_rate / sample_rate - 1.0) > RATE_MISMATCH_WARNING:
         warnings.append(LogWarning("sample_rate_mismatch", f"--sample-rate {sample_rate:g} Hz but the time column "
                                                            f"gives {timing.estimated_rate:.6g} Hz"))
+
+    if time_s is not None and time_unit != "samples" and not \
+            PLAUSIBLE_SAMPLE_RATE[0] <= timing.sample_rate <= PLAUSIBLE_SAMPLE_RATE[1]:
+        per_unit = {u: timing.sample_rate * TIME_UNITS[time_unit] / f for u, f in TIME_UNITS.items()
+                    if u not in (time_unit, "samples")}
+        usual = [f"{u} ({rate:.6g} Hz)" for u, rate in per_unit.items()
+                 if PLAUSIBLE_SAMPLE_RATE[0] <= rate <= PLAUSIBLE_SAMPLE_RATE[1]]
+        warnings.append(LogWarning("unusual_sample_rate", f"column {table.time_column!r} read in {time_unit} gives "
+                                                          f"{timing.sample_rate:.6g} Hz, outside the "
+                                                          f"{PLAUSIBLE_SAMPLE_RATE[0]:g}-{PLAUSIBLE_SAMPLE_RATE[1]:g} "
+                                                          "Hz of IMU logs: is the time in another unit? "
+                                                          + (f"(--time-unit {', '.join(usual)})" if usual else "")))
+    for c in range(6):
+        if n > 1 and np.ptp(table.channels[:, c]) == 0:
+            warnings.append(LogWarning("constant_channel", f"channel {CHANNELS[c]} ({table.names[c]}) reads "
+                                                           f"{table.channels[0, c]:.6g} in every one of the {n} "
+                                                           "rows: a dead or disconnected sensor, or a wrong "
+                                                           "column? plansim fit refuses a channel that never "
+                                                           "changes"))
 
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
                                gap_starts=timing.gap_starts)
