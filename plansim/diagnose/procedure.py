@@ -336,7 +336,10 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     # the samples' noise depends on the samples alone: estimated once, shared by every refit below
     # (every static segment at the model's noise: one that scatters more is the within tests' finding, and its mean
     # is tested as any other's — estimate_noise's noisier=False)
-    options["noise"] = recording_noise(recording, stated_white, stated_step, noisier=False)
+    # and each static mean's quantisation error over a level unknown within its step (conditional=False: the tests
+    # need a null that holds wherever the level sits; conditioned on the level counts, whose σ the data barely
+    # tell, the K2 and g² scores of jjf2003 nulls ran at 1.3-1.7 times their null variance: docs/closing-the-loop.md)
+    options["noise"] = recording_noise(recording, stated_white, stated_step, noisier=False, conditional=False)
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the
     # null hypothesis — the base model — as a score test estimates its nuisance parameters; every fit below then
     # takes it as given. Estimated with the candidates in the model instead, it came out too small wherever a

@@ -589,14 +589,15 @@ def _noise_segments(schedule) -> list[int]:
     return [k for k, s in enumerate(schedule.segments) if s.test != "move"]
 
 
-def recording_noise(recording, stated_white=None, stated_step=None, noisier: bool = True) -> NoiseEstimate:
+def recording_noise(recording, stated_white=None, stated_step=None, noisier: bool = True,
+                    conditional: bool = True) -> NoiseEstimate:
     """The noise of a recording's samples (:func:`plansim.fit.noise.estimate_noise` over every segment that is
-    not a move, *noisier* passed on), which :func:`fit_recording` takes as its ``noise`` so that refits of the same
-    samples share it."""
+    not a move, *noisier* and *conditional* passed on), which :func:`fit_recording` takes as its ``noise`` so that
+    refits of the same samples share it."""
     schedule = recording.schedule
     segments = _noise_segments(schedule)
     return estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in segments],
-                          [schedule.segments[k] for k in segments], stated_white, stated_step, noisier)
+                          [schedule.segments[k] for k in segments], stated_white, stated_step, noisier, conditional)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)

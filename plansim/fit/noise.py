@@ -641,7 +641,7 @@ def _noisier_segments(within: np.ndarray, within_dof: np.ndarray, static: list[i
 
 
 def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=None, stated_step=None,
-                   noisier: bool = True) -> NoiseEstimate:
+                   noisier: bool = True, conditional: bool = True) -> NoiseEstimate:
     """The noise of each channel and the variance of each segment mean, from the samples alone.
 
     Parameters
@@ -667,6 +667,14 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
         out of the Allan fit (:func:`_noisier_segments`; default). ``plansim diagnose`` turns it off: there such a
         segment is a finding of the within-segment tests, and its mean is tested as any other's (a segment a turn
         spilled into is off, not merely noisy; weighed by its own scatter it left the rest to catalogue names).
+    conditional : bool
+        A static segment's quantisation error given where its samples fall
+        (:func:`quantisation_error_given_levels`; default), or, with False, over a level unknown within a step:
+        :func:`quantisation_error_variance` at the noise σ its scatter shows less q²/12 (Sheppard), q²/12 for a
+        segment that never leaves its code (the resolution of a digital reading, JCGM 100 F.2.2.1). ``plansim
+        diagnose`` takes the latter: its tests need a null that holds whatever the level's place in its step,
+        and the conditional error leans on a σ the level counts barely identify (docs/fitting.md) — on 40 null
+        recordings of jjf2003 it left the K2 and g² efficient scores' mean square at 1.6–1.7 and 1.3 instead of 1.
 
     Returns
     -------
@@ -783,7 +791,7 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             own_quantisation = 0.0
             if ch.quantisation_step > 0:
-                if s.is_rotating or sigma_before[c] is None:
+                if s.is_rotating or sigma_before[c] is None or not conditional:
                     # turning: the signal itself sweeps the levels; its scatter less q²/12 (Sheppard)
                     dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
                     quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
