@@ -113,6 +113,25 @@ def test_time_analysis_finds_gaps_jitter_and_repeats():
         analyse_time(None, 1000)
 
 
+def test_a_clock_coarser_than_the_sampling_and_a_misstamped_sample():
+    """A 100 Hz log whose clock is rounded to 20 ms (steps of 0 and 20 ms) or to whole seconds: the rate is the
+    samples over the span, not 1 / the median step (50 Hz, 1 Hz), and its 20 ms or 1 s steps are no gaps; one sample
+    stamped with its predecessor's time (a step of 0, then one of 20 ms) is no gap either. A real gap still is."""
+    t = np.arange(38000) / 100.0
+    rounded = np.round(t / 0.02) * 0.02
+    report = analyse_time(rounded, t.size)
+    assert report.sample_rate == pytest.approx(100.0, rel=1e-3) and report.gaps == () and report.repeated > 18000
+    seconds = np.floor(t)
+    report = analyse_time(seconds, t.size)
+    assert report.sample_rate == pytest.approx(100.0, rel=5e-3) and report.gaps == ()
+    glitch = t[:1000].copy()
+    glitch[300] = glitch[299]
+    report = analyse_time(glitch, 1000)
+    assert report.gaps == () and report.missing_samples == 0 and report.repeated == 1
+    glitch[600:] += 0.5
+    assert [k for k, _ in analyse_time(glitch, 1000).gaps] == [600]
+
+
 def test_a_turn_between_two_rests_is_a_rotation_with_its_steady_rate():
     rng = np.random.default_rng(7)
     rest = static_noise("white", 5.0, rng)

@@ -117,6 +117,9 @@ VERTICAL_AXIS_TOLERANCE = math.radians(20.0)
 APPROXIMATE_TILT = math.radians(15.0)
 #: a time step longer than this many sample periods is a gap (at least one sample missing)
 GAP_FACTOR = 1.5
+#: a time column whose span holds more than this many times the samples its median step implies comes from a clock
+#: coarser than the sampling (:func:`analyse_time`)
+COARSE_CLOCK_FACTOR = 1.05
 #: a saturated stretch is entered or left by a step of more than this many σ
 SATURATION_STEP = 5.0
 #: robust standard deviation from the median absolute deviation of a normal distribution
@@ -134,7 +137,8 @@ class TimeReport:
     sample_rate : float
         The nominal sample rate used, Hz (given, or estimated).
     estimated_rate : float
-        1 / median time step, Hz (NaN without a time column).
+        1 / median time step, Hz, or the samples over the span where the clock is coarser than the sampling
+        (more samples than clock steps); NaN without a time column.
     jitter_rms, jitter_max : float
         RMS and largest deviation of a time step from 1 / sample_rate, gaps excluded, s.
     gaps : tuple of (int, float)
@@ -169,7 +173,9 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     samples : int
         N, the number of samples.
     sample_rate : float or None
-        The nominal rate, Hz; ``None``: 1 / the median time step.
+        The nominal rate, Hz; ``None``: 1 / the median time step, or (N − 1)/span where the span holds more than
+        :data:`COARSE_CLOCK_FACTOR` times the samples that step implies (a clock coarser than the sampling: its
+        steps of 0 are reported as ``repeated``, and a gap is then a step of more than ``GAP_FACTOR`` clock steps).
     """
     if time is None:
         if sample_rate is None:
@@ -182,10 +188,24 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     positive = dt[dt > 0]
     if positive.size == 0:
         raise ValueError("time: the time never advances; give the time column in seconds or the sample rate")
-    estimated = 1.0 / float(np.median(positive))
+    tick = float(np.median(positive))  # the clock's usual advance
+    estimated = 1.0 / tick
+    # a clock coarser than the sampling (times rounded to 20 ms at 100 Hz, whole seconds) advances less often than
+    # the samples come: more samples than ticks over the log's span, which gaps alone never give (they add time,
+    # not samples). The rate is then the samples over the span, and a gap is a step of more than GAP_FACTOR ticks
+    duration = float(time[-1] - time[0])
+    span_rate = (samples - 1) / duration if duration > 0 else math.nan
+    if span_rate > COARSE_CLOCK_FACTOR * estimated:
+        estimated = span_rate
     nominal = estimated if sample_rate is None else float(sample_rate)
     period = 1.0 / nominal
-    gap = dt > GAP_FACTOR * period
+    step = max(period, tick)
+    gap = dt > GAP_FACTOR * step
+    # one sample stamped with its predecessor's time (a step of 0, then one of two periods) is a glitch of the
+    # clock, not a gap: nothing is missing
+    glitch = np.zeros_like(gap)
+    glitch[1:] = (dt[:-1] == 0) & (dt[:-1] + dt[1:] <= (1.0 + GAP_FACTOR) * step)
+    gap &= ~glitch
     gaps = tuple((int(k) + 1, float(dt[k])) for k in np.flatnonzero(gap))
     missing = int(sum(max(round(d * nominal) - 1, 1) for _, d in gaps))
     regular = dt[~gap] - period
