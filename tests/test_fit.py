@@ -858,3 +858,19 @@ def test_the_quantisers_covariance_is_the_full_harmonic_sum():
     assert b.shape[0] == 2000
     np.testing.assert_allclose(quantiser_covariance(b, difference, var_diff, q), direct, rtol=0,
                                atol=1e-12 * np.abs(direct).max())
+
+
+def test_an_exact_fit_marks_no_residual():
+    """Two poses by hand leave the fit no degrees of freedom: it passes through every row, and its residuals of
+    1e-13–1e-10 (rounding) with a u of the same order were marked significant. A u that is a rounding error of the
+    mean's own is no u: nothing is marked."""
+    from plansim.report.fit import fit_report
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    site = Site(math.radians(40.0), 50.0)
+    s = hand_session(consumer_unit(3), spread_poses(2, seed=4), rest=10.0, seed=4, gravity=site.gravity,
+                     gyro_noise=8.7e-4, accel_noise=9.8e-3)
+    fit = fit_recording(Recording(s.samples, s.schedule, {"source": "simulated"}), site, moves=False)
+    assert fit.chi2_dof == 0
+    rows = fit_report(fit).split("marked *\n", 1)[1].splitlines()[1:3]
+    assert len(rows) == 2 and not any("*" in row for row in rows), rows

@@ -17,6 +17,9 @@ from plansim.units import KINDS
 
 #: display unit of a segment mean (and of a residual, a bias instability) per sensor kind, and its SI factor
 OUTPUT_UNITS = {"gyro": ("deg/h", KINDS["angular_rate"]["deg/h"]), "accel": ("ug", KINDS["acceleration"]["ug"])}
+#: a residual's u below this fraction of its segment mean's own u is a rounding error (the fit passes through the
+#: row): the residual is not marked
+EXACT_ROW = 1e-6
 WHITE_UNITS = {"gyro": ("deg/sqrt(h)", KINDS["angle_random_walk"]["deg/sqrt(h)"]),
                "accel": ("ug/sqrt(Hz)", KINDS["velocity_random_walk"]["ug/sqrt(Hz)"])}
 
@@ -149,11 +152,16 @@ def fit_report(result, residuals: bool = True) -> str:
         lines += ["", f"Residuals = observed − fitted segment mean (gyros {gu}, accelerometers {au}); "
                   "|r|/u > 3 marked *",
                   f"{'seg':>4s} {'label':34s} " + " ".join(f"{c:>10s}" for c in CHANNELS)]
+        # a residual whose u is a rounding error of the mean's own (the fit leaves that row no degrees of freedom:
+        # it passes through it) is not marked, however small the residual
+        own = np.sqrt(np.maximum(np.diag(np.asarray(result.covariance, dtype=float)), 0.0)).reshape(
+            result.residuals.shape) if result.covariance is not None else np.zeros(result.residuals.shape)
         for s, k in enumerate(result.used):
             cells = []
             for c in range(6):
                 factor = gf if c < 3 else af
                 r, u = result.residuals[s, c], result.residual_sd[s, c]
+                u = u if u > EXACT_ROW * own[s, c] else 0.0
                 if not result.fitted_rows[s, c]:
                     cells.append(f"{'-':>9s} ")  # not fitted (a hand turn's accelerometer)
                     continue
