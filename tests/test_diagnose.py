@@ -361,15 +361,15 @@ def test_a_scale_factor_that_changes_after_its_rate_test_is_unexplained_and_name
     assert "gyro_scale_asymmetry[y] was significant but is not named" in diagnose_report(d)
 
 
-def test_a_slow_effect_the_between_segment_noise_takes_up_is_reported_as_slow_scatter():
+def test_a_slow_effect_the_between_segment_noise_takes_up_is_reported_as_excess_scatter():
     """Eight poses by hand, a warm-up of 0.3 °/s decaying over a quarter of the session on gx. The base fit takes it
     up as between-segment noise (a slow effect and slow noise look alike without a repeated pose), so no test can
-    flag it; the diagnosis says so — slow scatter in gx at ≥ SLOW_SCATTER_RATIO times what the samples predict,
+    flag it; the diagnosis says so — excess scatter in gx at ≥ EXCESS_SCATTER_RATIO times what the samples predict,
     with the advice to repeat a pose — instead of "nothing unexplained". Without the warm-up, nothing is said (nor on
     40 null recordings of jjf2003 and of linear_gaussian, whose largest ratio was 0.91 and 0.97: docs)."""
     import math
 
-    from plansim.diagnose.procedure import SLOW_SCATTER_RATIO
+    from plansim.diagnose.procedure import EXCESS_SCATTER_RATIO
     from plansim.fit.site import Site
     from plansim.io.recording import Recording
     from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
@@ -379,16 +379,16 @@ def test_a_slow_effect_the_between_segment_noise_takes_up_is_reported_as_slow_sc
     s = hand_session(consumer_unit(3), spread_poses(8, seed=4), rest=30.0, seed=4, gravity=site.gravity,
                      earth_rate=earth, gyro_noise=8.7e-4, accel_noise=9.8e-3)
     null = diagnose(Recording(s.samples, s.schedule, {"source": "simulated"}), site, null_draws=200)
-    assert null.unexplained["slow_scatter"] == []
+    assert null.unexplained["excess_scatter"] == []
     samples = s.samples.copy()
     fraction = np.arange(samples.shape[0]) / samples.shape[0]
     samples[:, 0] += np.radians(0.3) * np.exp(-fraction / 0.25)
     d = diagnose(Recording(samples, s.schedule, {"source": "simulated"}), site, null_draws=200)
-    assert [item["channel"] for item in d.unexplained["slow_scatter"]] == ["gx"]
-    item = d.unexplained["slow_scatter"][0]
-    assert item["ratio"] >= SLOW_SCATTER_RATIO and item["unit"] == "rad/s"
+    assert [item["channel"] for item in d.unexplained["excess_scatter"]] == ["gx"]
+    item = d.unexplained["excess_scatter"][0]
+    assert item["ratio"] >= EXCESS_SCATTER_RATIO and item["unit"] == "rad/s"
     report = diagnose_report(d)
-    assert "SLOW SCATTER in gx" in report and "repeat a pose" in report
+    assert "EXCESS SCATTER in gx" in report and "repeat a pose" in report
     assert "Nothing unexplained remains" not in report
 
 
@@ -410,7 +410,7 @@ def test_json_keys_and_the_command(tmp_path, capsys):
     assert {"residual_rms", "chi2_dof", "holdout_rms"} <= set(out["before"])
     assert {"name", "unit", "before", "after", "u_after"} <= set(out["parameters"][0])
     assert {"alpha", "draws", "segments_tested", "smallest_adjusted_p_value", "flagged"} <= set(out["within_segment"])
-    assert "within_segments" in out["unexplained"] and out["unexplained"]["slow_scatter"] == []
+    assert "within_segments" in out["unexplained"] and out["unexplained"]["excess_scatter"] == []
     assert out["selected"] == ["gyro_scale_asymmetry"]
     figure = tmp_path / "diag.png"
     assert main(["diagnose", str(path), "--scenario", "linear_gaussian", "--null-draws", "200",

@@ -139,12 +139,12 @@ def holdout(fit) -> dict:
     return {"rms": rms, "skipped": skipped, "scheme": "leave one segment out (GLS cross-validation residuals)"}
 
 
-#: the between-segment noise a fit takes up is reported as slow scatter (``unexplained["slow_scatter"]``) where its
+#: the between-segment noise a fit takes up is reported as excess scatter (``unexplained["excess_scatter"]``) where its
 #: s.d. is at least this many times the segment means' s.d. that the samples predict: information, not a test
-SLOW_SCATTER_RATIO = 2.0
+EXCESS_SCATTER_RATIO = 2.0
 
 
-def _slow_scatter(fit) -> list[dict]:
+def _excess_scatter(fit) -> list[dict]:
     """The channels whose segment means scatter far beyond what their samples predict, taken up by the base fit as
     between-segment noise (:func:`plansim.fit.joint.between_segment_noise`).
 
@@ -152,8 +152,8 @@ def _slow_scatter(fit) -> list[dict]:
     from the same residuals: slow noise the segments are too short to show (a bias instability over minutes) and a
     slow effect (a bias that follows the temperature, a warm-up) both end up in it, and the tests can no longer see
     either. A recording that repeats no setting at distant times cannot tell the two apart, so this is reported as
-    what it is — the size of the slow scatter against the samples' prediction (s.d. ratio ≥
-    :data:`SLOW_SCATTER_RATIO`) — not as a test or a named effect."""
+    what it is — the size of the excess scatter against the samples' prediction (s.d. ratio ≥
+    :data:`EXCESS_SCATTER_RATIO`) — not as a test or a named effect."""
     slow = fit.between_noise
     if slow is None or fit.covariance_predicted is None:
         return []
@@ -163,7 +163,7 @@ def _slow_scatter(fit) -> list[dict]:
         rows = np.asarray(fit.fitted_rows, dtype=bool)[:, c]
         expected = math.sqrt(float(np.median(predicted[rows, c])))
         sd = math.sqrt(float(slow.variance[c]))
-        if expected > 0 and sd >= SLOW_SCATTER_RATIO * expected:
+        if expected > 0 and sd >= EXCESS_SCATTER_RATIO * expected:
             out.append({"channel": CHANNELS[c], "between_sd": sd, "predicted_sd": expected, "ratio": sd / expected,
                         "correlation_time_s": float(slow.correlation_time[c]),
                         "unit": UNITS_SI[channel_kind(c)]["mean"]})
@@ -439,7 +439,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                    "change": None if change is None else {**change, "unit": next(
                        q.si_unit for q in PARAMETERS if q.name == change["parameter"])},
                    "within_segments": [dict(item) for item in within.flagged],
-                   "slow_scatter": _slow_scatter(after)}
+                   "excess_scatter": _excess_scatter(after)}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
     return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=within,
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,

@@ -106,21 +106,26 @@ def diagnose_report(d) -> str:
                          f"{spec.display_unit} between segment {change['between'][0]} {change['labels'][0]} and "
                          f"{change['between'][1]} {change['labels'][1]} (at about {change['at_s']:.0f} s; "
                          f"p = {_p(change['p_value'])})")
-    elif d.unexplained.get("slow_scatter"):
+    elif d.unexplained.get("excess_scatter"):
         lines.append(f"No lack of fit is flagged at segment level (p = {_p(after.p_value)}), but the tests cannot "
                      "see a slow effect here:")
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
-    for item in d.unexplained.get("slow_scatter", []):
+    for item in d.unexplained.get("excess_scatter", []):
         c = CHANNELS.index(item["channel"])
         unit, factor = OUTPUT_UNITS[_kind(c)]
-        lines.append(f"  SLOW SCATTER in {item['channel']}: its segment means scatter {item['ratio']:.3g} times what "
+        lines.append(f"  EXCESS SCATTER in {item['channel']}: its segment means scatter {item['ratio']:.3g} times what "
                      f"its samples predict ({item['between_sd'] / factor:.3g} against "
                      f"{item['predicted_sd'] / factor:.3g} {unit}, correlated over {item['correlation_time_s']:g} s)")
-    if d.unexplained.get("slow_scatter"):
-        lines.append("  taken up as slow noise: slow noise and a slow effect (a bias that follows the temperature, a "
-                     "warm-up, a drift) look alike in this recording; repeat a pose at the end of the run, or log "
-                     "the temperature, to tell them apart")
+    taus = {item["correlation_time_s"] > 0 for item in d.unexplained.get("excess_scatter", [])}
+    if True in taus:
+        lines.append("  correlated in time, taken up as slow noise: slow noise and a slow effect (a bias that follows "
+                     "the temperature, a warm-up, a drift) look alike in this recording; repeat a pose at the end of "
+                     "the run, or log the temperature, to tell them apart")
+    if False in taus:
+        lines.append("  independent from segment to segment (correlated over 0 s): an input that differs from pose to "
+                     "pose and that the model gets wrong (the site's latitude or gravity; the table's errors larger "
+                     "than its grade) or noise the segments cannot show")
     lines += _within_lines(d)
     lines += ["", "Candidates (first round; adjusted p: Westfall–Young min-p over the identifiable ones)",
               f"{'effect':25s} {'identifiable':>12s} {'dof':>4s} {'statistic':>10s} {'p':>9s} {'adjusted p':>10s}  "
