@@ -272,6 +272,9 @@ def test_bad_logs_are_refused_naming_the_line_and_column(tmp_path, capsys):
         path.write_text("\n".join(copy) + "\n")
         return str(path)
 
+    # a lab temperature no IMU runs at (a typo, or kelvin)
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--temperature", "1e6"],
+                 "--temperature 1000000.0: expected the lab's temperature, -100 to 200 degC")
     # a missing column (without --columns the channels are gx ... az)
     write_synthetic(tmp_path / "bad.csv", t, x, names=("gx", "gy", "gz", "ax", "ay", "acc_z"))
     expect_error(tmp_path, capsys, ["import", str(tmp_path / "bad.csv"), "--out", out, "--time", "time"],

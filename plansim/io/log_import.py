@@ -59,6 +59,9 @@ RATE_MISMATCH_WARNING = 0.01
 MAX_PREAMBLE_LINES = 50
 #: rows converted to numbers at a time while reading
 _BLOCK_ROWS = 65536
+#: the range of a lab temperature given with --temperature, degC: the widest a MEMS IMU is rated for (automotive
+#: and military grades run from -55 to +125 degC), with a margin
+LAB_TEMPERATURE = (-100.0, 200.0)
 #: the temperature assumed for each segment when the log has no temperature channel, degC
 DEFAULT_TEMPERATURE = 20.0
 
@@ -482,8 +485,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     for option, value in (("--window", window), ("--min-static", min_static)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value > 0 and math.isfinite(value)):
             raise ValueError(f"{option} {value!r}: expected a positive number of seconds")
-    if temperature is not None and not math.isfinite(temperature):
-        raise ValueError(f"--temperature {temperature!r}: expected a finite number of degC")
+    if temperature is not None and not (math.isfinite(temperature)
+                                        and LAB_TEMPERATURE[0] <= temperature <= LAB_TEMPERATURE[1]):
+        raise ValueError(f"--temperature {temperature!r}: expected the lab's temperature, {LAB_TEMPERATURE[0]:g} to "
+                         f"{LAB_TEMPERATURE[1]:g} degC (the widest range a MEMS IMU is rated for)")
     site = {}
     for key, value, option in (("site_latitude_deg", latitude, "--latitude"), ("site_height_m", height, "--height")):
         if value is None:
