@@ -460,6 +460,17 @@ def test_an_offset_in_counts_is_subtracted_before_the_scale(tmp_path, capsys):
     # read as signed counts, the unsigned log is 16 g at rest: refused by the 1 g check, naming the scale
     with pytest.raises(ValueError, match="at rest the accelerometers read"):
         import_log(tmp_path / "unsigned.csv", time_column="time", units="deg/s,g", scale="16.4,2048")
+    # on the command line a list that starts with a minus sign is the option's value, not another option (argparse
+    # alone said "expected one argument"): a negative offset is taken, a negative scale refused naming it
+    write_synthetic(tmp_path / "shifted.csv", t, counts - 5.0)
+    out = tmp_path / "shifted.nc"
+    assert main(["import", str(tmp_path / "shifted.csv"), "--out", str(out), "--time", "time", "--units", "deg/s,g",
+                 "--scale", "16.4,2048", "--offset", "-5,-5"]) == 0
+    capsys.readouterr()
+    np.testing.assert_allclose(read_recording(out).samples, signed.recording.samples, rtol=0, atol=1e-12)
+    assert main(["import", str(tmp_path / "signed.csv"), "--out", str(tmp_path / "neg.nc"), "--time", "time",
+                 "--units", "deg/s,g", "--scale", "-16.4,-2048"]) == 2
+    assert "--scale '-16.4,-2048': '-16.4' for channel gx; expected a positive number" in capsys.readouterr().err
 
 
 def test_simulated_recording_times_are_the_nominal_ones():

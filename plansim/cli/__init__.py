@@ -59,10 +59,30 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: options whose value is a comma-separated list of numbers that may start with a minus sign
+SIGNED_LIST_OPTIONS = ("--scale", "--offset")
+
+
+def _join_signed_lists(argv: list[str]) -> list[str]:
+    """``--scale -16.4,-2048`` as ``--scale=-16.4,-2048``: argparse takes a value that starts with "-" and is not one
+    plain negative number for an option, and says only "expected one argument"."""
+    out: list[str] = []
+    k = 0
+    while k < len(argv):
+        value = argv[k + 1] if k + 1 < len(argv) else ""
+        if argv[k] in SIGNED_LIST_OPTIONS and value[:1] == "-" and (value[1:2].isdigit() or value[1:2] == "."):
+            out.append(f"{argv[k]}={value}")
+            k += 2
+            continue
+        out.append(argv[k])
+        k += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command of *argv* (default: ``sys.argv[1:]``); return its exit status (see :data:`EPILOG`)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_join_signed_lists(sys.argv[1:] if argv is None else list(argv)))
     if getattr(args, "chunk_size", 1) < 1:
         parser.error(f"--chunk-size {args.chunk_size}: must be >= 1")
     try:
