@@ -272,6 +272,9 @@ def test_bad_logs_are_refused_naming_the_line_and_column(tmp_path, capsys):
         path.write_text("\n".join(copy) + "\n")
         return str(path)
 
+    # a raw log given to fit instead of import: the error says what to do
+    assert main(["fit", str(log)]) == 2
+    assert f"Turn it into a recording first: plansim import {log.name} --out rec.nc" in capsys.readouterr().err
     # a lab temperature no IMU runs at (a typo, or kelvin)
     expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--temperature", "1e6"],
                  "--temperature 1000000.0: expected the lab's temperature, -100 to 200 degC")

@@ -315,7 +315,10 @@ def read_csv(target: Path) -> Recording:
         attrs, columns, header_line = _read_header(fh, where)
         missing = [name for name in CSV_SAMPLE_COLUMNS if name not in columns]
         if missing:
-            raise ValueError(f"{where}: column {missing[0]!r} is missing; required: {', '.join(CSV_SAMPLE_COLUMNS)}")
+            raise ValueError(f"{where}: column {missing[0]!r} is missing; required: {', '.join(CSV_SAMPLE_COLUMNS)}"
+                             + ("" if table_target.exists() else f", with its segment table {table_target.name!r} "
+                                "beside it. Is it a raw log? Turn it into a recording first: plansim import "
+                                f"{target.name} --out rec.nc (docs/measured-data.md)"))
         read_columns = CSV_SAMPLE_COLUMNS + ((CSV_TEMPERATURE_COLUMN,) if CSV_TEMPERATURE_COLUMN in columns else ())
         use = [columns.index(name) for name in read_columns]
         try:
