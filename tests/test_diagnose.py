@@ -366,7 +366,7 @@ def test_a_slow_effect_the_between_segment_noise_takes_up_is_reported_as_excess_
     up as between-segment noise (a slow effect and slow noise look alike without a repeated pose), so no test can
     flag it; the diagnosis says so — excess scatter in gx at ≥ EXCESS_SCATTER_RATIO times what the samples predict,
     with the advice to repeat a pose — instead of "nothing unexplained". Without the warm-up, nothing is said (nor on
-    40 null recordings of jjf2003 and of linear_gaussian, whose largest ratio was 0.91 and 0.97: docs)."""
+    40 null recordings of jjf2003 and of linear_gaussian, whose largest ratio was 1.13 and 0.97: docs)."""
     import math
 
     from plansim.diagnose.procedure import EXCESS_SCATTER_RATIO
