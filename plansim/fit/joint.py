@@ -600,7 +600,6 @@ def recording_noise(recording, stated_white=None, stated_step=None, noisier: boo
                           [schedule.segments[k] for k in segments], stated_white, stated_step, noisier, conditional)
 
 
-@threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)
 def _refuse_constant_channels(recording) -> None:
     """A ``ValueError`` naming each channel that reads one value in every sample of the recording.
 
@@ -619,6 +618,7 @@ def _refuse_constant_channels(recording) -> None:
               "changes cannot be fitted")
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # small matrices: BLAS threads only compete (diagnose)
 def fit_recording(recording, site: Site | None = None, turntable=None, turntable_source: str = "",
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
