@@ -117,6 +117,10 @@ VERTICAL_AXIS_TOLERANCE = math.radians(20.0)
 APPROXIMATE_TILT = math.radians(15.0)
 #: a time step longer than this many sample periods is a gap (at least one sample missing)
 GAP_FACTOR = 1.5
+#: a break in the time column of at most this many missing samples is a dropped sample (a wireless link loses a row
+#: now and then), not a gap: a pose's mean does not need it, and a turn is integrated over the time column, which
+#: bridges it (:func:`analyse_time`)
+DROPPED_MAX = 2
 #: a time column whose span holds more than this many times the samples its median step implies comes from a clock
 #: coarser than the sampling (:func:`analyse_time`)
 COARSE_CLOCK_FACTOR = 1.05
@@ -142,11 +146,14 @@ class TimeReport:
     jitter_rms, jitter_max : float
         RMS and largest deviation of a time step from 1 / sample_rate, gaps excluded, s.
     gaps : tuple of (int, float)
-        ``(k, dt)``: a gap of dt seconds before sample k (dt > GAP_FACTOR / sample_rate).
+        ``(k, dt)``: a gap of dt seconds before sample k (dt > GAP_FACTOR / sample_rate, more than
+        :data:`DROPPED_MAX` samples missing).
     missing_samples : int
         Samples missing in the gaps: Σ round(dt × sample_rate) − 1.
     repeated : int
         Time steps of exactly zero.
+    dropped : tuple of (int, int)
+        ``(k, m)``: m ≤ :data:`DROPPED_MAX` samples dropped before sample k — not a gap.
     """
 
     sample_rate: float
@@ -156,6 +163,12 @@ class TimeReport:
     gaps: tuple[tuple[int, float], ...]
     missing_samples: int
     repeated: int
+    dropped: tuple[tuple[int, int], ...] = ()
+
+    @property
+    def dropped_samples(self) -> int:
+        """Samples dropped in breaks that are not gaps."""
+        return sum(m for _, m in self.dropped)
 
     @property
     def gap_starts(self) -> np.ndarray:
@@ -206,12 +219,15 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     glitch = np.zeros_like(gap)
     glitch[1:] = (dt[:-1] == 0) & (dt[:-1] + dt[1:] <= (1.0 + GAP_FACTOR) * step)
     gap &= ~glitch
-    gaps = tuple((int(k) + 1, float(dt[k])) for k in np.flatnonzero(gap))
-    missing = int(sum(max(round(d * nominal) - 1, 1) for _, d in gaps))
+    breaks = [(int(k) + 1, float(dt[k]), max(round(dt[k] * nominal) - 1, 1)) for k in np.flatnonzero(gap)]
+    gaps = tuple((k, d) for k, d, m in breaks if m > DROPPED_MAX)
+    missing = int(sum(m for _, _, m in breaks if m > DROPPED_MAX))
+    dropped = tuple((k, m) for k, _, m in breaks if m <= DROPPED_MAX)
     regular = dt[~gap] - period
     jitter_rms = float(np.sqrt(np.mean(regular**2))) if regular.size else 0.0
     jitter_max = float(np.max(np.abs(regular))) if regular.size else 0.0
-    return TimeReport(nominal, estimated, jitter_rms, jitter_max, gaps, missing, int(np.count_nonzero(dt == 0)))
+    return TimeReport(nominal, estimated, jitter_rms, jitter_max, gaps, missing, int(np.count_nonzero(dt == 0)),
+                      dropped)
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,6 @@ log may still be used for despite a flaw (a gap, a saturated stretch, timing jit
 from __future__ import annotations
 
 import csv
-import dataclasses
 import math
 import os
 from dataclasses import dataclass, field
@@ -29,6 +28,7 @@ from plansim.estimate.segmentation import (
     AXES,
     DEFAULT_MIN_STATIC,
     DEFAULT_WINDOW,
+    DROPPED_MAX,
     Segmentation,
     Span,
     TimeReport,
@@ -67,8 +67,6 @@ DEFAULT_TEMPERATURE = 20.0
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples")
-#: a break in the time column of at most this many missing samples is a dropped sample, not a gap (:func:`import_log`)
-DROPPED_MAX = 2
 #: a sample rate from the time column outside this range (Hz) is a warning: an IMU log is sampled at 1 Hz to 100 kHz,
 #: and a rate outside it is most often a time column in another unit than --time-unit says (ms read as s: 1000 Hz
 #: reads as 1 Hz)
@@ -524,24 +522,16 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     except ValueError as exc:
         raise ValueError(f"{where}: column {table.time_column!r}: {exc}") from None
     period = 1.0 / timing.sample_rate
-    # rows dropped here and there (a wireless link loses a sample now and then) are not gaps: a pose's mean does not
-    # need them and a turn is integrated over the time column, which bridges them
-    missing_of = {k: max(round(dt * timing.sample_rate) - 1, 1) for k, dt in timing.gaps}
-    dropped = [(k, dt) for k, dt in timing.gaps if missing_of[k] <= DROPPED_MAX]
-    gaps = [(k, dt) for k, dt in timing.gaps if missing_of[k] > DROPPED_MAX]
-    if dropped:
-        warnings.append(LogWarning("dropped_samples", f"{sum(missing_of[k] for k, _ in dropped)} sample(s) dropped "
-                                                      f"in {len(dropped)} place(s), at most {DROPPED_MAX} in a row "
-                                                      f"(first before line {table.lines[dropped[0][0]]}): kept inside "
-                                                      "poses and turns, a turn integrated over the time column"))
-    dropped_samples = sum(missing_of[k] for k, _ in dropped)
-    timing = dataclasses.replace(timing, gaps=tuple(gaps), missing_samples=sum(missing_of[k] for k, _ in gaps))
-    if gaps:
-        k, dt = max(gaps, key=lambda g: g[1])
-        warnings.append(LogWarning("gap", f"{len(gaps)} gap(s) in the time column, "
-                                          f"{sum(missing_of[g] for g, _ in gaps)} sample(s) missing; the largest, "
-                                          f"{dt:.6g} s, before line {table.lines[k]}. No static span holds a gap, and "
-                                          "a turn across one has no angle"))
+    if timing.dropped:
+        warnings.append(LogWarning("dropped_samples", f"{timing.dropped_samples} sample(s) dropped in "
+                                                      f"{len(timing.dropped)} place(s), at most {DROPPED_MAX} in a row "
+                                                      f"(first before line {table.lines[timing.dropped[0][0]]}): kept "
+                                                      "inside poses and turns, a turn integrated over the time column"))
+    if timing.gaps:
+        k, dt = max(timing.gaps, key=lambda g: g[1])
+        warnings.append(LogWarning("gap", f"{len(timing.gaps)} gap(s) in the time column, {timing.missing_samples} "
+                                          f"sample(s) missing; the largest, {dt:.6g} s, before line {table.lines[k]}. "
+                                          "No static span holds a gap, and a turn across one has no angle"))
     if timing.repeated:
         warnings.append(LogWarning("repeated_time", f"{timing.repeated} time step(s) of exactly 0 s: the time "
                                                     "column's resolution is coarser than the sample period?"))
@@ -574,7 +564,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                            "changes"))
 
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
-                               gap_starts=np.array([k for k, _ in gaps], dtype=np.int64))
+                               gap_starts=timing.gap_starts)
     statics = segmentation.of_kind("static")
     at_rest = float(np.median([np.linalg.norm(span.mean[3:]) for span in statics]))
     if abs(at_rest / STANDARD_GRAVITY - 1.0) > GRAVITY_TOLERANCE:
@@ -662,7 +652,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                       "time_jitter_max_s": timing.jitter_max, "time_gaps": len(timing.gaps),
                       "time_gap_missing_samples": timing.missing_samples,
                       "time_gap_largest_s": max((dt for _, dt in timing.gaps), default=0.0),
-                      "time_dropped_samples": dropped_samples})
+                      "time_dropped_samples": timing.dropped_samples})
     if table.temperature is None:
         how = "given (--temperature)" if temperature is not None else "assumed (the log has no temperature)"
         attrs["segment_temperature"] = f"{segment_temperature:g} degC, {how}"
