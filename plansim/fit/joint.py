@@ -40,7 +40,7 @@ from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.fit.identify import Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import find_transitions, fit_moves
-from plansim.fit.noise import NoiseEstimate, estimate_noise, quantisation_harmonics
+from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise, quantisation_harmonics
 from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
@@ -612,7 +612,7 @@ def _refuse_constant_channels(recording) -> None:
     constant = [c for c in range(6) if np.ptp(samples[:, c]) == 0]
     if constant:
         raise ValueError("recording: " + "; ".join(
-            f"channel {CHANNELS[c]} reads {samples[0, c]:.6g} {'rad/s' if c < 3 else 'm/s^2'} in every one of its "
+            f"channel {CHANNELS[c]} reads {samples[0, c]:.6g} {UNITS_SI[channel_kind(c)]['mean']} in every one of its "
             f"{samples.shape[0]} samples" for c in constant)
             + ": a dead or disconnected sensor, or a wrong column (plansim import --columns); a channel that never "
               "changes cannot be fitted")
