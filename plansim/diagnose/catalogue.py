@@ -74,24 +74,24 @@ def _kernel_columns(fit, argument: str, entries) -> tuple[np.ndarray, np.ndarray
     """Columns (S, 6, m) of the kernel's effect array *argument* at each (row, column) of *entries* at the fit's
     solution, (m,) the part of each that the designed excitation gives (:attr:`Signature.designed`), and (S, 6, m)
     the same columns for an ideal sensor in the same poses (:attr:`Signature.geometry`)."""
-    model, tilts = fit.model, fit.nuisance
-    no_earth = np.zeros(3)
-    out, designed, geometry = [], [], []
-    for theta, columns in ((fit.theta, out), (nominal_parameters(), geometry)):
-        draws = model.draws(theta, tilts)
-        base = model.averaged(draws, effects=None)[0]
-        base_designed = model.averaged(draws, earth_enu=no_earth, effects=None)[0]
+    model = fit.model
+
+    def columns(theta, earth_enu=None) -> np.ndarray:
+        draws = model.draws(theta, fit.nuisance)
+        base = model.averaged(draws, earth_enu=earth_enu, effects=None)[0]
+        out = []
         for index in entries:
             effects = model.effect_arguments()
             effects[argument][index] += STEP
-            column = (model.averaged(draws, effects={argument: effects[argument]})[0] - base) / STEP
-            columns.append(column)
-            if columns is out:
-                without = (model.averaged(draws, earth_enu=no_earth, effects={argument: effects[argument]})[0]
-                           - base_designed) / STEP
-                norm = float(np.linalg.norm(column))
-                designed.append(float(np.linalg.norm(without)) / norm if norm > 0 else 0.0)
-    return np.stack(out, axis=-1), np.array(designed), np.stack(geometry, axis=-1)
+            out.append((model.averaged(draws, earth_enu=earth_enu, effects={argument: effects[argument]})[0]
+                        - base) / STEP)
+        return np.stack(out, axis=-1)
+
+    at_fit = columns(fit.theta)
+    norm = np.linalg.norm(at_fit.reshape(-1, at_fit.shape[-1]), axis=0)
+    without = np.linalg.norm(columns(fit.theta, np.zeros(3)).reshape(-1, at_fit.shape[-1]), axis=0)
+    designed = np.where(norm > 0, without / np.where(norm > 0, norm, 1.0), 0.0)
+    return at_fit, designed, columns(nominal_parameters())
 
 
 def signatures(fit) -> tuple[Signature, ...]:
