@@ -83,6 +83,7 @@ def diagnose_report(d) -> str:
                      f"clearly better (statistic {item['family_statistic']:.1f} against {item['statistic']:.1f}, "
                      f"more than the {item['margin']:.1f} its best column gains on noise alone)")
     after = d.lack_of_fit_after
+    excess = d.unexplained.get("excess_scatter", [])
     if after.flagged:
         lines.append(f"UNEXPLAINED residual after the refit (p = {_p(after.p_value)}): not named after any "
                      "catalogue effect; where it sits:")
@@ -106,18 +107,18 @@ def diagnose_report(d) -> str:
                          f"{spec.display_unit} between segment {change['between'][0]} {change['labels'][0]} and "
                          f"{change['between'][1]} {change['labels'][1]} (at about {change['at_s']:.0f} s; "
                          f"p = {_p(change['p_value'])})")
-    elif d.unexplained.get("excess_scatter"):
+    elif excess:
         lines.append(f"No lack of fit is flagged at segment level (p = {_p(after.p_value)}), but the tests cannot "
                      "see a slow effect here:")
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
-    for item in d.unexplained.get("excess_scatter", []):
+    for item in excess:
         c = CHANNELS.index(item["channel"])
         unit, factor = OUTPUT_UNITS[_kind(c)]
         lines.append(f"  EXCESS SCATTER in {item['channel']}: its segment means scatter {item['ratio']:.3g} times what "
                      f"its samples predict ({item['between_sd'] / factor:.3g} against "
                      f"{item['predicted_sd'] / factor:.3g} {unit}, correlated over {item['correlation_time_s']:g} s)")
-    taus = {item["correlation_time_s"] > 0 for item in d.unexplained.get("excess_scatter", [])}
+    taus = {item["correlation_time_s"] > 0 for item in excess}
     if True in taus:
         lines.append("  correlated in time, taken up as slow noise: slow noise and a slow effect (a bias that follows "
                      "the temperature, a warm-up, a drift) look alike in this recording; repeat a pose at the end of "
