@@ -388,6 +388,31 @@ def test_a_time_column_in_another_unit_and_a_dead_channel_are_named(tmp_path, ca
     assert "channel gy reads 0 rad/s in every one of its" in capsys.readouterr().err
 
 
+def test_a_steady_turn_about_the_vertical_with_no_rest_is_warned_of(tmp_path):
+    """A table turning steadily at 30 deg/s about the vertical for the whole log (found by feeding plansim such a
+    log): the accelerometers are steady, and with no rest elsewhere to compare with, the detector takes the turn
+    for rest and its rate for the gyros' bias. The import says so (``rest_turning_about_vertical``) when the gyro
+    output is at least 1 deg/s and along the pose's own vertical; a bias of 2 deg/s across the vertical (a
+    consumer gyro's), or the synthetic log's 0.37 deg/s, is not warned of."""
+    t, x = synthetic_log(seconds_rest=6.0)
+    steady = x.copy()
+    steady[:, :3] = np.random.default_rng(1).normal(size=(t.size, 3)) * math.radians(0.1)
+    steady[:, 2] += math.radians(30.0)
+    log = tmp_path / "log.csv"
+    write_synthetic(log, t, steady)
+    result = import_log(log, time_column="time")
+    message = {w.name: w.message for w in result.warnings}["rest_turning_about_vertical"]
+    assert "reads 30 deg/s on its gyros" in message and "its rate for the gyros' bias" in message
+    assert "rest_turning_about_vertical" in result.recording.attrs["import_warnings"]
+    across = steady.copy()
+    across[:, 2] -= math.radians(30.0)
+    across[:, 0] += math.radians(2.0)
+    write_synthetic(log, t, across)
+    assert "rest_turning_about_vertical" not in {w.name for w in import_log(log, time_column="time").warnings}
+    write_synthetic(log, t, x)
+    assert "rest_turning_about_vertical" not in {w.name for w in import_log(log, time_column="time").warnings}
+
+
 def test_rows_dropped_here_and_there_are_not_gaps(tmp_path):
     """A wireless IMU loses a row now and then: 5 % of the rows dropped at random (at most two in a row kept that
     way) made every stretch hold a gap, and the log could not be imported at all. They are a named warning now; the

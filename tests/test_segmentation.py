@@ -223,3 +223,19 @@ def test_a_pose_that_drifts_or_a_slow_turn_is_not_a_held_pose():
     spans = segment_log(x, s.time, 100.0).of_kind("static")
     starts = {span.start for span in spans}
     assert len(spans) == 10 and first[4] not in starts and first[8] not in starts
+
+
+def test_two_equal_samples_at_a_peak_are_not_a_rail_unless_the_value_is_held_twice():
+    """Step 10: a fast move's smooth peak falls between two samples, which then read alike (a 16-bit log's
+    75.7 deg/s peak, far inside its +-2000 deg/s, was taken for a rail); three equal samples, or two at a value
+    reached twice, are a rail."""
+    from plansim.estimate.segmentation import SATURATION_RUN, stuck_runs
+
+    peak = np.array([0.0, 5.0, 10.0, 12.0, 12.0, 10.0, 5.0, 0.0])
+    assert stuck_runs(peak, 12.0, 1.0) == []
+    flat = np.array([0.0, 5.0, 10.0] + [12.0] * SATURATION_RUN + [10.0, 5.0, 0.0])
+    assert stuck_runs(flat, 12.0, 1.0) == [(3, 3 + SATURATION_RUN)]
+    twice = np.concatenate([peak, peak])
+    assert stuck_runs(twice, 12.0, 1.0) == [(3, 5), (11, 13)]
+    # entered and left by one step (a slow peak of a quantised channel): never a rail
+    assert stuck_runs(np.array([10.0, 11.0, 12.0, 12.0, 12.0, 12.0, 11.0]), 12.0, 1.0) == []

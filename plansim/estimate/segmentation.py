@@ -62,11 +62,14 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    is not known.
 9. **Steady rate.** Where a rotation holds one steady turn (step 6) of at least half its duration, its
    measured rate is reported.
-10. **Saturation.** Two or more equal consecutive samples at a channel's largest or smallest value in the
-    log, outside the static spans, entered or left by a step of more than ``SATURATION_STEP`` σ, at a value
+10. **Saturation.** ``SATURATION_RUN`` or more equal consecutive samples at a channel's largest or smallest
+    value in the log (two are enough where the value is held by two such runs or more: a rail reached twice),
+    outside the static spans, entered or left by a step of more than ``SATURATION_STEP`` σ, at a value
     more than ``SATURATION_STEP`` σ + one step away from every level the channel holds while quiet (at
-    rest or turning steadily): a stretch stuck at a rail. A rate held beyond the range for a whole steady
-    turn reads as a steady turn at the rail value; no detector can tell it from the data alone.
+    rest or turning steadily): a stretch stuck at a rail. Two equal samples once are not enough: a fast
+    move's smooth peak falls between two samples, which then read alike whatever its curvature (a 16-bit
+    log's 75.7 °/s peak, far inside its ±2000 °/s, was taken for a rail). A rate held beyond the range for a
+    whole steady turn reads as a steady turn at the rail value; no detector can tell it from the data alone.
 
 Every threshold is a multiple of the log's own noise; the multiples are module constants, chosen by
 simulation (tests/test_segmentation.py measures their false alarms on static noise of several kinds).
@@ -126,6 +129,8 @@ DROPPED_MAX = 2
 COARSE_CLOCK_FACTOR = 1.05
 #: a saturated stretch is entered or left by a step of more than this many σ
 SATURATION_STEP = 5.0
+#: equal samples in a row at a channel's extreme that make a rail on their own (step 10)
+SATURATION_RUN = 3
 #: robust standard deviation from the median absolute deviation of a normal distribution
 MAD_TO_SIGMA = 1.482602218505602
 
@@ -693,9 +698,11 @@ def _saturation(x: np.ndarray, statics: list[Span], steady: list[tuple[int, int]
 
 
 def stuck_runs(values: np.ndarray, value: float, jump: float) -> list[tuple[int, int]]:
-    """Runs ``[a, b)`` of two or more samples of *values* equal to *value* (a channel's extreme) that are entered
-    or left by a step of more than *jump*: a signal stuck at a rail. A smooth peak of a quantised channel
-    also repeats its extreme, but enters and leaves it by one step (step 10 of the module docstring)."""
+    """Runs ``[a, b)`` of samples of *values* equal to *value* (a channel's extreme) that are entered or left by a
+    step of more than *jump*: a signal stuck at a rail. A smooth peak of a quantised channel also repeats its
+    extreme, but enters and leaves it by one step; a fast one falls between two samples, which then read alike:
+    a run needs :data:`SATURATION_RUN` samples, or two when the value is held by two such runs or more (step 10
+    of the module docstring)."""
     n = values.shape[0]
     out = []
     for a, b in _runs(values == value):
@@ -705,6 +712,8 @@ def stuck_runs(values: np.ndarray, value: float, jump: float) -> list[tuple[int,
         leave = abs(values[b] - value) if b < n else 0.0
         if max(entry, leave) > jump:
             out.append((a, b))
+    if len(out) < 2:
+        out = [(a, b) for a, b in out if b - a >= SATURATION_RUN]
     return out
 
 

@@ -66,7 +66,15 @@ LAB_TEMPERATURE = (-100.0, 200.0)
 DEFAULT_TEMPERATURE = 20.0
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
-                 "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples")
+                 "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
+                 "rest_turning_about_vertical")
+#: a static pose whose gyro output is at least this (rad/s) and points along its own specific force (within
+#: :data:`VERTICAL_TURN_CONE`) is warned of as possibly a steady turn about the vertical: the one turn that leaves
+#: the accelerometers steady, which the detector (step 6) can tell from rest only against a rest elsewhere in the log
+VERTICAL_TURN_RATE = math.radians(1.0)
+#: half-angle of the cone about the specific force within which such a gyro output counts as along it. A bias of
+#: random direction falls in it by chance 1 − cos 10° = 1.5 % of the time
+VERTICAL_TURN_CONE = math.radians(10.0)
 #: a sample rate from the time column outside this range (Hz) is a warning: an IMU log is sampled at 1 Hz to 100 kHz,
 #: and a rate outside it is most often a time column in another unit than --time-unit says (ms read as s: 1000 Hz
 #: reads as 1 Hz)
@@ -586,6 +594,19 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                       f"{table.lines[span.stop - 1]} is tilted "
                                                       f"{math.degrees(span.tilt):.1f} deg from {span.up}: orientation "
                                                       "'unknown'"))
+    for span in statics:
+        rate, force = span.mean[:3], span.mean[3:]
+        magnitude = float(np.linalg.norm(rate))
+        along = abs(float(np.dot(rate, force))) / max(magnitude * float(np.linalg.norm(force)), 1e-300)
+        if magnitude >= VERTICAL_TURN_RATE and along >= math.cos(VERTICAL_TURN_CONE):
+            warnings.append(LogWarning("rest_turning_about_vertical", f"the static span on lines "
+                                       f"{table.lines[span.start]}-{table.lines[span.stop - 1]} reads "
+                                       f"{math.degrees(magnitude):.3g} deg/s on its gyros, within "
+                                       f"{math.degrees(math.acos(min(along, 1.0))):.2g} deg of its vertical: a "
+                                       "steady turn about the vertical looks like rest to the accelerometers; with "
+                                       "no rest elsewhere in the log to compare with, it is taken for one, its "
+                                       "rate for the gyros' bias. If the table was turning, mark the span "
+                                       "(docs/measured-data.md)"))
     held = [span for span in statics if math.isfinite(span.held)]
     if held:
         warnings.append(LogWarning("held_pose", f"{len(held)} static pose(s) held by hand: the accelerometers are "
