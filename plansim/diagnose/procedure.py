@@ -2,7 +2,10 @@
 
 1. **Base fit** M0 (:func:`plansim.fit.fit_recording`: the noise from the data, the table's and fixture's
    Type B errors per setting, the between-segment noise the residuals show).
-2. **Lack of fit** of M0 at segment level, against its simulated null (:func:`plansim.diagnose.scores.lack_of_fit`),
+2. **Lack of fit** of M0 at segment level, against its simulated null (:func:`plansim.diagnose.scores.lack_of_fit`;
+   M0 fitted once more for it with each static mean's quantisation error given its level counts, ``plansim fit``'s
+   noise model, under which this family holds its level, where the candidates' tests need the error over a level
+   unknown within its step: docs/closing-the-loop.md, step 1),
    and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, against
    a null simulated from the recording's own noise (:func:`plansim.diagnose.within.within_segment_tests`); each at
    α/4 (:data:`SEGMENT_LEVEL_SHARE`, :data:`WITHIN_SHARE`), so that "something is unexplained" keeps the level α/2.
@@ -340,6 +343,13 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     # need a null that holds wherever the level sits; conditioned on the level counts, whose σ the data barely
     # tell, the K2 and g² scores of jjf2003 nulls ran at 1.3-1.7 times their null variance: docs/closing-the-loop.md)
     options["noise"] = recording_noise(recording, stated_white, stated_step, noisier=False, conditional=False)
+    # the segment-level lack of fit, an omnibus over every row, is tested under the error given the level counts
+    # instead (conditional=True, plansim fit's): that is the model under which its null holds. Under the error over
+    # the step, a pair of segments' quantiser covariance follows their fitted level difference in full, and on 1000
+    # jjf2003 nulls the base and final lack of fit fired in 29 and 24 (2.9 % and 2.4 % on their α/4 = 1.25 %);
+    # under the error given the counts, in 7 and 8 (docs/closing-the-loop.md, "Figures")
+    lof_options = {**options, "noise": recording_noise(recording, stated_white, stated_step, noisier=False,
+                                                       conditional=True)}
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the
     # null hypothesis — the base model — as a score test estimates its nuisance parameters; every fit below then
     # takes it as given. Estimated with the candidates in the model instead, it came out too small wherever a
@@ -356,7 +366,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                                   before.noise, alpha=a_within, seed=seed)
     sigs = signatures(before)
     null = null_residuals(before, null_draws, seed)
-    lof = lack_of_fit(before, alpha=a_segment, null=null)
+    lof_before = fit_recording(recording, **lof_options)
+    lof = lack_of_fit(lof_before, alpha=a_segment, null=null_residuals(lof_before, null_draws, seed))
     scores = score_candidates(before, sigs, alpha=a_select, null=null)
     first = scores
     steps = [scores]
@@ -366,7 +377,9 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     current = before
     by_effect = {s.effect: s for s in sigs}
     not_named = []
-    lof_current = lof
+    # the step and the change in time that a significant candidate is compared with (explained_better): in the
+    # candidates' own metric, like with like, and only when one is significant
+    lof_current = None
     while True:
         open_ = [s for s in scores if s.identifiable and s.adjusted_p_value < a_select]
         if not open_:
@@ -378,6 +391,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         # held-out prediction error (it penalised the six-component nonlinearity against the three-component
         # asymmetry: 0–1 of 5 quadratic nonlinearities at 5× were named) compares like with like.
         best = max(open_, key=lambda c: (c.strongest_component(), -c.adjusted_p_value))
+        if lof_current is None:
+            lof_current = lack_of_fit(current, alpha=a_segment, null=null)
         beaten = explained_better(best, lof_current, a_segment)
         if beaten is not None:  # a step or a change in time explains it clearly better: leave it unexplained
             not_named.append(beaten)
@@ -412,10 +427,12 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         by_effect.update({s.effect: s for s in remaining})
         null = null_residuals(current, null_draws, seed + len(selected))
         scores = score_candidates(current, remaining, alpha=a_select, null=null)
-        lof_current = lack_of_fit(current, alpha=a_segment, null=null)
+        lof_current = None
         steps.append(scores)
     after = current
-    lof_after = lack_of_fit(after, alpha=a_segment, null=null_residuals(after, null_draws, seed + 1000))
+    # the final model under the lack of fit's noise model, its between-segment noise estimated under it
+    lof_after_fit = fit_recording(recording, **lof_options, extra=extra) if selected else lof_before
+    lof_after = lack_of_fit(lof_after_fit, alpha=a_segment, null=null_residuals(lof_after_fit, null_draws, seed + 1000))
     sizes = {}
     if after.extra is not None:
         for effect in selected:
@@ -433,7 +450,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     step = pattern[2] if pattern[1] == "step" else None
     change = pattern[2] if pattern[1] == "change" else None
     unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged),
-                   "where": _where(after, lof_after) if lof_after.flagged else [],
+                   "where": _where(lof_after_fit, lof_after) if lof_after.flagged else [],
                    "step": None if step is None else {**step, "unit": UNITS_SI[channel_kind(
                        CHANNELS.index(step["channel"]))]["mean"]},
                    "change": None if change is None else {**change, "unit": next(
