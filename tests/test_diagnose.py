@@ -288,6 +288,10 @@ def test_an_asymmetry_in_jjf2003_order_is_a_scale_change_in_time_and_the_report_
     assert t["parameter"] == "Kgxx" and t["component"] == "x" and t["cosine"] > 0.9999
     assert t["labels"] == ["rate x -5 deg/s", "rate x +0 deg/s"]
     assert "this recording cannot say which" in diagnose_report(d)
+    # jjf2003's 12-bit accelerometers: their means are mostly the quantiser's error, and the report says what
+    # that does to the tests' level (docs/closing-the-loop.md, "Undithered channels"); its gyros are dithered
+    assert d.undithered == ("ax", "ay", "az") and diagnosis_json(d)["undithered_channels"] == ["ax", "ay", "az"]
+    assert "Note: the segment means of ax, ay, az are mostly a quantiser's error" in diagnose_report(d)
     interleaved = load_scenario("jjf2003", ['schedule.rate_points=["5 deg/s", "-5 deg/s", "20 deg/s", "-20 deg/s", '
                                             '"50 deg/s", "-50 deg/s", "100 deg/s", "-100 deg/s", "0 deg/s"]'])
     interleaved = dataclasses.replace(interleaved, effects=scenario.effects)
@@ -411,7 +415,7 @@ def test_json_keys_and_the_command(tmp_path, capsys):
     assert {"name", "unit", "before", "after", "u_after"} <= set(out["parameters"][0])
     assert {"alpha", "draws", "segments_tested", "smallest_adjusted_p_value", "flagged"} <= set(out["within_segment"])
     assert "within_segments" in out["unexplained"] and out["unexplained"]["excess_scatter"] == []
-    assert out["selected"] == ["gyro_scale_asymmetry"]
+    assert out["selected"] == ["gyro_scale_asymmetry"] and out["undithered_channels"] == []
     figure = tmp_path / "diag.png"
     assert main(["diagnose", str(path), "--scenario", "linear_gaussian", "--null-draws", "200",
                  "--plot", str(figure)]) == 0

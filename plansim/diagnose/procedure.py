@@ -41,7 +41,15 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from plansim.diagnose.catalogue import signatures
-from plansim.diagnose.scores import NULL_DRAWS, CandidateScore, LackOfFit, lack_of_fit, null_residuals, score_candidates
+from plansim.diagnose.scores import (
+    NULL_DRAWS,
+    CandidateScore,
+    LackOfFit,
+    lack_of_fit,
+    null_residuals,
+    score_candidates,
+    undithered_channels,
+)
 from plansim.diagnose.within import within_segment_tests
 from plansim.fit import fit_recording, recording_noise
 from plansim.fit.noise import UNITS_SI, channel_kind
@@ -82,6 +90,11 @@ class Diagnosis:
     #: a significant candidate that was not named because a step or a change in time explains the residual clearly
     #: better (:func:`explained_better`): its effect, component and statistic, and the step or change
     not_named: tuple = ()
+    #: the channels whose segment means' predicted variance is mostly a quantiser's error the noise does not
+    #: dither (:func:`plansim.diagnose.scores.undithered_channels`): a fixed function of each level, nearly the same
+    #: in every repetition of the recording, so the tests on them hold their level over a population of units,
+    #: not over the noise (docs/closing-the-loop.md, "Undithered channels")
+    undithered: tuple[str, ...] = ()
 
 
 def _rms_per_channel(fit) -> dict:
@@ -462,7 +475,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,
                      holdout=hold, steps=tuple(steps),
                      information={"before": _information(before), "after": _information(after)}, alpha=alpha,
-                     attribution=tuple(attribution), not_named=tuple(not_named))
+                     attribution=tuple(attribution), not_named=tuple(not_named),
+                     undithered=tuple(CHANNELS[c] for c in sorted(undithered_channels(before))))
 
 
 def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict | None:
@@ -551,6 +565,7 @@ def diagnosis_json(d: Diagnosis) -> dict:
                                  if isinstance(v, dict) else v) for k, v in a.items()} for a in d.attribution],
             "not_named": [{k: (_number(v) if isinstance(v, float) else v) for k, v in item.items() if k != "where"}
                           for item in d.not_named],
+            "undithered_channels": list(d.undithered),
             "within_segment": {"alpha": d.within.alpha, "draws": d.within.draws,
                                "segments_tested": len(d.within.segments),
                                "smallest_adjusted_p_value": d.within.smallest_adjusted_p(),

@@ -128,6 +128,11 @@ def diagnose_report(d) -> str:
                      "pose and that the model gets wrong (the site's latitude or gravity; the table's errors larger "
                      "than its grade) or noise the segments cannot show")
     lines += _within_lines(d)
+    if d.undithered:
+        lines.append(f"Note: the segment means of {', '.join(d.undithered)} are mostly a quantiser's error that the "
+                     "noise does not dither: a fixed function of each level, nearly the same in every repetition. "
+                     "The tests on them hold their false-alarm rate over a population of units, not over this "
+                     "recording's noise (docs/closing-the-loop.md, \"Undithered channels\").")
     lines += ["", "Candidates (first round; adjusted p: Westfall–Young min-p over the identifiable ones)",
               f"{'effect':25s} {'identifiable':>12s} {'dof':>4s} {'statistic':>10s} {'p':>9s} {'adjusted p':>10s}  "
               "aliased with / would be separated by"]
