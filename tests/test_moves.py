@@ -226,12 +226,22 @@ def test_a_gap_a_settle_time_and_a_rail_take_a_move_out():
     moved = Recording(rec.samples, dataclasses.replace(rec.schedule, segments=tuple(segments)), rec.attrs)
     _, unused = find_transitions(moved)
     assert "settle time" in unused["segment 5"]
-    # a gyro at its rail for two samples in the first move
+    # a gyro at its rail for three samples in the first move (segmentation step 10)
     samples = rec.samples.copy()
     k = int(rec.first_sample[1]) + 20
-    samples[k:k + 2, 0] = samples[:, 0].max() + 1.0  # entered and left by far more than 5 sigma (sigma 0 here)
+    rail = samples[:, 0].max() + 1.0  # entered and left by far more than 5 sigma (sigma 0 here)
+    samples[k:k + 3, 0] = rail
     _, unused = find_transitions(Recording(samples, rec.schedule, rec.attrs, timestamps=rec.time))
-    assert "gyro x reads its extreme" in unused["segment 1"]
+    assert list(unused) == ["segment 1"] and "gyro x reads its extreme" in unused["segment 1"]
+    # two samples there once are a fast peak, not a rail; two samples at the same value in two moves are a rail
+    # reached twice, and both moves are out
+    samples[k + 2, 0] = samples[k + 3, 0]
+    _, unused = find_transitions(Recording(samples, rec.schedule, rec.attrs, timestamps=rec.time))
+    assert not unused
+    k2 = int(rec.first_sample[3]) + 20
+    samples[k2:k2 + 2, 0] = rail
+    _, unused = find_transitions(Recording(samples, rec.schedule, rec.attrs, timestamps=rec.time))
+    assert list(unused) == ["segment 1", "segment 3"]
     # one usable move is not enough: no gravity sequence, and the fit says Kg is not identified
     two = Recording(rec.samples[:int(rec.first_sample[3])],
                     dataclasses.replace(rec.schedule, segments=rec.schedule.segments[:3]), rec.attrs)

@@ -11,8 +11,8 @@ uncertainty.
 
 **Transitions.** Two static segments of the recording with only moving segments between them (``move`` or
 ``rotation``), none with a settle time (time not recorded) and no gap in the time axis, and no gyro stuck at
-its extreme over the recording (two samples or more, entered or left by a step of more than 5 times its noise
-at rest, as ``plansim import`` tells a rail: the rate there is not known).
+its extreme over the recording (three samples or more, or two at a value reached twice, entered or left by a
+step of more than 5 times its noise at rest, as ``plansim import`` tells a rail: the rate there is not known).
 
 **Model** (per transition from pose i to pose j; JJF 2003 eq. (1) for the gyros, the joint fit's Ka, Ba and
 G as known inputs):
@@ -142,6 +142,8 @@ def find_transitions(recording) -> tuple[list[Transition], dict]:
     rails = [(samples[:, c].min(), samples[:, c].max()) for c in range(3)]
     scatter = np.array([[np.std(recording.segment_samples(k)[:, c]) for c in range(3)] for k in static])
     jump = SATURATION_STEP * np.median(scatter, axis=0) if len(static) else np.zeros(3)
+    # the rails over the whole recording (a value reached twice counts, wherever the other time is)
+    stuck = [(c, a, b) for c in range(3) for value in rails[c] for a, b in stuck_runs(samples[:, c], value, jump[c])]
     out, unused = [], {}
     for i, j in zip(static[:-1], static[1:]):
         between = tuple(range(i + 1, j))
@@ -160,23 +162,13 @@ def find_transitions(recording) -> tuple[list[Transition], dict]:
             if np.any(steps > GAP_FACTOR * period):
                 unused[where] = "a gap in the time axis: samples are missing, the motion's integral is not known"
                 continue
-        stuck = _rail(samples[start:stop, :3], rails, jump)
-        if stuck is not None:
-            unused[where] = (f"gyro {'xyz'[stuck]} reads its extreme over the recording for two samples in a row: "
-                             "saturated? The rate there is not known")
+        hit = next((c for c, a, b in stuck if a < stop and b > start), None)
+        if hit is not None:
+            unused[where] = (f"gyro {'xyz'[hit]} reads its extreme over the recording for several samples in a "
+                             "row: saturated? The rate there is not known")
             continue
         out.append(Transition(i, j, between, start, stop))
     return out, unused
-
-
-def _rail(block: np.ndarray, rails, jump: np.ndarray) -> int | None:
-    """The first gyro channel of *block* stuck at the recording's extreme (:func:`stuck_runs`: two or more samples
-    there, entered or left by more than *jump*, SATURATION_STEP times its noise at rest), or None."""
-    for c in range(3):
-        for value in rails[c]:
-            if stuck_runs(block[:, c], value, jump[c]):
-                return c
-    return None
 
 
 class _Moves:

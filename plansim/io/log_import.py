@@ -605,8 +605,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                        f"{math.degrees(math.acos(min(along, 1.0))):.2g} deg of its vertical: a "
                                        "steady turn about the vertical looks like rest to the accelerometers; with "
                                        "no rest elsewhere in the log to compare with, it is taken for one, its "
-                                       "rate for the gyros' bias. If the table was turning, mark the span "
-                                       "(docs/measured-data.md)"))
+                                       "rate for the gyros' bias. If the table was turning, make it a 'rotation' with "
+                                       "its rate in the segment table (docs/measured-data.md, \"Review and edit "
+                                       "the segment table\")"))
     held = [span for span in statics if math.isfinite(span.held)]
     if held:
         warnings.append(LogWarning("held_pose", f"{len(held)} static pose(s) held by hand: the accelerometers are "
