@@ -74,6 +74,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.special import chdtrc
+from threadpoolctl import threadpool_limits
 
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES
@@ -183,7 +184,10 @@ class _Geometry:
         self.X = X
         self.r = self.project(self.W @ (fit.observed - fit.fitted).ravel())
         V = np.asarray(fit.covariance, dtype=float)
-        values, vectors = np.linalg.eigh(V)
+        # one BLAS thread, whoever calls: where eigenvalues coincide, the eigenvectors' basis — and so every null
+        # draw below — is the BLAS's, and differed with its thread count (same seed, same numbers)
+        with threadpool_limits(limits=1, user_api="blas"):
+            values, vectors = np.linalg.eigh(V)
         self.V_root = vectors * np.sqrt(np.maximum(values, 0.0))  # V = V_root V_rootᵀ
         self.channel_of_row = np.tile(np.arange(6), fit.observed.shape[0])[rows]
         #: P⊥ W V^{1/2}: a whitened residual's noise is this times a standard normal vector
