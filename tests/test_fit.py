@@ -21,7 +21,7 @@ import xarray as xr
 
 from plansim.cli import main
 from plansim.config.scenario import ErrorDistribution
-from plansim.fit import TABLE_1_TURNTABLE, Site, fit_recording, resolve_site
+from plansim.fit import TABLE_1_TURNTABLE, Site, fit_recording, recording_noise, recording_noise_models, resolve_site
 from plansim.fit.identify import identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.noise import (
@@ -594,6 +594,28 @@ def test_a_segment_spanning_more_steps_than_an_integer_holds_takes_its_own_scatt
         assert quantisation_error_given_levels(1e-25, ramp, 0.0) == 0.0
     assert quantised_noise_sigma(float("nan"), [ramp]) == 0.0
     assert quantisation_error_given_levels(float("nan"), ramp, 0.0) == 0.0
+
+
+def test_both_quantisation_models_from_one_pass_are_each_model_alone():
+    """plansim diagnose takes the segment means' variance under both models of a static mean's quantisation error
+    (given the level counts; over a level unknown within its step) from one pass over the samples
+    (recording_noise_models): each is, to the bit, what recording_noise gives for that model alone, and on jjf2003
+    (12-bit accelerometers the noise does not dither) the two differ. A model that is not a bool is refused."""
+    recording = simulate_and_record(load_scenario("jjf2003"), seed=5, trial=0)
+    pair = recording_noise_models(recording, noisier=False, conditionals=(False, True))
+    for model, conditional in zip(pair, (False, True)):
+        alone = recording_noise(recording, noisier=False, conditional=conditional)
+        for name in ("within_std", "mean_variance", "mean_variance_dof", "quantisation_variance",
+                     "quantisation_sigma"):
+            np.testing.assert_array_equal(getattr(model, name), getattr(alone, name), err_msg=name)
+        assert [c.white for c in model.channels] == [c.white for c in alone.channels]
+        assert model.notes == alone.notes
+    accelerometers = slice(3, 6)
+    assert not np.allclose(pair[0].mean_variance[:, accelerometers], pair[1].mean_variance[:, accelerometers])
+    with pytest.raises(TypeError, match="conditionals"):
+        recording_noise_models(recording, conditionals=("given",))
+    with pytest.raises(TypeError, match="conditionals"):
+        recording_noise_models(recording, conditionals=())
 
 
 def test_the_noise_before_a_quantiser_it_does_not_dither():

@@ -51,7 +51,7 @@ from plansim.diagnose.scores import (
     undithered_channels,
 )
 from plansim.diagnose.within import within_segment_tests
-from plansim.fit import fit_recording, recording_noise
+from plansim.fit import fit_recording, recording_noise_models
 from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
@@ -355,14 +355,16 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     # and each static mean's quantisation error over a level unknown within its step (conditional=False: the tests
     # need a null that holds wherever the level sits; conditioned on the level counts, whose σ the data barely
     # tell, the K2 and g² scores of jjf2003 nulls ran at 1.3-1.7 times their null variance: docs/closing-the-loop.md)
-    options["noise"] = recording_noise(recording, stated_white, stated_step, noisier=False, conditional=False)
+    # (both noise models below come from one pass over the samples: recording_noise_models)
+    candidates_noise, lof_noise = recording_noise_models(recording, stated_white, stated_step, noisier=False,
+                                                         conditionals=(False, True))
+    options["noise"] = candidates_noise
     # the segment-level lack of fit, an omnibus over every row, is tested under the error given the level counts
     # instead (conditional=True, plansim fit's): that is the model under which its null holds. Under the error over
     # the step, a pair of segments' quantiser covariance follows their fitted level difference in full, and on 1000
     # jjf2003 nulls the base and final lack of fit fired in 29 and 24 (2.9 % and 2.4 % on their α/4 = 1.25 %);
     # under the error given the counts, in 7 and 8 (docs/closing-the-loop.md, "Figures")
-    lof_options = {**options, "noise": recording_noise(recording, stated_white, stated_step, noisier=False,
-                                                       conditional=True)}
+    lof_options = {**options, "noise": lof_noise}
     # the noise between segments (slow noise the segments are too short to show) is estimated once, under the
     # null hypothesis — the base model — as a score test estimates its nuisance parameters; every fit below then
     # takes it as given. Estimated with the candidates in the model instead, it came out too small wherever a

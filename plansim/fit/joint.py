@@ -40,7 +40,7 @@ from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.fit.identify import Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import find_transitions, fit_moves
-from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise, quantisation_harmonics
+from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
 from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
@@ -594,10 +594,18 @@ def recording_noise(recording, stated_white=None, stated_step=None, noisier: boo
     """The noise of a recording's samples (:func:`plansim.fit.noise.estimate_noise` over every segment that is
     not a move, *noisier* and *conditional* passed on), which :func:`fit_recording` takes as its ``noise`` so that
     refits of the same samples share it."""
+    return recording_noise_models(recording, stated_white, stated_step, noisier, (conditional,))[0]
+
+
+def recording_noise_models(recording, stated_white=None, stated_step=None, noisier: bool = True,
+                           conditionals=(True, False)) -> tuple[NoiseEstimate, ...]:
+    """:func:`recording_noise` under each static quantisation model in *conditionals*, from one pass over the
+    samples (:func:`plansim.fit.noise.estimate_noise_models`)."""
     schedule = recording.schedule
     segments = _noise_segments(schedule)
-    return estimate_noise([np.asarray(recording.segment_samples(k), dtype=float) for k in segments],
-                          [schedule.segments[k] for k in segments], stated_white, stated_step, noisier, conditional)
+    return estimate_noise_models([np.asarray(recording.segment_samples(k), dtype=float) for k in segments],
+                                 [schedule.segments[k] for k in segments], stated_white, stated_step, noisier,
+                                 conditionals)
 
 
 def _refuse_constant_channels(recording) -> None:

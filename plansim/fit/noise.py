@@ -680,6 +680,25 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
     -------
     NoiseEstimate
     """
+    return estimate_noise_models(segment_samples, segments, stated_white, stated_step, noisier, (conditional,))[0]
+
+
+def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_white=None, stated_step=None,
+                          noisier: bool = True, conditionals=(True, False)) -> tuple[NoiseEstimate, ...]:
+    """:func:`estimate_noise` under each static quantisation model in *conditionals* (``conditional`` =
+    True/False there), from one pass over the samples: the channels' noise, the scatter and the level counts are
+    the samples', whatever the model of a static mean's quantisation error. ``plansim diagnose`` takes both (its
+    candidates' tests under the one, its lack of fit under the other).
+
+    Returns
+    -------
+    tuple of NoiseEstimate
+        One per entry of *conditionals*, in its order; they share ``channels`` and ``within_std``.
+    """
+    conditionals = tuple(conditionals)
+    if not conditionals or not all(isinstance(c, (bool, np.bool_)) for c in conditionals):
+        raise TypeError(f"conditionals = {conditionals!r}: expected one or more bools (True: a static mean's "
+                        "quantisation error given its level counts; False: over a level unknown within its step)")
     stated_q = np.zeros(6) if stated_step is None else np.nan_to_num(np.asarray(stated_step, dtype=float), nan=0.0)
     if stated_q.shape != (6,) or np.any(stated_q < 0):
         raise ValueError(f"stated_step: expected 6 steps >= 0 (gx gy gz ax ay az, SI; 0 or NaN: not stated), got "
@@ -766,9 +785,40 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
                 if ch.quantisation_step > 0 and static else [] for c, ch in enumerate(channels)]
     pooled = [{k: np.concatenate([segment_samples[r][:, c] for r in cluster]) for cluster in clusters[c]
                for k in cluster} for c in range(6)]
+    # (needed only for the error given the level counts: the one costly step, 0.35 s of 0.6 s on jjf2003)
     sigma_before = [quantised_noise_posterior(ch.quantisation_step, [pooled[c][cluster[0]] for cluster in clusters[c]],
                                               stated[c] * math.sqrt(rate) if np.isfinite(stated[c]) else None)
-                    if ch.quantisation_step > 0 and static else None for c, ch in enumerate(channels)]
+                    if ch.quantisation_step > 0 and static and any(conditionals) else None
+                    for c, ch in enumerate(channels)]
+    shared = _Shared(segment_samples, segments, tuple(channels), within, within_dof, shaken, rms, static,
+                     sigma_before, pooled, tuple(notes))
+    return tuple(_mean_variance(shared, bool(c)) for c in conditionals)
+
+
+@dataclass(frozen=True)
+class _Shared:
+    """What :func:`estimate_noise_models` takes from the samples once, whatever the quantisation model."""
+
+    segment_samples: list
+    segments: list
+    channels: tuple
+    within: np.ndarray
+    within_dof: np.ndarray
+    shaken: np.ndarray
+    rms: np.ndarray
+    static: list
+    sigma_before: list
+    pooled: list
+    notes: tuple
+
+
+def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
+    """The variance of each segment mean from the channels' noise model, a static mean's quantisation error given
+    its level counts (*conditional*) or over a level unknown within its step (:func:`estimate_noise`)."""
+    segment_samples, segments, channels = shared.segment_samples, shared.segments, shared.channels
+    within, within_dof, shaken, rms = shared.within, shared.within_dof, shared.shaken, shared.rms
+    static, sigma_before, pooled = shared.static, shared.sigma_before, shared.pooled
+    S = len(segments)
     variance = np.zeros((S, 6))
     variance_dof = np.full((S, 6), math.inf)
     quantisation = np.zeros((S, 6))
@@ -811,4 +861,4 @@ def estimate_noise(segment_samples: list[np.ndarray], segments, stated_white=Non
             variance[k, c] = total
             denominator = white**2 / white_dof + slow**2 / slow_dof
             variance_dof[k, c] = total**2 / denominator if denominator > 0 else math.inf
-    return NoiseEstimate(tuple(channels), within, variance, variance_dof, quantisation, dither, tuple(notes))
+    return NoiseEstimate(channels, within, variance, variance_dof, quantisation, dither, shared.notes)
