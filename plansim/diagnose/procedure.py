@@ -457,19 +457,23 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
             sizes[effect] = {"components": [n[len(effect) + 1:-1] for n in names],
                              "value": [float(after.extra.estimate[i]) for i in idx],
                              "u": [float(after.extra.u[i]) for i in idx], "unit": unit}
-    # where it sits: the step or the change of a parameter, whichever has the smaller p, when it is at least as
-    # telling as the omnibus test
-    pattern = [(x["p_value"], name, x) for name, x in (("step", lof_after.step), ("change", lof_after.change))
+    # where it sits: the step, the change of a parameter or the odd segment, whichever has the smallest p, when it is
+    # at least as telling as the omnibus test
+    pattern = [(x["p_value"], name, x) for name, x in (("step", lof_after.step), ("change", lof_after.change),
+                                                       ("outlier", lof_after.outlier))
                if x is not None and lof_after.flagged and x["p_value"] <= lof_after.omnibus_p_value]
     pattern = min(pattern, key=lambda item: item[0]) if pattern else (None, None, None)
     step = pattern[2] if pattern[1] == "step" else None
     change = pattern[2] if pattern[1] == "change" else None
+    outlier = pattern[2] if pattern[1] == "outlier" else None
     unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged),
                    "where": _where(lof_after_fit, lof_after) if lof_after.flagged else [],
                    "step": None if step is None else {**step, "unit": UNITS_SI[channel_kind(
                        CHANNELS.index(step["channel"]))]["mean"]},
                    "change": None if change is None else {**change, "unit": next(
                        q.si_unit for q in PARAMETERS if q.name == change["parameter"])},
+                   "outlier": None if outlier is None else {**outlier, "unit": UNITS_SI[channel_kind(
+                       CHANNELS.index(outlier["channel"]))]["mean"]},
                    "within_segments": [dict(item) for item in within.flagged],
                    "excess_scatter": _excess_scatter(after)}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
@@ -482,13 +486,14 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
 
 
 def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict | None:
-    """The lack of fit's step or change of a parameter in time that explains the residual clearly better than
-    candidate *best* does, or None.
+    """The lack of fit's step, change of a parameter in time or odd segment that explains the residual clearly better
+    than candidate *best* does, or None.
 
     The closed test names a significant candidate; but a feature outside the catalogue can make a candidate
     significant through the part of its signature they share (a y gyro's scale factor that changes after the y
     rate test moves the ω² test's y turn, which the y asymmetry also moves). Each family is compared with the
-    candidate's strongest component like with like — a step's profile likelihood ratio with the component's
+    candidate's strongest component like with like — a step's or an odd segment's profile likelihood ratio with the
+    component's
     (:func:`plansim.diagnose.scores._profile_likelihood_ratios`), a change's efficient score with the component's
     efficient score — and the family wins when it is significant at *alpha* and its statistic exceeds the
     component's by more than the family's own 1 − *alpha* null quantile (what the best of its many columns gains
@@ -498,10 +503,10 @@ def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict
     if not np.any(np.isfinite(values)):
         return None
     j = int(np.nanargmax(values))
-    for family, found in (("step", lof.step), ("change", lof.change)):
+    for family, found in (("step", lof.step), ("change", lof.change), ("outlier", lof.outlier)):
         if found is None or not found["p_value"] < alpha or family not in lof.margins:
             continue
-        mine = float(values[j] if family == "step" else best.component_efficient[j])
+        mine = float(best.component_efficient[j] if family == "change" else values[j])
         if found["statistic"] - mine > lof.margins[family]:
             return {"effect": best.effect, "component": best.components[j], "statistic": mine, "family": family,
                     "family_statistic": float(found["statistic"]), "margin": float(lof.margins[family]),
@@ -535,7 +540,9 @@ def diagnosis_json(d: Diagnosis) -> dict:
                 "step": None if x.step is None else {k: (_number(v) if isinstance(v, float) else v)
                                                      for k, v in x.step.items()},
                 "change": None if x.change is None else {k: (_number(v) if isinstance(v, float) else v)
-                                                         for k, v in x.change.items()}}
+                                                         for k, v in x.change.items()},
+                "outlier": None if x.outlier is None else {k: (_number(v) if isinstance(v, float) else v)
+                                                           for k, v in x.outlier.items()}}
 
     def side(fit, hold):
         return {"residual_rms": {k: _number(v) for k, v in _rms_per_channel(fit).items()},

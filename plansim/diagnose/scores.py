@@ -45,8 +45,16 @@ likelihood ratio with the channel's between-segment noise re-estimated under the
 through a run moves every later segment's mean: the omnibus test barely sees it, because the slow noise between
 segments, estimated from the same residuals, takes it up (a correlation time of 300 s and a σ of about half the
 step) — and so would a step score measured against that noise — while a step is one abrupt change where that noise
-changes little from one 30 s segment to the next. The two tests are held together at
-α by their min-p over the same draws (each draw's p-values its ranks among the draws).
+changes little from one 30 s segment to the next. The largest **change** of one parameter part-way through the
+run (:func:`change_columns`) is scored alike, and so is the **odd segment**: the one segment whose mean in one
+channel is most off the model (:func:`outlier_columns`, a column that moves that segment's mean alone; its profile
+likelihood ratio is the leave-one-segment-out residual's, with the channel's between-segment noise re-estimated
+without that segment). One segment far off — a rate the table did not hold, a pose knocked, a scale factor that
+holds only at some rates — is otherwise taken up by the between-segment noise, estimated from the residuals it
+is in, as noise "independent from segment to segment", and no other test sees it: a 5 % loss of the x gyro's
+scale factor at ±5 °/s alone (4.4e-3 rad/s, some 290 times a segment mean's u) left the omnibus at p = 0.11 and
+gx's between-segment noise at 69 times its samples' prediction. The tests are held together at α by their min-p
+over the same draws (each draw's p-values its ranks among the draws).
 
 **Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
 over the rate points of one axis are both even in ω). Which one the residual is attributed to is decided by each
@@ -136,8 +144,9 @@ class CandidateScore:
 @dataclass(frozen=True)
 class LackOfFit:
     """The segment-level lack of fit (module docstring): ``statistic`` and ``dof`` of the omnibus ‖r_w‖²,
-    ``p_value`` the family's (omnibus and step, min-p), ``flagged`` p_value < α; ``omnibus_p_value`` and
-    ``step`` (the largest step's statistic, p, channel, place and size) each against the simulated null;
+    ``p_value`` the family's (omnibus, step, change and odd segment, min-p), ``flagged`` p_value < α;
+    ``omnibus_p_value`` and ``step`` (the largest step's statistic, p, channel, place and size) each against the
+    simulated null;
     ``per_channel`` channel -> (statistic, dof, p) of the omnibus on the channel's rows."""
 
     statistic: float
@@ -150,10 +159,13 @@ class LackOfFit:
     #: the largest change of one parameter part-way through the run (:func:`change_columns`): its statistic, p,
     #: parameter, place and size (SI), or None
     change: dict | None = None
-    #: "step", "change" -> the 1 − α quantile of the family's largest statistic over the null draws: how much the
-    #: best of its many columns gains on noise alone (plansim.diagnose.procedure: whether it explains the residual
-    #: clearly better than a candidate)
+    #: "step", "change", "outlier" -> the 1 − α quantile of the family's largest statistic over the null draws: how
+    #: much the best of its many columns gains on noise alone (plansim.diagnose.procedure: whether it explains the
+    #: residual clearly better than a candidate)
     margins: dict = field(repr=False, default_factory=dict)
+    #: the segment whose mean in one channel is most off the model (:func:`outlier_columns`): its statistic, p,
+    #: channel, segment, label, time and size (SI), or None
+    outlier: dict | None = None
 
 
 #: what would separate each effect from what it aliases with, when it is not identifiable
@@ -460,6 +472,27 @@ def step_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     return (np.array(columns).T if columns else np.zeros((6 * S, 0))), where
 
 
+def outlier_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+    """The columns (6S, m) of one segment's mean off the model in one channel: for channel c and segment s, 1 on
+    c's fitted row of s alone; and each column's (channel, segment, segment) (indices into the fit's segments).
+    A channel left out of the step test (its means' noise an undithered quantiser's, :data:`UNDITHERED_SHARE`) is
+    left out here too. A segment the base model needs to identify a combination (one that cannot be held out) has
+    a column the base model spans, and :meth:`_Geometry.surviving` drops it."""
+    rows = np.asarray(fit.fitted_rows, dtype=bool)
+    S = rows.shape[0]
+    excluded = undithered_channels(fit)
+    columns, where = [], []
+    for c in range(6):
+        if c in excluded:
+            continue
+        for s in np.flatnonzero(rows[:, c]):
+            column = np.zeros((S, 6))
+            column[s, c] = 1.0
+            columns.append(column.ravel())
+            where.append((c, int(s), int(s)))
+    return (np.array(columns).T if columns else np.zeros((6 * S, 0))), where
+
+
 #: the grid of σ²·λ_max over which the step test profiles a channel's between-segment noise (0: none; then
 #: 10⁻² … 10⁴): the same grid for the data and every null draw, so a coarse grid costs a little power, not level
 STEP_PROFILE_GRID = np.concatenate([[0.0], np.logspace(-2.0, 4.0, 25)])
@@ -681,6 +714,24 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         ranks.append(rank)
         p_values.append(change["p_value"])
         margins["change"] = float(np.quantile(scored[1], 1 - alpha)) if B else math.inf
+    # the segment most off the model in one channel: the same profile likelihood ratio as the step's, for a column
+    # that moves one segment's mean alone (outlier_columns)
+    columns, where = outlier_columns(fit)
+    kept = g.surviving(columns, where) if columns.shape[1] else None
+    outlier = None
+    if kept is not None:
+        WS, where = kept
+        statistic, null_statistic, sizes = _profile_likelihood_ratios(fit, g, WS, np.array([w[0] for w in where]),
+                                                                      null)
+        null_statistic = null_statistic.max(axis=0)
+        found, rank = _largest(fit, statistic, null_statistic, sizes, where, B, lambda c: {"channel": CHANNELS[c]})
+        segment = where[int(np.argmax(statistic))][1]
+        outlier = {k: v for k, v in found.items() if k not in ("between", "labels")}
+        outlier.update(segment=int(fit.used[segment]), label=fit.labels[segment],
+                       at_s=float(fit.segment_times[segment]))
+        ranks.append(rank)
+        p_values.append(outlier["p_value"])
+        margins["outlier"] = float(np.quantile(null_statistic, 1 - alpha)) if B else math.inf
     p = p_omnibus
     if len(p_values) > 1:
         p = (1 + np.count_nonzero(np.min(ranks, axis=0) <= min(p_values))) / (B + 1)
@@ -692,7 +743,7 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
         Lc = float(np.sum(g.r[sel] ** 2))
         pc = (1 + np.count_nonzero(np.sum(null[sel] ** 2, axis=0) >= Lc)) / (B + 1)
         per_channel[name] = (Lc, int(sel.sum()), float(pc))
-    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change, margins)
+    return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change, margins, outlier)
 
 
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:

@@ -13,6 +13,9 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 from plansim.report.fit import OUTPUT_UNITS, _g, _kind
 
+#: what each family of the lack of fit's patterns is called in the report
+_FAMILY_NAMES = {"step": "step", "change": "change in time", "outlier": "odd segment"}
+
 
 def _p(value: float) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
@@ -79,7 +82,7 @@ def diagnose_report(d) -> str:
         lines.append("Found: no catalogue effect is named.")
     for item in d.not_named:
         lines.append(f"  {item['effect']}[{item['component']}] was significant but is not named: the "
-                     f"{'step' if item['family'] == 'step' else 'change in time'} below explains the residual "
+                     f"{_FAMILY_NAMES[item['family']]} below explains the residual "
                      f"clearly better (statistic {item['family_statistic']:.1f} against {item['statistic']:.1f}, "
                      f"more than the {item['margin']:.1f} its best column gains on noise alone)")
     after = d.lack_of_fit_after
@@ -100,6 +103,14 @@ def diagnose_report(d) -> str:
             lines.append(f"  a step in {step['channel']} of {step['size'] / factor:+.3g} {unit} between segment "
                          f"{step['between'][0]} {step['labels'][0]} and {step['between'][1]} {step['labels'][1]} "
                          f"(at about {step['at_s']:.0f} s; p = {_p(step['p_value'])})")
+        outlier = d.unexplained.get("outlier")
+        if outlier is not None:
+            c = CHANNELS.index(outlier["channel"])
+            unit, factor = OUTPUT_UNITS[_kind(c)]
+            lines.append(f"  one segment off in {outlier['channel']}: segment {outlier['segment']} {outlier['label']} "
+                         f"by {outlier['size'] / factor:+.3g} {unit} (at about {outlier['at_s']:.0f} s; "
+                         f"p = {_p(outlier['p_value'])}; the largest leave-one-segment-out residual, the "
+                         "between-segment noise re-estimated without it)")
         change = d.unexplained.get("change")
         if change is not None:
             spec = next(q for q in PARAMETERS if q.name == change["parameter"])
