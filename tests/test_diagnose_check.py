@@ -7,7 +7,13 @@ import json
 import numpy as np
 import pytest
 
-from plansim.checks.diagnose_check import _add_out_of_catalogue, case_seed, check_json, run_diagnose_check
+from plansim.checks.diagnose_check import (
+    _add_out_of_catalogue,
+    _middle_segment,
+    case_seed,
+    check_json,
+    run_diagnose_check,
+)
 from plansim.cli import main
 from plansim.io.scenario_file import load_scenario
 
@@ -43,7 +49,7 @@ def test_a_small_null_run_and_its_report(tmp_path, capsys):
 def test_the_effects_outside_the_catalogue_are_what_they_say():
     """A bias step from the middle sample on; a clock fast by ε reads nominal sample i·(1 + ε); a noise burst on gx
     over 40–50 % of the run with the stated sd (20 000 samples: the sample sd within 4 %, 5.7 of its standard
-    errors); a name outside the list is refused."""
+    errors); one segment's gx off by the size; a name outside the list is refused."""
     ramp = np.tile(np.arange(1000.0)[:, None], (1, 6))
     step = _add_out_of_catalogue("bias_step", ramp.copy(), 2.5, 0) - ramp
     assert np.all(step[:500] == 0) and np.all(step[500:, 0] == 2.5) and np.all(step[:, 1:] == 0)
@@ -61,6 +67,16 @@ def test_the_effects_outside_the_catalogue_are_what_they_say():
     scaled = _add_out_of_catalogue("scale_change", ramp.copy() + 7.0, 1e-3, 0, bias=7.0) - (ramp + 7.0)
     assert np.all(scaled[:500] == 0) and np.all(scaled[:, 1:] == 0)
     np.testing.assert_allclose(scaled[500:, 0], 1e-3 * ramp[500:, 0], rtol=1e-12)
+    # one segment's gx off: the segment that holds the middle sample, and nothing else
+    schedule = load_scenario("linear_gaussian").schedule
+    first, end = _middle_segment(schedule)
+    starts = np.cumsum([0] + [segment.samples for segment in schedule.segments])
+    assert first in starts and end in starts and first <= starts[-1] // 2 < end
+    total = int(starts[-1])
+    off = _add_out_of_catalogue("segment_offset", np.zeros((total, 6)), 0.5, 0, span=(first, end))
+    assert np.all(off[first:end, 0] == 0.5) and np.count_nonzero(off) == end - first
+    with pytest.raises(ValueError, match="span"):
+        _add_out_of_catalogue("segment_offset", np.zeros((10, 6)), 0.5, 0)
 
 
 def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(monkeypatch):

@@ -18,7 +18,8 @@ Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simul
   sample clock that runs fast by k × 100 ppm (the segment table, in nominal time, drifts off the data); a burst
   of extra white noise on gx over a tenth of the run, of k × its noise per sample; a change of the x gyro's scale
   factor half-way through, of k × the change that moves a segment at the schedule's largest rate by a gx segment
-  mean's standard uncertainty. And a lever arm of 5 mm on
+  mean's standard uncertainty; one segment's gx off (the segment that holds the middle sample: a rate the table
+  did not hold, a pose knocked), by k × the standard uncertainty of a gx segment mean. And a lever arm of 5 mm on
   the x accelerometer that the fit is not told (aliased with P in JJF 2003: it must never be attributed).
 
 ``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, the
@@ -57,7 +58,7 @@ FIELDS = {"gyro_scale_asymmetry": "gyro_asymmetry", "gyro_scale_nonlinearity": N
           "gyro_g2_sensitivity", "accel_quadratic": "accel_second_order", "lever_arm": "accel_lever_arm"}
 #: effects outside the catalogue, added to the samples (:func:`_add_out_of_catalogue`); the lever arm the fit is
 #: not told is run with the catalogue effects
-OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst", "scale_change")
+OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst", "scale_change", "segment_offset")
 #: the catalogue effects injected (the lever arm at a fixed 5 mm, the others at each size)
 CATALOGUE_CASES = ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
                    "bias_drift", "lever_arm")
@@ -275,7 +276,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 recording = simulate_and_record(unquantised, seed=s, trial=0)
                 _, _, truth = simulate_recording(scenario, s, 0)
                 samples = _add_out_of_catalogue(effect, np.array(recording.samples, dtype=float), size, s,
-                                                bias=float(truth[PARAMETER_INDEX["Bgx"]]))
+                                                bias=float(truth[PARAMETER_INDEX["Bgx"]]),
+                                                span=_middle_segment(recording.schedule))
                 recording = type(recording)(_acquire(scenario, samples), recording.schedule, dict(recording.attrs))
                 d, _ = _run(scenario, recording, truth, alpha, null_draws, s)
                 flagged += _alarm(d)
@@ -304,10 +306,20 @@ def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: f
     if effect == "scale_change":
         return (k * u_mean / max_rate, "1", "the change of the x gyro's scale factor that moves a segment at the "
                 "schedule's largest rate by a gx segment mean's standard uncertainty")
+    if effect == "segment_offset":
+        return k * u_mean, "rad/s", "the standard uncertainty of a gx segment mean (the fit's V)"
     raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
 
 
-def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: int, bias: float = 0.0) -> np.ndarray:
+def _middle_segment(schedule) -> tuple[int, int]:
+    """The (first, end) sample of the segment that holds the recording's middle sample."""
+    starts = np.cumsum([0] + [segment.samples for segment in schedule.segments])
+    k = int(np.searchsorted(starts, starts[-1] // 2, side="right") - 1)
+    return int(starts[k]), int(starts[k + 1])
+
+
+def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: int, bias: float = 0.0,
+                          span: tuple[int, int] | None = None) -> np.ndarray:
     """The samples (n, 6) with an out-of-catalogue effect of *size* (:func:`_out_of_catalogue_size`) added.
 
     ``bias_step``: gx + size from the middle sample on. ``clock_fast``: the sensor's clock runs fast by the
@@ -315,6 +327,8 @@ def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: i
     the segment table, in nominal time, drifts off the data by up to size × the run). ``noise_burst``: white
     noise of sd *size* added to gx over a tenth of the run, from 40 % of it. ``scale_change``: the x gyro's scale
     factor grows by the relative *size* from the middle sample on (gx − *bias*, the unit's Bgx, times *size* added).
+    ``segment_offset``: gx + size over one segment's samples, *span* = (first, end) (the segment that holds the
+    middle sample: :func:`_middle_segment`) — a rate the table did not hold, a pose knocked.
     """
     n = samples.shape[0]
     if effect == "bias_step":
@@ -328,6 +342,11 @@ def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: i
         samples[start:stop, 0] += size * np.random.default_rng(seed).standard_normal(stop - start)
     elif effect == "scale_change":
         samples[n // 2:, 0] += size * (samples[n // 2:, 0] - bias)
+    elif effect == "segment_offset":
+        if span is None or not 0 <= span[0] < span[1] <= n:
+            raise ValueError(f"span = {span!r}: segment_offset needs the (first, end) sample of one segment, "
+                             f"within the {n} samples")
+        samples[span[0]:span[1], 0] += size
     else:
         raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
     return samples

@@ -74,7 +74,7 @@ def add_commands(sub) -> None:
     p.add_argument("--effects", default=None, metavar="E1,E2",
                    help="the injected effects to run, comma-separated (default all: gyro_scale_asymmetry, "
                         "gyro_scale_nonlinearity, gyro_g2_sensitivity, accel_quadratic, bias_drift, lever_arm, "
-                        "bias_step, clock_fast, noise_burst, scale_change); the nulls always run")
+                        "bias_step, clock_fast, noise_burst, scale_change, segment_offset); the nulls always run")
     p.add_argument("--alpha", type=float, default=0.05)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--null-draws", type=int, default=500, help="simulated null draws per test (default 500)")
