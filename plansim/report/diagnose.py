@@ -17,6 +17,11 @@ from plansim.report.fit import OUTPUT_UNITS, _g, _kind
 _FAMILY_NAMES = {"step": "step", "change": "change in time", "outlier": "odd segment"}
 
 
+def _display_unit(channel: str) -> tuple[str, float]:
+    """The display unit of a channel's segment means (°/h, µg) and its size in SI."""
+    return OUTPUT_UNITS[_kind(CHANNELS.index(channel))]
+
+
 def _p(value: float) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
 
@@ -30,8 +35,7 @@ def _within_lines(d) -> list[str]:
     lines = [f"UNEXPLAINED within segments (level {w.alpha:g}, family-wise over {len(w.segments)} segments, "
              "6 channels and 5 tests): not named after any catalogue effect"]
     for item in w.flagged[:12]:
-        c = CHANNELS.index(item["channel"])
-        unit, factor = OUTPUT_UNITS[_kind(c)]
+        unit, factor = _display_unit(item["channel"])
         test = item["test"]
         if test == "trend":
             what = f"trend {item['slope'] / factor:+.3g} {unit}/s"
@@ -91,22 +95,19 @@ def diagnose_report(d) -> str:
         lines.append(f"UNEXPLAINED residual after the refit (p = {_p(after.p_value)}): not named after any "
                      "catalogue effect; where it sits:")
         for where in d.unexplained["where"]:
-            c = CHANNELS.index(where["channel"])
-            unit, factor = OUTPUT_UNITS[_kind(c)]
+            unit, factor = _display_unit(where["channel"])
             segs = "; ".join(f"{s['segment']} {s['label']} ({s['residual'] / factor:+.3g} {unit}, z = {s['z']:+.1f})"
                              for s in where["segments"]) or "spread over the segments, none beyond 3u"
             lines.append(f"  {where['channel']} (p = {_p(where['p_value'])}): {segs}")
         step = d.unexplained.get("step")
         if step is not None:
-            c = CHANNELS.index(step["channel"])
-            unit, factor = OUTPUT_UNITS[_kind(c)]
+            unit, factor = _display_unit(step["channel"])
             lines.append(f"  a step in {step['channel']} of {step['size'] / factor:+.3g} {unit} between segment "
                          f"{step['between'][0]} {step['labels'][0]} and {step['between'][1]} {step['labels'][1]} "
                          f"(at about {step['at_s']:.0f} s; p = {_p(step['p_value'])})")
         outlier = d.unexplained.get("outlier")
         if outlier is not None:
-            c = CHANNELS.index(outlier["channel"])
-            unit, factor = OUTPUT_UNITS[_kind(c)]
+            unit, factor = _display_unit(outlier["channel"])
             lines.append(f"  one segment off in {outlier['channel']}: segment {outlier['segment']} {outlier['label']} "
                          f"by {outlier['size'] / factor:+.3g} {unit} (at about {outlier['at_s']:.0f} s; "
                          f"p = {_p(outlier['p_value'])}; the largest leave-one-segment-out residual, the "
@@ -124,8 +125,7 @@ def diagnose_report(d) -> str:
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
     for item in excess:
-        c = CHANNELS.index(item["channel"])
-        unit, factor = OUTPUT_UNITS[_kind(c)]
+        unit, factor = _display_unit(item["channel"])
         lines.append(f"  EXCESS SCATTER in {item['channel']}: its segment means scatter {item['ratio']:.3g} times what "
                      f"its samples predict ({item['between_sd'] / factor:.3g} against "
                      f"{item['predicted_sd'] / factor:.3g} {unit}, correlated over {item['correlation_time_s']:g} s)")
