@@ -500,7 +500,8 @@ STEP_PROFILE_GRID = np.concatenate([[0.0], np.logspace(-2.0, 4.0, 25)])
 
 def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list, null: np.ndarray):
     """The profile likelihood ratio of a step in one channel's level, for each step column, on the data and on
-    every null draw; ``None`` if no column survives the base model.
+    every null draw; ``None`` if no column survives the base model. Any column that lives in one channel's rows,
+    *where* giving its channel first, is scored the same way: the odd segment's too (:func:`outlier_columns`).
 
     A bias that jumps part-way through a run puts a step into the residuals, and the between-segment noise the
     base fit estimates from those same residuals (:func:`plansim.fit.joint.between_segment_noise`: a term of
@@ -717,14 +718,11 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     # the segment most off the model in one channel: the same profile likelihood ratio as the step's, for a column
     # that moves one segment's mean alone (outlier_columns)
     columns, where = outlier_columns(fit)
-    kept = g.surviving(columns, where) if columns.shape[1] else None
+    profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
     outlier = None
-    if kept is not None:
-        WS, where = kept
-        statistic, null_statistic, sizes = _profile_likelihood_ratios(fit, g, WS, np.array([w[0] for w in where]),
-                                                                      null)
-        null_statistic = null_statistic.max(axis=0)
-        found, rank = _largest(fit, statistic, null_statistic, sizes, where, B, lambda c: {"channel": CHANNELS[c]})
+    if profiled is not None:
+        statistic, null_statistic, _, where = profiled
+        found, rank = _largest(fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
         segment = where[int(np.argmax(statistic))][1]
         outlier = {k: v for k, v in found.items() if k not in ("between", "labels")}
         outlier.update(segment=int(fit.used[segment]), label=fit.labels[segment],
