@@ -44,6 +44,7 @@ from scipy.stats import binom
 from plansim.config import parse_scenario
 from plansim.diagnose.procedure import diagnose
 from plansim.fit import resolve_site, scenario_fit_options
+from plansim.io.recording_data import segment_first_samples
 from plansim.io.scenario_file import apply_overrides
 from plansim.kernels.layout import ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP
 from plansim.kernels.quantiser import quantise
@@ -313,9 +314,10 @@ def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: f
 
 def _middle_segment(schedule) -> tuple[int, int]:
     """The (first, end) sample of the segment that holds the recording's middle sample."""
-    starts = np.cumsum([0] + [segment.samples for segment in schedule.segments])
-    k = int(np.searchsorted(starts, starts[-1] // 2, side="right") - 1)
-    return int(starts[k]), int(starts[k + 1])
+    first = segment_first_samples(schedule)
+    middle = (first[-1] + schedule.segments[-1].samples) // 2
+    k = int(np.searchsorted(first, middle, side="right") - 1)
+    return int(first[k]), int(first[k] + schedule.segments[k].samples)
 
 
 def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: int, bias: float = 0.0,
