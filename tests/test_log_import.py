@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from plansim.cli import main
+from plansim.estimate.segmentation import segment_log
 from plansim.io.log_import import MAX_PREAMBLE_LINES, import_log, parse_offset, parse_scale, parse_units
 from plansim.io.recording import nominal_time, read_recording, write_recording
 from plansim.io.scenario_file import load_scenario
@@ -361,6 +362,64 @@ def test_flawed_logs_import_with_named_warnings(tmp_path):
     write_synthetic(log, t + rng.uniform(-0.0015, 0.0015, t.size), x)
     result = import_log(log, time_column="time", sample_rate=102.0)
     assert {w.name for w in result.warnings} == {"jitter", "sample_rate_mismatch"}
+
+
+def test_a_declared_full_scale_finds_a_steady_turn_held_at_the_rail(tmp_path, capsys):
+    """A turn held beyond the gyro's range reads as a steady turn at the rail: quiet, in one pose, at one level,
+    as a table holding that rate would read. From the data alone it cannot be told (step 10 of
+    plansim.estimate.segmentation): the turn is taken as a rotation by the wrong angle. With --full-scale the rail
+    is known: every sample at it is saturated, the turn is a move, and the warning names the full scale. A single
+    clipped sample of a fast peak is found too, and a log that reads beyond its declared full scale is refused."""
+    fs = 100.0
+    rng = np.random.default_rng(3)
+    n_rest, n_ramp, n_hold = 400, 50, 300
+    n = 2 * n_rest + 2 * n_ramp + n_hold
+    x = rng.normal(size=(n, 6)) * np.r_[[0.1] * 3, [0.01] * 3]  # gyros in deg/s
+    x[:, 5] += 9.81
+    x[:, :3] += [0.3, -0.2, 0.1]
+    true_rate = 250.0  # deg/s, for a +/-200 deg/s gyro
+    profile = np.concatenate([np.linspace(0, true_rate, n_ramp), np.full(n_hold, true_rate),
+                              np.linspace(true_rate, 0, n_ramp)])
+    x[n_rest:n_rest + profile.size, 2] += profile
+    x[:, 2] = np.minimum(x[:, 2], 200.0)  # the converter's rail
+    t = np.arange(n) / fs
+    log = tmp_path / "log.csv"
+    write_synthetic(log, t, x)
+    out = str(tmp_path / "rec.nc")
+    # without the full scale, the clipped turn is a rotation by the clipped angle
+    blind = import_log(log, time_column="time", units="deg/s,m/s^2")
+    assert "saturated" not in [w.name for w in blind.warnings]
+    turned = math.degrees(float(blind.segmentation.of_kind("rotation")[0].integrated[2]))
+    assert turned < 0.9 * profile.sum() / fs  # the angle the table turned, lost at the rail
+    # with it, the turn is a move, and the recording notes the full scale
+    assert main(["import", str(log), "--out", out, "--time", "time", "--units", "deg/s,m/s^2",
+                 "--full-scale", "200,16"]) == 0
+    text = capsys.readouterr().out
+    assert "at its full scale of 200 deg/s (--full-scale)" in text
+    notes = read_recording(out).schedule.notes["import"]
+    assert notes["full_scale"] == {"gx": 200.0, "gy": 200.0, "gz": 200.0, "ax": 16.0, "ay": 16.0, "az": 16.0}
+    assert notes["saturation_rule"].startswith("declared full scale")
+    known = import_log(log, time_column="time", units="deg/s,m/s^2", full_scale="200,16")
+    assert known.segmentation.of_kind("rotation") == []
+    assert any("saturated" in span.reason for span in known.segmentation.of_kind("move"))
+    (stretch,) = known.segmentation.saturation
+    assert stretch.channel == 2 and stretch.stop - stretch.start >= n_hold
+    # one clipped sample of a fast peak, in a turn that never holds the rail
+    peak = x.copy()
+    peak[:, 2] = np.minimum(peak[:, 2], 150.0)
+    peak[n_rest + 60, 2] = 200.0
+    write_synthetic(log, t, peak)
+    found = import_log(log, time_column="time", units="deg/s,m/s^2", full_scale="200,16").segmentation.saturation
+    assert [(s.channel, s.start, s.stop) for s in found] == [(2, n_rest + 60, n_rest + 61)]
+    # a log that reads beyond its declared full scale, a full scale that is not positive, the wrong count
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--units", "deg/s,m/s^2",
+                                    "--full-scale", "100,16"], "channel gz (gz) reads 200 deg/s at line")
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--full-scale", "0,16"],
+                 "--full-scale '0,16': '0' for channel gx; expected a positive full scale in the channel's unit")
+    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--full-scale", "1,2,3"],
+                 "--full-scale '1,2,3': 3 entries; expected 2")
+    with pytest.raises(ValueError, match=r"full_scale = \[1.0, -1.0, .*expected 6 positive numbers"):
+        segment_log(x, None, fs, full_scale=[1.0, -1.0, 1.0, 1.0, 1.0, 1.0])
 
 
 def test_a_time_column_in_another_unit_and_a_dead_channel_are_named(tmp_path, capsys):

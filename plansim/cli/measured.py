@@ -25,7 +25,7 @@ def _cmd_import(args) -> int:
     result = import_log(args.log, columns=columns, time_column=args.time, time_unit=args.time_unit,
                         units=args.units, scale=args.scale, offset=args.offset, sample_rate=args.sample_rate,
                         temperature_column=args.temperature_column, temperature=args.temperature,
-                        latitude=args.latitude, height=args.height, **options)
+                        latitude=args.latitude, height=args.height, full_scale=args.full_scale, **options)
     write_recording(result.recording, args.out)  # whole or not at all
     print(format_summary(result))
     print(f"\nwrote recording: {args.out} (review its segment table: docs/measured-data.md)")
@@ -33,6 +33,8 @@ def _cmd_import(args) -> int:
 
 
 def _add_import_command(sub) -> None:
+    from plansim.estimate.segmentation import FULL_SCALE_MARGIN
+
     p = sub.add_parser(
         "import", help=COMMANDS["import"],
         description="Read a plain CSV log (six channels; a time column or a sample rate) and write a recording "
@@ -61,6 +63,11 @@ def _add_import_command(sub) -> None:
                         "divides (e.g. 32768,32768 for an unsigned 16-bit converter)")
     p.add_argument("--sample-rate", type=float, default=None, metavar="HZ",
                    help="sample rate; required without --time (default: from the time column)")
+    p.add_argument("--full-scale", default=None, metavar="GYRO,ACCEL",
+                   help="the sensor's full scale (the largest magnitude it reads) in --units, gyro,accelerometer or "
+                        "one per channel (e.g. 2000,16 with --units deg/s,g): every sample within "
+                        f"{FULL_SCALE_MARGIN * 100:g} %% of it is at the rail, a steady turn held there included. "
+                        "Default: a rail is looked for in the data")
     p.add_argument("--temperature-column", default=None, metavar="COL", help="a temperature column in degC")
     p.add_argument("--temperature", type=float, default=None, metavar="DEGC",
                    help="the lab's temperature, for a log without a temperature column (default 20, noted as assumed)")

@@ -70,6 +70,9 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
     move's smooth peak falls between two samples, which then read alike whatever its curvature (a 16-bit
     log's 75.7 °/s peak, far inside its ±2000 °/s, was taken for a rail). A rate held beyond the range for a
     whole steady turn reads as a steady turn at the rail value; no detector can tell it from the data alone.
+    Where the channel's **full scale is declared** (``full_scale``), the rule is that instead: every sample at or
+    beyond ``1 − FULL_SCALE_MARGIN`` of the full scale in magnitude is at the rail, one sample or many, in a pose
+    or in a turn — a steady turn held at the rail included.
 
 Every threshold is a multiple of the log's own noise; the multiples are module constants, chosen by
 simulation (tests/test_segmentation.py measures their false alarms on static noise of several kinds).
@@ -131,6 +134,10 @@ COARSE_CLOCK_FACTOR = 1.05
 SATURATION_STEP = 5.0
 #: equal samples in a row at a channel's extreme that make a rail on their own (step 10)
 SATURATION_RUN = 3
+#: a sample within this fraction of a channel's declared full scale, or beyond it, is at the rail (step 10). A
+#: converter's rail is not its part's nominal range: a "±2000 °/s" 16-bit gyro at its nominal 16.4 LSB/(°/s) tops
+#: out at 32767 / 16.4 = 1998.0 °/s, 0.1 % below it
+FULL_SCALE_MARGIN = 5e-3
 #: robust standard deviation from the median absolute deviation of a normal distribution
 MAD_TO_SIGMA = 1.482602218505602
 
@@ -412,7 +419,7 @@ def _quiet_stretch(ratio: np.ndarray, length: int, blocked: np.ndarray) -> int:
 
 def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float, *,
                 window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
-                gap_starts: np.ndarray | None = None) -> Segmentation:
+                gap_starts: np.ndarray | None = None, full_scale: np.ndarray | None = None) -> Segmentation:
     """Find the static spans of a log and classify the motion between them (see the module docstring).
 
     Parameters
@@ -429,6 +436,9 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         Shortest static span, s.
     gap_starts : (G,) int array or None
         Samples that follow a gap in the time axis (:func:`analyse_time`); windows do not reach across them.
+    full_scale : (6,) array or None
+        Each channel's full scale (the largest magnitude it can read), rad/s or m/s²; NaN where not known,
+        ``None``: none known. A declared full scale replaces the detector of step 10 for its channel.
 
     Returns
     -------
@@ -449,6 +459,11 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     for name, value in (("window", window), ("min_static", min_static)):
         if not (value > 0 and math.isfinite(value)):
             raise ValueError(f"{name} = {value!r} s; expected a positive number of seconds")
+    if full_scale is not None:
+        full_scale = np.asarray(full_scale, dtype=np.float64)
+        if full_scale.shape != (6,) or not np.all(np.isnan(full_scale) | ((full_scale > 0) & np.isfinite(full_scale))):
+            raise ValueError(f"full_scale = {full_scale.tolist()!r}; expected 6 positive numbers (rad/s for gx gy gz, "
+                             "m/s^2 for ax ay az), NaN where not known")
     n = x.shape[0]
     w = max(MIN_WINDOW_SAMPLES, int(round(window * sample_rate)))
     half = w // 2
@@ -558,7 +573,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         # a pose joined from pieces holds the samples between them too (at most a window of them)
         statics.append(Span("static", a, b, m, up=up, tilt=tilt,
                             orientation="approximate" if tilt <= APPROXIMATE_TILT else "unknown", held=shake))
-    saturation = _saturation(x, statics, steady, sigma, step)
+    saturation = _saturation(x, statics, steady, sigma, step, full_scale)
     spans: list[Span] = []
     previous = None
     for span in statics + [None]:
@@ -678,13 +693,17 @@ def _sigma(variance: np.ndarray, w: int, floor: np.ndarray) -> np.ndarray:
 
 
 def _saturation(x: np.ndarray, statics: list[Span], steady: list[tuple[int, int]], sigma: np.ndarray,
-                step: np.ndarray) -> list[Saturation]:
+                step: np.ndarray, full_scale: np.ndarray | None = None) -> list[Saturation]:
     """Stretches stuck at a rail: see step 10 of the module docstring."""
     at_rest = np.zeros(x.shape[0], dtype=bool)
     for span in statics:
         at_rest[span.start:span.stop] = True
     found = []
     for c in range(6):
+        if full_scale is not None and not np.isnan(full_scale[c]):  # the rail is known: every sample at it
+            for a, b in _runs(np.abs(x[:, c]) >= (1.0 - FULL_SCALE_MARGIN) * full_scale[c]):
+                found.append(Saturation(c, a, b, float(x[a + int(np.argmax(np.abs(x[a:b, c]))), c])))
+            continue
         # the levels the channel holds while quiet (at rest or turning steadily) are not rails
         levels = np.array([span.mean[c] for span in statics] + [float(x[a:b, c].mean()) for a, b in steady])
         margin = SATURATION_STEP * sigma[c] + step[c]

@@ -29,6 +29,7 @@ from plansim.estimate.segmentation import (
     DEFAULT_MIN_STATIC,
     DEFAULT_WINDOW,
     DROPPED_MAX,
+    FULL_SCALE_MARGIN,
     Segmentation,
     Span,
     TimeReport,
@@ -64,6 +65,10 @@ _BLOCK_ROWS = 65536
 LAB_TEMPERATURE = (-100.0, 200.0)
 #: the temperature assumed for each segment when the log has no temperature channel, degC
 DEFAULT_TEMPERATURE = 20.0
+#: a sample more than this fraction beyond its channel's declared full scale is an error: a sensor cannot read
+#: beyond its rail, so the full scale or the units are wrong (the margin allows a converter whose rail lies a little
+#: beyond its part's nominal range)
+FULL_SCALE_EXCEEDED = 0.02
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
@@ -171,7 +176,15 @@ def parse_offset(text: str | None) -> tuple[float, ...] | None:
     return _per_channel(text, "--offset", "counts at zero input of the gyros, of the accelerometers", positive=False)
 
 
-def _per_channel(text: str | None, option: str, pair: str, positive: bool) -> tuple[float, ...] | None:
+def parse_full_scale(text: str | None) -> tuple[float, ...] | None:
+    """Each channel's full scale from ``--full-scale``, in the channels' ``--units`` (not counts): two entries
+    (gyros, accelerometers) or six; ``None``: not known (the rail is then looked for in the data)."""
+    return _per_channel(text, "--full-scale", "gyro full scale, accelerometer full scale", positive=True,
+                        allowed="a positive full scale in the channel's unit (--units)")
+
+
+def _per_channel(text: str | None, option: str, pair: str, positive: bool,
+                 allowed: str = "a positive number of counts per unit") -> tuple[float, ...] | None:
     """Two entries (gyros, accelerometers) or six numbers of *option*; ``None`` when not given."""
     if text is None:
         return None
@@ -187,8 +200,8 @@ def _per_channel(text: str | None, option: str, pair: str, positive: bool) -> tu
         except ValueError:
             raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]} is not a number") from None
         if not math.isfinite(value) or (positive and not value > 0):
-            allowed = "a positive number of counts per unit" if positive else "a finite number of counts"
-            raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]}; expected {allowed}")
+            expected = allowed if positive else "a finite number of counts"
+            raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]}; expected {expected}")
         values.append(value)
     return tuple(values)
 
@@ -428,7 +441,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                time_unit: str = "s", units: str | None = None, scale: str | None = None,
                offset: str | None = None, sample_rate: float | None = None, temperature_column: str | None = None,
                temperature: float | None = None, latitude: float | None = None, height: float | None = None,
-               window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC) -> ImportResult:
+               window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
+               full_scale: str | None = None) -> ImportResult:
     """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
 
     Parameters
@@ -460,6 +474,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         The site, deg and m, written as ``site_latitude_deg`` and ``site_height_m``.
     window, min_static : float
         The detector's window and shortest static span, s.
+    full_scale : str or None
+        ``--full-scale``: each channel's full scale (the largest magnitude it reads) in ``units``, two or six
+        entries; a sample within :data:`plansim.estimate.segmentation.FULL_SCALE_MARGIN` of it is at the rail.
+        ``None``: a rail is looked for in the data (step 10 of :mod:`plansim.estimate.segmentation`).
 
     Raises
     ------
@@ -474,6 +492,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         raise ValueError(f"--scale {scale!r} needs --units: say which unit the counts are per (e.g. --units "
                          "deg/s,g)")
     zero_counts = parse_offset(offset)
+    rails = parse_full_scale(full_scale)
     if zero_counts is not None and counts_per_unit is None:
         raise ValueError(f"--offset {offset!r} needs --scale (and --units): the offset is in counts")
     if time_unit not in TIME_UNITS:
@@ -511,6 +530,15 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     divisors = np.ones(6) if counts_per_unit is None else np.array(counts_per_unit)
     offsets = np.zeros(6) if zero_counts is None else np.array(zero_counts)
     samples = (table.channels - offsets) / divisors * factors
+    rail_si = None if rails is None else np.array(rails) * factors
+    if rail_si is not None:  # a sensor cannot read beyond its rail: the full scale (or the units) are wrong
+        for c in range(6):
+            k = int(np.argmax(np.abs(samples[:, c])))
+            if abs(samples[k, c]) > (1.0 + FULL_SCALE_EXCEEDED) * rail_si[c]:
+                raise ValueError(f"--full-scale {full_scale!r}: channel {CHANNELS[c]} ({table.names[c]}) reads "
+                                 f"{samples[k, c] / factors[c]:.6g} {unit_names[c]} at line {table.lines[k]}, beyond "
+                                 f"its full scale of {rails[c]:g} {unit_names[c]}; expected the range the sensor "
+                                 "reads (in --units), e.g. 2000,16 with --units deg/s,g")
 
     warnings: list[LogWarning] = []
     time_s = None
@@ -572,7 +600,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                            "changes"))
 
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
-                               gap_starts=timing.gap_starts)
+                               gap_starts=timing.gap_starts, full_scale=rail_si)
     statics = segmentation.of_kind("static")
     at_rest = float(np.median([np.linalg.norm(span.mean[3:]) for span in statics]))
     if abs(at_rest / STANDARD_GRAVITY - 1.0) > GRAVITY_TOLERANCE:
@@ -585,9 +613,17 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     for s in segmentation.saturation:
         first, last = table.lines[s.start], table.lines[s.stop - 1]
         shown = s.value / factors[s.channel] * divisors[s.channel] + offsets[s.channel]  # as the file has it
-        warnings.append(LogWarning("saturated", f"channel {CHANNELS[s.channel]} ({table.names[s.channel]}) stuck at "
-                                                f"{shown:.6g} (its extreme) on lines {first}-{last}: a rail? A turn "
-                                                "over it has no angle"))
+        channel = f"channel {CHANNELS[s.channel]} ({table.names[s.channel]})"
+        pose = next((span for span in statics if span.start < s.stop and s.start < span.stop), None)
+        in_pose = ("" if pose is None else f"; inside the static pose on lines {table.lines[pose.start]}-"
+                   f"{table.lines[pose.stop - 1]}, whose mean it clips: remove that segment from the table")
+        if rails is None:
+            text = (f"{channel} stuck at {shown:.6g} (its extreme) on lines {first}-{last}: a rail? A turn over it "
+                    "has no angle")
+        else:
+            text = (f"{channel} reads {shown:.6g}, at its full scale of {rails[s.channel]:g} {unit_names[s.channel]} "
+                    f"(--full-scale), on lines {first}-{last}: a turn over it has no angle")
+        warnings.append(LogWarning("saturated", text + in_pose))
     for span in statics:
         if span.orientation == "unknown":
             warnings.append(LogWarning("tilted_pose", f"the static span on lines {table.lines[span.start]}-"
@@ -637,6 +673,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "units": dict(zip(CHANNELS, unit_names)),
         "counts_per_unit": None if counts_per_unit is None else dict(zip(CHANNELS, counts_per_unit)),
         "zero_offset_counts": None if zero_counts is None else dict(zip(CHANNELS, zero_counts)),
+        "full_scale": None if rails is None else dict(zip(CHANNELS, rails)),
+        "saturation_rule": ("declared full scale (--full-scale): a sample within "
+                            f"{FULL_SCALE_MARGIN:.1%} of it" if rails is not None
+                            else "found in the data (no --full-scale): a stretch stuck at a channel's extreme"),
         "preamble": list(table.preamble),
         "header": table.has_header,
         "time_column": table.time_column,
