@@ -191,9 +191,9 @@ def _excess_scatter(fit) -> list[dict]:
 def _where(fit, lof: LackOfFit) -> list[dict]:
     """Where a remaining residual sits: the channels whose own lack of fit is significant (p below
     :data:`WHERE_LEVEL` over the number of channels tested, Bonferroni: at 0.05 each, one of five channels the
-    residual does not touch is listed with probability 1 − 0.95⁵ ≈ 23 %; on four jjf2003 recordings with one gx
-    segment far off, such a channel was listed in all four, and gx, whose omnibus the between-segment noise had
-    taken up, in none), and their segments with |r|/u > :data:`WHERE_Z`, largest first."""
+    residual does not touch is listed with probability 1 − 0.95⁵ ≈ 23 %), and their segments with
+    |r|/u > :data:`WHERE_Z`, largest first. A channel's own lack of fit sums its rows of the residual whitened by
+    V's symmetric root (:attr:`plansim.diagnose.scores._Geometry.to_rows`)."""
     out = []
     z = fit.residuals / fit.residual_sd
     level = WHERE_LEVEL / max(len(lof.per_channel), 1)

@@ -202,6 +202,12 @@ class _Geometry:
             values, vectors = np.linalg.eigh(V)
         self.V_root = vectors * np.sqrt(np.maximum(values, 0.0))  # V = V_root V_rootᵀ
         self.channel_of_row = np.tile(np.arange(6), fit.observed.shape[0])[rows]
+        # W = Λ^{-1/2} Uᵀ (on the fitted rows: plansim.fit.joint.whitening) whitens along V's eigenvectors, so an
+        # entry of r_w is not one segment's channel; U r_w is the residual whitened by V's symmetric root
+        # U Λ^{-1/2} Uᵀ, whose entries are the fitted rows (a channel's rows exactly when V does not couple
+        # channels, nearly when it does): what a statistic over one channel's rows must sum
+        fitted_columns = self.W[:, rows]
+        self.to_rows = (fitted_columns / np.linalg.norm(fitted_columns, axis=1)[:, None]).T
         #: P⊥ W V^{1/2}: a whitened residual's noise is this times a standard normal vector
         self.noise_map = self.project(self.W @ self.V_root)
 
@@ -734,12 +740,13 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     if len(p_values) > 1:
         p = (1 + np.count_nonzero(np.min(ranks, axis=0) <= min(p_values))) / (B + 1)
     per_channel = {}
+    r_rows, null_rows = g.to_rows @ g.r, g.to_rows @ null  # the fitted rows' own entries (_Geometry.to_rows)
     for c, name in enumerate(CHANNELS):
         sel = g.channel_of_row == c
         if not np.any(sel):
             continue
-        Lc = float(np.sum(g.r[sel] ** 2))
-        pc = (1 + np.count_nonzero(np.sum(null[sel] ** 2, axis=0) >= Lc)) / (B + 1)
+        Lc = float(np.sum(r_rows[sel] ** 2))
+        pc = (1 + np.count_nonzero(np.sum(null_rows[sel] ** 2, axis=0) >= Lc)) / (B + 1)
         per_channel[name] = (Lc, int(sel.sum()), float(pc))
     return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change, margins, outlier)
 
