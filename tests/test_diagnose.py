@@ -15,12 +15,13 @@ import pytest
 from scipy.stats import binom
 
 from plansim.cli import main
+from plansim.config import parse_scenario
 from plansim.diagnose.catalogue import EFFECTS, signatures
 from plansim.diagnose.procedure import diagnose, diagnosis_json, levels
-from plansim.diagnose.scores import lack_of_fit, null_residuals, score_candidates
+from plansim.diagnose.scores import coupled_null_residuals, lack_of_fit, score_candidates
 from plansim.fit import fit_recording, recording_noise, resolve_site
 from plansim.io.recording import write_recording
-from plansim.io.scenario_file import load_scenario
+from plansim.io.scenario_file import apply_overrides, load_scenario
 from plansim.model.parameters import PARAMETER_NAMES
 from plansim.report.diagnose import diagnose_report
 from plansim.runner import simulate_and_record
@@ -206,25 +207,67 @@ def test_false_alarms_over_many_null_recordings():
 
 def test_the_lack_of_fit_is_tested_under_the_error_given_the_level_counts():
     """Step 1 of docs/closing-the-loop.md: the candidates take each static mean's quantisation error over a level
-    unknown within its step; the segment-level lack of fit takes it given the level counts (plansim fit's), the
+    unknown within its step; the segment-level omnibus takes it given the level counts (plansim fit's), the
     model under which that family held its share over 1000 jjf2003 nulls (7 base, 8 final, on 12.5 each; 29 and 24
-    under the other). On a jjf2003 recording, whose 12-bit accelerometers the noise does not dither, the two
-    models give different statistics, and the reported lack of fit is the one given the counts."""
+    under the other). The step, the change and the odd segment are scored on the candidates' fit, their null draws
+    coupled with the omnibus's (one ξ, each fit's symmetric root of V). On a jjf2003 recording, whose 12-bit
+    accelerometers the noise does not dither, the two models give different omnibus statistics; the reported
+    omnibus is the one given the counts, the reported step the candidates' fit's, and the family's p their min-p
+    over the coupled draws."""
     scenario = load_scenario("jjf2003")
     recording = simulate_and_record(scenario, seed=5, trial=0)
     site, lever = resolve_site(scenario=scenario), scenario.effects.accel_lever_arm
     d = diagnose(recording, site, scenario.turntable, lever_arm=lever, null_draws=200, seed=3)
-
-    def lack_of_fit_under(conditional):
-        noise = recording_noise(recording, None, None, noisier=False, conditional=conditional)
-        fit = fit_recording(recording, site, scenario.turntable, lever_arm=lever, noise=noise, moves=False)
-        return lack_of_fit(fit, alpha=levels(0.05)["lack_of_fit"], null=null_residuals(fit, 200, 3))
-
+    noise = recording_noise(recording, None, None, noisier=False, conditional=True)
+    given = fit_recording(recording, site, scenario.turntable, lever_arm=lever, noise=noise, moves=False)
+    over = d.before  # the candidates' fit
+    a = levels(0.05)["lack_of_fit"]
     # outside diagnose's one-thread limit: the null draws do not depend on the BLAS's threads
-    given, over = lack_of_fit_under(True), lack_of_fit_under(False)
-    assert d.lack_of_fit.statistic == pytest.approx(given.statistic, rel=1e-9)
-    assert d.lack_of_fit.p_value == pytest.approx(given.p_value, rel=1e-9)
-    assert abs(over.statistic - given.statistic) > 0.01 * given.statistic
+    null_given, null_over = coupled_null_residuals((given, over), 200, 3)
+    expected = lack_of_fit(given, alpha=a, null=null_given, local=(over, null_over))
+    omnibus_given, alone_over = lack_of_fit(given, alpha=a, null=null_given), lack_of_fit(over, alpha=a, null=null_over)
+    assert d.lack_of_fit.statistic == pytest.approx(expected.statistic, rel=1e-9)
+    assert d.lack_of_fit.p_value == pytest.approx(expected.p_value, rel=1e-9)
+    assert d.lack_of_fit.statistic == pytest.approx(omnibus_given.statistic, rel=1e-9)
+    assert d.lack_of_fit.omnibus_p_value == pytest.approx(omnibus_given.omnibus_p_value, rel=1e-9)
+    assert d.lack_of_fit.step["statistic"] == pytest.approx(alone_over.step["statistic"], rel=1e-9)
+    assert d.lack_of_fit.step["statistic"] != pytest.approx(omnibus_given.step["statistic"], rel=1e-3)
+    assert abs(alone_over.statistic - omnibus_given.statistic) > 0.01 * omnibus_given.statistic
+
+
+def test_coupled_null_draws_are_each_fit_s_null_and_the_same_errors_where_the_models_agree():
+    """coupled_null_residuals: for one fit its draws have the covariance of its whitened residual's null,
+    P⊥ W V Wᵀ P⊥ (checked on 4000 draws: every element within 5 standard errors); for two fits of one
+    recording under the same noise model they are the same numbers; for the two quantisation models of a jjf2003
+    recording the gyro rows' draws, read on the fitted rows (_Geometry.to_rows), go together draw by draw
+    (median correlation above 0.9: the models differ there only in the quantisation error of partly dithered
+    means); fits of different schedules are refused."""
+    scenario = load_scenario("jjf2003")
+    recording = simulate_and_record(scenario, seed=5, trial=0)
+    site = resolve_site(scenario=scenario)
+    fits = {c: fit_recording(recording, site, scenario.turntable, moves=False,
+                             noise=recording_noise(recording, None, None, noisier=False, conditional=c))
+            for c in (False, True)}
+    from plansim.diagnose.scores import _Geometry
+
+    g = _Geometry(fits[False])
+    (draws,) = coupled_null_residuals((fits[False],), 4000, 7)
+    expected = g.noise_map @ g.noise_map.T
+    observed = draws @ draws.T / draws.shape[1]
+    scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)) + expected**2) / math.sqrt(draws.shape[1])
+    assert np.all(np.abs(observed - expected) <= 5 * scale + 1e-12 * np.abs(expected).max())
+    same = coupled_null_residuals((fits[False], fits[False]), 50, 7)
+    assert np.array_equal(same[0], same[1])
+    over, given = coupled_null_residuals((fits[False], fits[True]), 200, 7)
+    gyro = np.isin(g.channel_of_row, [0, 1, 2])
+    assert np.allclose(g.to_rows.T @ g.to_rows, np.eye(g.to_rows.shape[0]), atol=1e-9)  # a rotation
+    a, b = (g.to_rows @ over)[gyro], (_Geometry(fits[True]).to_rows @ given)[gyro]  # each row a segment's channel
+    corr = np.sum(a * b, axis=0) / np.sqrt(np.sum(a * a, axis=0) * np.sum(b * b, axis=0))
+    assert np.median(corr) > 0.9, np.median(corr)
+    six = parse_scenario(apply_overrides(scenario.document, ["schedule.positions=6"]), source="six positions")
+    other = fit_recording(simulate_and_record(six, seed=1, trial=0), site, six.turntable, moves=False)
+    with pytest.raises(ValueError, match=r"differ in number \(\[234, 270\]\)"):
+        coupled_null_residuals((fits[False], other), 10, 0)
 
 
 def test_a_refit_never_adds_components_that_together_alias_a_parameter():

@@ -5,7 +5,9 @@
 2. **Lack of fit** of M0 at segment level, against its simulated null (:func:`plansim.diagnose.scores.lack_of_fit`;
    M0 fitted once more for it with each static mean's quantisation error given its level counts, ``plansim fit``'s
    noise model, under which this family holds its level, where the candidates' tests need the error over a level
-   unknown within its step: docs/closing-the-loop.md, step 1),
+   unknown within its step: docs/closing-the-loop.md, step 1; its step, change in time and odd segment, which
+   leave the undithered channels out, are scored on M0 itself, their null draws coupled with the omnibus's:
+   :func:`plansim.diagnose.scores.coupled_null_residuals`),
    and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, against
    a null simulated from the recording's own noise (:func:`plansim.diagnose.within.within_segment_tests`); each at
    α/4 (:data:`SEGMENT_LEVEL_SHARE`, :data:`WITHIN_SHARE`), so that "something is unexplained" keeps the level α/2.
@@ -45,6 +47,7 @@ from plansim.diagnose.scores import (
     NULL_DRAWS,
     CandidateScore,
     LackOfFit,
+    coupled_null_residuals,
     lack_of_fit,
     null_residuals,
     score_candidates,
@@ -388,7 +391,14 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     sigs = signatures(before)
     null = null_residuals(before, null_draws, seed)
     lof_before = fit_recording(recording, **lof_options)
-    lof = lack_of_fit(lof_before, alpha=a_segment, null=null_residuals(lof_before, null_draws, seed))
+    # the step, the change and the odd segment are scored on the candidates' fit (the error over the step), the
+    # omnibus on lof_before, their null draws coupled (one world, two noise models) so that the min-p holds. Given
+    # the level counts, a partly dithered gyro's segment means (jjf2003: 12 bits, the noise 0.4 of a step) carry a
+    # quantisation error of up to 16 deg/h on some segments (1-3 deg/h over the step), whose weights take a step in
+    # the gyro's level up: a step of the x gyro's bias at 5x a segment mean's u scored 14-18 there and 19-22 on the
+    # candidates' fit, against the same null quantiles (docs/closing-the-loop.md, "Figures")
+    lof_null, local_null = coupled_null_residuals((lof_before, before), null_draws, seed)
+    lof = lack_of_fit(lof_before, alpha=a_segment, null=lof_null, local=(before, local_null))
     scores = score_candidates(before, sigs, alpha=a_select, null=null)
     first = scores
     steps = [scores]
@@ -453,7 +463,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     after = current
     # the final model under the lack of fit's noise model, its between-segment noise estimated under it
     lof_after_fit = fit_recording(recording, **lof_options, extra=extra) if selected else lof_before
-    lof_after = lack_of_fit(lof_after_fit, alpha=a_segment, null=null_residuals(lof_after_fit, null_draws, seed + 1000))
+    lof_null, local_null = coupled_null_residuals((lof_after_fit, after), null_draws, seed + 1000)
+    lof_after = lack_of_fit(lof_after_fit, alpha=a_segment, null=lof_null, local=(after, local_null))
     sizes = {}
     if after.extra is not None:
         for effect in selected:

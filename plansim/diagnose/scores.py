@@ -54,7 +54,9 @@ holds only at some rates — is otherwise taken up by the between-segment noise,
 is in, as noise "independent from segment to segment", and no other test sees it: a 5 % loss of the x gyro's
 scale factor at ±5 °/s alone (4.4e-3 rad/s, some 290 times a segment mean's u) left the omnibus at p = 0.11 and
 gx's between-segment noise at 69 times its samples' prediction. The tests are held together at α by their min-p
-over the same draws (each draw's p-values its ranks among the draws).
+over the same draws (each draw's p-values its ranks among the draws). The diagnosis takes the omnibus and the
+other three on two fits of one recording — the omnibus under the quantisation error given the level counts, the
+others under the candidates' — with null draws coupled between them (:func:`coupled_null_residuals`).
 
 **Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
 over the rate points of one axis are both even in ω). Which one the residual is attributed to is decided by each
@@ -201,6 +203,7 @@ class _Geometry:
         with threadpool_limits(limits=1, user_api="blas"):
             values, vectors = np.linalg.eigh(V)
         self.V_root = vectors * np.sqrt(np.maximum(values, 0.0))  # V = V_root V_rootᵀ
+        self.V_basis = vectors  # V_root V_basisᵀ is V's symmetric square root (coupled_null_residuals)
         self.channel_of_row = np.tile(np.arange(6), fit.observed.shape[0])[rows]
         # W = Λ^{-1/2} Uᵀ (on the fitted rows: plansim.fit.joint.whitening) whitens along V's eigenvectors, so an
         # entry of r_w is not one segment's channel; U r_w is the residual whitened by V's symmetric root
@@ -684,55 +687,71 @@ def _largest(fit, scores, null_scores, sizes, where, B: int, what) -> tuple[dict
 
 
 def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,
-                null: np.ndarray | None = None) -> LackOfFit:
+                null: np.ndarray | None = None, local=None) -> LackOfFit:
     """The segment-level lack of fit against the simulated null (module docstring, "Lack of fit"): the omnibus
-    ‖r_w‖² (overall and per channel) and the largest step in one channel's level between segments adjacent in
-    time, the two held together at α by their min-p over the same null draws."""
+    ‖r_w‖² (overall and per channel), the largest step in one channel's level between segments adjacent in
+    time, the largest change of one parameter and the odd segment, held together at α by their min-p over the
+    same null draws.
+
+    *local*: ``(fit_local, null_local)``, another fit of the same recording's segments and its null draws coupled
+    with *null* (:func:`coupled_null_residuals`), on which the step, the change and the odd segment are scored
+    instead of on *fit* (default: *fit* and *null*). :func:`plansim.diagnose.procedure.diagnose` takes the omnibus
+    under the noise model given the level counts and the local tests under the candidates' (module docstring of
+    the procedure).
+    """
     if not 0 < alpha < 1:
         raise ValueError(f"alpha = {alpha!r}: must be between 0 and 1")
     g = _Geometry(fit)
     if null is None:
         null = g.null_residuals(int(null_draws), seed)
     B = null.shape[1]
+    if local is None:
+        local_fit, local_null, lg = fit, null, g
+    else:
+        local_fit, local_null = local
+        lg = _Geometry(local_fit)
+        if local_null.shape != (lg.r.size, B):
+            raise ValueError(f"local: null draws of shape {local_null.shape}; expected {(lg.r.size, B)} (the local "
+                             f"fit's {lg.r.size} whitened rows, as many draws as null's {B})")
     L = float(g.r @ g.r)
     L_null = np.sum(null**2, axis=0)
     p_omnibus = (1 + np.count_nonzero(L_null >= L)) / (B + 1)
     dof = int(g.r.size - g.Q.shape[1])
     # the largest step: each column's profile likelihood ratio, the channel's between-segment noise re-estimated
     # with the step in the model (_step_likelihood_ratios), maximised over channels and boundaries
-    columns, where = step_columns(fit)
+    columns, where = step_columns(local_fit)
     step = change = None
     # each statistic's p against the simulated null, and each null draw's own p (its rank among the draws): the
     # family's p is the min-p over the statistics, against the min-p of the same draws
     ranks = [_draw_p_values(L_null)]
     p_values = [p_omnibus]
     margins = {}
-    profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
+    profiled = _step_likelihood_ratios(local_fit, lg, columns, where, local_null) if columns.shape[1] else None
     if profiled is not None:
-        step, rank = _largest(fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
+        step, rank = _largest(local_fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
         ranks.append(rank)
         p_values.append(step["p_value"])
         margins["step"] = float(np.quantile(profiled[1], 1 - alpha)) if B else math.inf
     # the largest change of one parameter part-way through the run (a scale factor, a cross-coupling, a g-term)
-    columns, where = change_columns(fit)
-    scored = _change_scores(g, columns, where, null) if columns.shape[1] else None
+    columns, where = change_columns(local_fit)
+    scored = _change_scores(lg, columns, where, local_null) if columns.shape[1] else None
     if scored is not None:
-        change, rank = _largest(fit, *scored, B, lambda k: {"parameter": PARAMETER_NAMES[k]})
+        change, rank = _largest(local_fit, *scored, B, lambda k: {"parameter": PARAMETER_NAMES[k]})
         ranks.append(rank)
         p_values.append(change["p_value"])
         margins["change"] = float(np.quantile(scored[1], 1 - alpha)) if B else math.inf
     # the segment most off the model in one channel: the same profile likelihood ratio as the step's, for a column
     # that moves one segment's mean alone (outlier_columns)
-    columns, where = outlier_columns(fit)
-    profiled = _step_likelihood_ratios(fit, g, columns, where, null) if columns.shape[1] else None
+    columns, where = outlier_columns(local_fit)
+    profiled = _step_likelihood_ratios(local_fit, lg, columns, where, local_null) if columns.shape[1] else None
     outlier = None
     if profiled is not None:
         statistic, null_statistic, _, where = profiled
-        found, rank = _largest(fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
+        found, rank = _largest(local_fit, *profiled, B, lambda c: {"channel": CHANNELS[c]})
         segment = where[int(np.argmax(statistic))][1]
         outlier = {k: v for k, v in found.items() if k not in ("between", "labels")}
-        outlier.update(segment=int(fit.used[segment]), label=fit.labels[segment],
-                       at_s=float(fit.segment_times[segment]))
+        outlier.update(segment=int(local_fit.used[segment]), label=local_fit.labels[segment],
+                       at_s=float(local_fit.segment_times[segment]))
         ranks.append(rank)
         p_values.append(outlier["p_value"])
         margins["outlier"] = float(np.quantile(null_statistic, 1 - alpha)) if B else math.inf
@@ -754,3 +773,22 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:
     """(n, B) simulated null whitened residuals of *fit*, to share between score_candidates and lack_of_fit."""
     return _Geometry(fit).null_residuals(int(draws), seed)
+
+
+def coupled_null_residuals(fits, draws: int = NULL_DRAWS, seed: int = 0) -> list[np.ndarray]:
+    """(n_f, B) simulated null whitened residuals of each fit of one recording, from the same draws.
+
+    Each fit's errors are e_f = V_f^{1/2} ξ, with V_f^{1/2} the symmetric square root of its covariance and one
+    ξ ~ N(0, I) for every fit: where two fits' noise models agree, a draw is the same errors for both, so that a
+    statistic taken on one fit and another on the other keep, draw by draw, the dependence they have on the data
+    (:func:`lack_of_fit`'s min-p over the omnibus of one fit and the local tests of another). The symmetric root
+    is what couples: it varies smoothly with V, where an eigenvector basis (:meth:`_Geometry.null_residuals`)
+    need not. Each fit's draws alone are N(0, V_f), whitened and residualised as its data.
+    """
+    geometries = [_Geometry(fit) for fit in fits]
+    sizes = {g.V_basis.shape[0] for g in geometries}
+    if len(sizes) != 1:
+        raise ValueError(f"fits: the segment means they model differ in number ({sorted(sizes)}); expected fits of "
+                         "one recording's segments")
+    xi = np.random.default_rng(seed).standard_normal((sizes.pop(), int(draws)))
+    return [g.noise_map @ (g.V_basis.T @ xi) for g in geometries]
