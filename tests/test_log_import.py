@@ -412,12 +412,12 @@ def test_a_declared_full_scale_finds_a_steady_turn_held_at_the_rail(tmp_path, ca
     found = import_log(log, time_column="time", units="deg/s,m/s^2", full_scale="200,16").segmentation.saturation
     assert [(s.channel, s.start, s.stop) for s in found] == [(2, n_rest + 60, n_rest + 61)]
     # a log that reads beyond its declared full scale, a full scale that is not positive, the wrong count
-    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--units", "deg/s,m/s^2",
-                                    "--full-scale", "100,16"], "channel gz (gz) reads 200 deg/s at line")
-    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--full-scale", "0,16"],
-                 "--full-scale '0,16': '0' for channel gx; expected a positive full scale in the channel's unit")
-    expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", "--full-scale", "1,2,3"],
-                 "--full-scale '1,2,3': 3 entries; expected 2")
+    for options, message in (
+            (["--units", "deg/s,m/s^2", "--full-scale", "100,16"], "channel gz (gz) reads 200 deg/s at line"),
+            (["--full-scale", "0,16"],
+             "--full-scale '0,16': '0' for channel gx; expected a positive full scale in the channel's unit"),
+            (["--full-scale", "1,2,3"], "--full-scale '1,2,3': 3 entries; expected 2")):
+        expect_error(tmp_path, capsys, ["import", str(log), "--out", out, "--time", "time", *options], message)
     with pytest.raises(ValueError, match=r"full_scale = \[1.0, -1.0, .*expected 6 positive numbers"):
         segment_log(x, None, fs, full_scale=[1.0, -1.0, 1.0, 1.0, 1.0, 1.0])
 
