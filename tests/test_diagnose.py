@@ -599,3 +599,31 @@ def test_a_channel_s_own_lack_of_fit_reads_that_channel_s_rows():
         rows = g.to_rows @ r
         assert np.sum(rows[gx] ** 2) >= 0.9 * np.sum(rows**2)
         assert np.sum(r[gx] ** 2) < 0.5 * np.sum(r**2)
+
+
+def test_noncentrality_is_one_at_a_candidate_s_noise_equivalent_size():
+    """plansim.diagnose.scores.noncentrality, the common scale diagnose-check quotes for effects outside the catalogue,
+    is the candidates' own: each usable component's column at its noise-equivalent size gives 1 (to 1e-9), twice the
+    size 4; a change the base model spans (a bias) gives 0, a step in it does not; a wrong shape is refused."""
+    from plansim.diagnose.scores import noncentrality
+
+    scenario = load_scenario("linear_gaussian")
+    fit = fit_recording(simulate_and_record(scenario, seed=3, trial=0), resolve_site(scenario=scenario),
+                        scenario.turntable, moves=False)
+    sigs = {s.effect: s for s in signatures(fit)}
+    checked = 0
+    for score in score_candidates(fit, tuple(sigs.values()), null_draws=20):
+        for k in np.flatnonzero(np.isfinite(score.noise_equivalent_size))[:2]:
+            column = sigs[score.effect].columns[:, :, k] * score.noise_equivalent_size[k]
+            assert noncentrality(fit, column) == pytest.approx(1.0, rel=1e-9), (score.effect, k)
+            assert noncentrality(fit, 2 * column) == pytest.approx(4.0, rel=1e-9)
+            checked += 1
+    assert checked >= 6
+    S = fit.observed.shape[0]
+    bias = np.zeros((S, 6))
+    bias[:, 0] = 1e-4  # gx's bias moved by 1e-4 rad/s in every segment: Bgx takes it
+    assert noncentrality(fit, bias) == 0.0
+    bias[S // 2:, 0] = 0.0  # … in half of them: a step, which it cannot
+    assert noncentrality(fit, bias) > 1.0
+    with pytest.raises(ValueError, match="delta"):
+        noncentrality(fit, np.zeros((S + 1, 6)))

@@ -122,3 +122,18 @@ def test_at_ten_times_the_effects_are_found_and_the_lever_arm_never_is():
         selections = by[(effect, 10.0)]["confusion"]
         assert selections and all(effect in key.split("+") for key in selections), (effect, selections)
     assert "lever_arm" not in "".join(by[("lever_arm", None)]["confusion"])
+
+
+def test_effects_outside_the_catalogue_are_sized_in_noise_equivalent_sizes():
+    """An effect that changes the segment means is injected at k × its noise-equivalent size, the catalogue's
+    yardstick: its change of the reference null's means has non-centrality k² on that fit
+    (plansim.diagnose.scores.noncentrality), and the report gives the size in the effect's natural unit too; a
+    noise burst, which changes the noise and not the means, stays in its noise per sample."""
+    report = run_diagnose_check(load_scenario("linear_gaussian"), null=1, per_effect=1, sizes=(3.0,),
+                                null_draws=50, effects=("segment_offset", "noise_burst"))
+    by = {e["effect"]: e for e in report.out_of_catalogue}
+    offset, burst = by["segment_offset"], by["noise_burst"]
+    assert offset["noncentrality"] == pytest.approx(9.0, rel=1e-6)
+    assert offset["scale"] == "its noise-equivalent size" and offset["in_natural_units"] > 0
+    assert burst["noncentrality"] is None and burst["in_natural_units"] == pytest.approx(3.0)
+    assert burst["scale"] == "the gx noise per sample"

@@ -14,13 +14,17 @@ Recordings of one scenario are simulated by plansim (:func:`plansim.runner.simul
   simulated without the quantiser, the effect added, then saturated and quantised as the scenario's acquisition
   does: :func:`_acquire`; added after the quantiser, they would leave samples off its codes that no sensor
   makes) (:func:`_add_out_of_catalogue`): a step in
-  the x gyro's bias half-way through the recording, of k × the standard uncertainty of a gx segment mean; a
-  sample clock that runs fast by k × 100 ppm (the segment table, in nominal time, drifts off the data); a burst
-  of extra white noise on gx over a tenth of the run, of k × its noise per sample; a change of the x gyro's scale
-  factor half-way through, of k × the change that moves a segment at the schedule's largest rate by a gx segment
-  mean's standard uncertainty; one segment's gx off (the segment that holds the middle sample: a rate the table
-  did not hold, a pose knocked), by k × the standard uncertainty of a gx segment mean. And a lever arm of 5 mm on
-  the x accelerometer that the fit is not told (aliased with P in JJF 2003: it must never be attributed).
+  the x gyro's bias half-way through the recording; a sample clock that runs fast (the segment table, in nominal
+  time, drifts off the data); a change of the x gyro's scale factor half-way through; one segment's gx off (the
+  segment that holds the middle sample: a rate the table did not hold, a pose knocked) — each at k × its
+  noise-equivalent size, the catalogue's yardstick: the size whose change of the reference null's segment means
+  has non-centrality 1 on that recording's base fit (:func:`_noncentrality`,
+  :func:`plansim.diagnose.scores.noncentrality`), found from the effect in its natural unit
+  (:func:`_out_of_catalogue_size`: a gx segment mean's standard uncertainty, 100 ppm of clock error, the scale
+  change that moves the largest rate's segment by that uncertainty) and quoted in it too; and a burst of extra
+  white noise on gx over a tenth of the run, of k × its noise per sample (it changes the noise, not the means,
+  so it has no noise-equivalent size). And a lever arm of 5 mm on the x accelerometer that the fit is not told
+  (aliased with P in JJF 2003: it must never be attributed).
 
 ``diagnose`` is run on each without being told what was injected. Counted: false alarms (anything selected, the
 base model's lack of fit, or anything unexplained after the refit, within segments included), detection
@@ -43,6 +47,7 @@ from scipy.stats import binom
 
 from plansim.config import parse_scenario
 from plansim.diagnose.procedure import diagnose
+from plansim.diagnose.scores import noncentrality
 from plansim.fit import resolve_site, scenario_fit_options
 from plansim.io.recording_data import segment_first_samples
 from plansim.io.scenario_file import apply_overrides
@@ -266,9 +271,25 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     white = reference.before.noise.channels[0].white
     sigma_sample = float(white * math.sqrt(sample_rate)) if math.isfinite(white) else u_mean
     max_rate = max(abs(seg.rate) for seg in scenario.schedule.segments if seg.rate_known)
+    first_null = case_seed(seed, "null", 0)  # the reference diagnosis's recording, before the quantiser
+    clean = simulate_and_record(unquantised, seed=first_null, trial=0)
+    clean_bias = float(simulate_recording(scenario, first_null, 0)[2][PARAMETER_INDEX["Bgx"]])
     for effect in (e for e in OUT_OF_CATALOGUE if e in effects):
+        # the yardstick of the catalogue's: k × the size whose change of the segment means has non-centrality 1 on
+        # the reference fit (mean changes are linear in the size; the clock's nearly); a burst, which changes the
+        # noise and not the means, in its noise per sample
+        natural, unit, natural_scale = _out_of_catalogue_size(effect, 1.0, u_mean, sigma_sample, max_rate)
+        nc = _noncentrality(effect, natural, reference.before, clean, clean_bias)
+        equivalent = natural / math.sqrt(nc) if nc is not None and 0 < nc < math.inf else None
         for k in sizes:
-            size, unit, scale = _out_of_catalogue_size(effect, k, u_mean, sigma_sample, max_rate)
+            if effect == "noise_burst":
+                size, scale = k * natural, natural_scale
+            elif equivalent is None:
+                raise ValueError(f"effect = {effect!r}: the base model spans its change of the segment means on "
+                                 f"{scenario.name!r}'s schedule (non-centrality {nc}); it has no noise-equivalent size")
+            else:
+                size, scale = k * equivalent, "its noise-equivalent size"
+            at = _noncentrality(effect, size, reference.before, clean, clean_bias)
             flagged, named = 0, 0
             for i in range(per_effect):
                 s = case_seed(seed, f"{effect}/{k}", i)
@@ -285,7 +306,9 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 named += bool(d.selected)
                 tick()
             report.out_of_catalogue.append({"effect": effect, "times": k, "scale": scale, "size": size,
-                                            "unit": unit, "recordings": per_effect,
+                                            "unit": unit, "noncentrality": at,
+                                            "in_natural_units": size / natural, "natural_unit": natural_scale,
+                                            "recordings": per_effect,
                                             "flagged_unexplained": flagged / per_effect,
                                             "named_after_a_candidate": named / per_effect})
     return report
@@ -310,6 +333,19 @@ def _out_of_catalogue_size(effect: str, k: float, u_mean: float, sigma_sample: f
     if effect == "segment_offset":
         return k * u_mean, "rad/s", "the standard uncertainty of a gx segment mean (the fit's V)"
     raise ValueError(f"effect = {effect!r}: must be one of {', '.join(OUT_OF_CATALOGUE)}")
+
+
+def _noncentrality(effect: str, size: float, fit, clean, bias: float) -> float | None:
+    """The non-centrality of an out-of-catalogue effect of *size* on the reference diagnosis's base *fit*
+    (:func:`plansim.diagnose.scores.noncentrality`, the metric of the candidates' noise-equivalent size): the change
+    it makes to the segment means of *clean*, that fit's recording before the quantiser (*bias*: its Bgx). None for
+    ``noise_burst``, which changes the noise, not the means."""
+    if effect == "noise_burst":
+        return None
+    samples = np.array(clean.samples, dtype=float)
+    changed = _add_out_of_catalogue(effect, samples.copy(), size, 0, bias=bias, span=_middle_segment(clean.schedule))
+    delta = type(clean)(changed, clean.schedule, dict(clean.attrs)).segment_means() - clean.segment_means()
+    return noncentrality(fit, np.asarray(delta)[np.asarray(fit.used)])
 
 
 def _middle_segment(schedule) -> tuple[int, int]:

@@ -53,7 +53,9 @@ def _cmd_diagnose_check(args) -> int:
             print(f"{e['effect']}[{e['component']}]{k}: detection {e['detection']:.2f}, attribution "
                   f"{e['attribution']:.2f}, selected {e['confusion']}")
         for e in data["out_of_catalogue"]:
-            print(f"{e['effect']} x{e['times']:g} ({e['scale']}): flagged {e['flagged_unexplained']:.2f}, named "
+            nes = "" if e["noncentrality"] is None else (
+                f", non-centrality {e['noncentrality']:.3g}; {e['in_natural_units']:.3g}x {e['natural_unit']}")
+            print(f"{e['effect']} x{e['times']:g} ({e['scale']}{nes}): flagged {e['flagged_unexplained']:.2f}, named "
                   f"after a candidate {e['named_after_a_candidate']:.2f}")
         if args.out:
             print(f"\nwrote: {args.out}")

@@ -770,6 +770,38 @@ def lack_of_fit(fit, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed:
     return LackOfFit(L, dof, float(p), bool(p < alpha), per_channel, float(p_omnibus), step, change, margins, outlier)
 
 
+def noncentrality(fit, delta) -> float:
+    """The non-centrality of a known change *delta* of the fitted segment means, in the metric of the candidates'
+    noise-equivalent size (module docstring): (‖z‖ / √(uᵀ M u))², z = P⊥ W δ, u = z/‖z‖, M = P⊥ W V Wᵀ P⊥ — the
+    squared signal-to-noise ratio of the score along δ's own direction, what the base model leaves of it against
+    the fitted noise. A candidate's component at its noise-equivalent size has non-centrality 1, so √ of this is
+    δ in multiples of a noise-equivalent size: a common scale for an effect outside the catalogue
+    (:mod:`plansim.checks.diagnose_check`). 0 when the base model spans δ.
+
+    Parameters
+    ----------
+    fit : JointFit
+        The fit (its segments, whitening and covariance).
+    delta : (S, 6) array
+        The change of each fitted segment's mean, SI, in the fit's segments (``fit.used``) order; its rows the fit
+        leaves out are ignored.
+    """
+    rows = np.asarray(fit.fitted_rows, dtype=bool)
+    delta = np.array(delta, dtype=float)
+    if delta.shape != rows.shape:
+        raise ValueError(f"delta: shape {delta.shape}, expected {rows.shape} (the fit's segments by six channels)")
+    if not np.all(np.isfinite(delta)):
+        raise ValueError("delta: must be finite")
+    delta[~rows] = 0.0
+    g = _Geometry(fit)
+    z = g.project(g.W @ delta.ravel())
+    norm = float(np.linalg.norm(z))
+    if norm <= ALIAS_TOLERANCE * max(float(np.linalg.norm(g.W @ delta.ravel())), 1e-300):
+        return 0.0
+    spread = float(g.spread((z / norm)[:, None])[0])
+    return (norm / spread) ** 2 if spread > 0 else math.inf
+
+
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:
     """(n, B) simulated null whitened residuals of *fit*, to share between score_candidates and lack_of_fit."""
     return _Geometry(fit).null_residuals(int(draws), seed)
