@@ -627,3 +627,37 @@ def test_noncentrality_is_one_at_a_candidate_s_noise_equivalent_size():
     assert noncentrality(fit, bias) > 1.0
     with pytest.raises(ValueError, match="delta"):
         noncentrality(fit, np.zeros((S + 1, 6)))
+
+
+def test_a_component_that_rests_on_one_segment_is_not_identifiable():
+    """In a six-position test each accelerometer's K2 column, once the bias and the channel's three Ka terms are
+    fitted, is the shape of one pose's offset: in the channel's six static rows (+x, −x, +y, −y, +z, −z) the
+    residual space is spanned by (1, 1, −1, −1, 0, 0) and (1, 1, 0, 0, −1, −1), and P⊥(1, 1, 0, 0, 0, 0) =
+    2·P⊥(1, 0, 0, 0, 0, 0) (closed form). The schedule cannot tell K2 from the +x pose being off (a pose knocked),
+    nor a gyro's g² from it: neither is identifiable, each names the segment it rests on and asks for a second
+    one. In the twelve-position schedule (two headings) every component keeps its test."""
+    from plansim.config import parse_scenario
+    from plansim.diagnose.scores import ONE_SEGMENT_COSINE
+
+    assert 0.94 < ONE_SEGMENT_COSINE < 0.95  # Φ(10·√((1 − ρ)/2)) = 0.95
+    # the closed form: one accelerometer's six rows, design (bias, f_x, f_y, f_z) in units of g
+    poses = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
+    Q = np.linalg.qr(np.column_stack([np.ones(6), poses]))[0]
+    k2_x, plus_x_off = poses[:, 0] ** 2, np.eye(6)[0]
+    assert np.allclose(k2_x - Q @ (Q.T @ k2_x), 2 * (plus_x_off - Q @ (Q.T @ plus_x_off)), atol=1e-12)
+    base = load_scenario("linear_gaussian")
+    six = parse_scenario(apply_overrides(base.document, ["schedule.positions=6"]), source="six positions")
+    for scenario, lone in ((six, True), (base, False)):
+        fit = fit_recording(simulate_and_record(scenario, seed=4, trial=0), resolve_site(scenario=scenario),
+                            scenario.turntable, moves=False)
+        scores = {s.effect: s for s in score_candidates(fit, signatures(fit), null_draws=20)}
+        for effect in ("accel_quadratic", "gyro_g2_sensitivity"):
+            s = scores[effect]
+            if lone:
+                assert not s.identifiable and np.isnan(s.p_value), effect
+                assert any(a.startswith("one segment (") and " for " in a for a in s.aliased_with), s.aliased_with
+                assert s.separating.startswith("a second segment that excites it"), s.separating
+            else:
+                assert s.identifiable and np.all(s.usable), effect
+                assert not any(a.startswith("one segment") for a in s.aliased_with)
+        assert scores["gyro_scale_asymmetry"].identifiable  # its rate points are many segments

@@ -105,6 +105,15 @@ EARTH_ONLY_TOLERANCE = 1e-3
 #: scatter only roughly, and a step statistic — the largest of many 1-dof scores, sensitive to one odd segment —
 #: flagged 6 of 40 jjf2003 null recordings there at α/2 = 0.025, every one on an accelerometer
 UNDITHERED_SHARE = 0.9
+#: a candidate component whose column correlates more than this with one segment's mean in one channel, on the
+#: schedule's geometry (:func:`_rests_on_one_segment`), rests on that segment alone: the schedule cannot tell the
+#: effect from that one segment being off (a pose knocked, a rate the table did not hold, a turn the import took for
+#: rest). The bound is the attribution's own measure (plansim.diagnose.procedure._attribution): two directions at
+#: cosine ρ are told apart at 10× the noise-equivalent size with probability Φ(10·√((1 − ρ)/2)), below 0.95 above
+#: it. Such a component is not usable. On jjf2003 and linear_gaussian every component's largest such cosine is at
+#: most 0.874 (the x2 nonlinearity); in a six-position test the g² and K2 components are 1.000 (each is, after the
+#: bias and the scale factors, the shape of one pose's offset)
+ONE_SEGMENT_COSINE = 1.0 - 2.0 * (1.6448536269514722 / 10.0) ** 2
 #: default number of simulated null draws
 NULL_DRAWS = 2000
 METHODS = ("westfall_young", "holm")
@@ -283,6 +292,45 @@ def _component_statistics(fit, g: _Geometry, Z: np.ndarray, channel: np.ndarray,
     return values, null_values
 
 
+def _rests_on_one_segment(fit, g: _Geometry, ideal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which candidate components rest on one segment (:data:`ONE_SEGMENT_COSINE`), judged on the schedule's
+    geometry as the excitation is: the ideal sensor's columns *ideal* (6S, m), each channel's rows scaled by its
+    typical segment-mean standard deviation (the median of V's diagonal over its rows, so that channels in
+    different units weigh alike), the base design projected out (P⊥, unweighted), against each fitted segment's
+    mean in one channel projected alike: cosine |z_k| / (‖z‖·√(1 − ‖Q_k‖²)) for z = P⊥ x and Q an orthonormal basis
+    of the scaled design. Not in V's metric: an undithered quantiser's covariance made one jjf2003 recording's
+    K2 z rest on one segment (cosine 1.000) and another's not (0.41). Returns (m,) bool and (m,) the flat index
+    s·6 + c of that segment's channel (into the fit's segments)."""
+    flat = np.flatnonzero(g.rows)
+    m = ideal.shape[1]
+    if not flat.size or not m:
+        return np.zeros(m, dtype=bool), np.zeros(m, dtype=int)
+    if not hasattr(g, "_one_segment"):
+        variance = np.diag(np.asarray(fit.covariance, dtype=float))
+        channel = flat % 6
+        scale = np.ones(flat.size)
+        for c in np.unique(channel):
+            scale[channel == c] = math.sqrt(max(float(np.median(variance[flat[channel == c]])), 1e-300))
+        D = np.asarray(fit.design, dtype=float)[flat] / scale[:, None]
+        Q = np.zeros((flat.size, 0))
+        if D.shape[1]:
+            u, sv, _ = np.linalg.svd(D, full_matrices=False)
+            Q = u[:, sv > 1e-10 * max(sv.max(), 1e-300)]
+        g._one_segment = (Q, scale, np.sqrt(np.maximum(1.0 - np.sum(Q**2, axis=1), 0.0)))
+    Q, scale, left = g._one_segment
+    X = ideal[flat] / scale[:, None]
+    Z = X - Q @ (Q.T @ X)
+    norm = np.linalg.norm(Z, axis=0)
+    aliased = norm <= ALIAS_TOLERANCE * np.maximum(np.linalg.norm(X, axis=0), 1e-300)  # the base model spans it
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # a segment's channel the base model spans (less than ALIAS_TOLERANCE of it survives) is no alternative
+        cosine = np.where((left[:, None] > ALIAS_TOLERANCE) & ~aliased[None, :],
+                          np.abs(Z) / (np.maximum(left[:, None], ALIAS_TOLERANCE) * np.maximum(norm[None, :], 1e-300)),
+                          0.0)
+    best = np.argmax(cosine, axis=0)
+    return cosine[best, np.arange(m)] > ONE_SEGMENT_COSINE, flat[best]
+
+
 def _chi2_sf(statistic, dof) -> np.ndarray:
     return chdtrc(dof, np.maximum(statistic, 0.0))
 
@@ -328,7 +376,7 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
     if int(null_draws) < 1:
         raise ValueError(f"null_draws = {null_draws!r}: must be >= 1")
     g = _Geometry(fit)
-    bases, raw = [], []
+    bases, raw, lone_of = [], [], []
     for sig in sigs:
         Wx = g.W @ sig.columns.reshape(-1, sig.columns.shape[-1])  # (n, m)
         Z = g.project(Wx)
@@ -346,6 +394,9 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         if sig.designed is not None:  # reached by the Earth rate alone: true, and of no use (docs/fitting.md)
             excited &= sig.designed > EARTH_ONLY_TOLERANCE
         usable = excited & (surviving > ALIAS_TOLERANCE * np.maximum(norms, 1e-300))
+        lone, lone_at = _rests_on_one_segment(fit, g, ideal.reshape(-1, ideal.shape[-1]))
+        lone &= usable
+        usable &= ~lone
         # noise-equivalent size: the size at which the component alone gives its 1-dof score a non-centrality of 1,
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
         spread = g.spread(Z / np.where(surviving > 0, surviving, 1.0))
@@ -358,7 +409,14 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         lost = excited & ~usable
         aliased = () if not np.any(lost) else _aliases(
             fit, g, Wx[:, np.flatnonzero(lost)[np.argmin((surviving / np.maximum(norms, 1e-300))[lost])]])
+        if np.any(lone):  # "one segment (its label) for the components resting on it"
+            resting: dict[int, list[str]] = {}
+            for j in np.flatnonzero(lone):
+                resting.setdefault(int(lone_at[j]) // 6, []).append(sig.components[j])
+            aliased = tuple(aliased) + tuple(f"one segment ({fit.labels[s]}) for {' '.join(c)}"
+                                             for s, c in resting.items())
         bases.append(basis)
+        lone_of.append(lone)
         raw.append((sig, usable, nes, aliased, Z))
     # candidate against candidate: surviving subspaces that coincide
     same = [set() for _ in sigs]
@@ -441,8 +499,11 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
                 cosines[i][sigs[j].effect] = g.cosine(directions[i], directions[j])
     for i, (sig, usable, nes, aliased, _) in enumerate(raw):
         names = tuple(aliased) + tuple(sorted(same[i]))
-        out.append(CandidateScore(sig.effect, bool(identifiable[i]), names,
-                                  "" if identifiable[i] else SEPARATING.get(sig.effect, ""),
+        separating = "" if identifiable[i] else SEPARATING.get(sig.effect, "")
+        if not identifiable[i] and np.any(lone_of[i]):
+            separating = ("a second segment that excites it (it rests on one segment, which that segment alone being "
+                          f"off would move alike); or {separating}")
+        out.append(CandidateScore(sig.effect, bool(identifiable[i]), names, separating,
                                   float(statistic[i]), int(dof[i]), float(p[i]), float(adjusted[i]), nes,
                                   sig.components, sig.unit, usable, component[i], cosines[i], efficient[i]))
     return tuple(out)
