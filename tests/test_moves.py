@@ -339,3 +339,29 @@ def test_a_gyro_wired_with_its_sign_flipped_is_found_and_said():
     assert np.all(np.abs(z) < 4.0), z
     assert moves.chi2 / moves.chi2_dof < 2.0
     assert any("the scale factor of the y gyro is negative" in note for note in fit.notes)
+
+
+def test_gyros_read_in_the_wrong_unit_are_found_and_said():
+    """A log in deg/s imported as rad/s (the gyros' columns ×180/π): started from Kg = ±I alone the moves' fit stopped
+    in a local minimum (the y and z scale factors −0.056 and +0.44, the moves scattering 25° beyond their noise);
+    started from ±(180/π)·I too, it finds every scale factor 57.3 times the truth's (within 4u of the truth so
+    scaled), and the report names the unit mix-up."""
+    s, rec = session(13, poses=20)
+    x = np.array(rec.samples)
+    x[:, :3] *= math.degrees(1.0)
+    fit = fit_recording(Recording(x, rec.schedule, rec.attrs, timestamps=rec.time), SITE)
+    truth = combination(s.theta) * math.degrees(1.0)
+    z = (fit.moves.method.estimate[KG_INDEX] - truth.ravel()) / fit.moves.method.u[KG_INDEX]
+    assert np.all(np.abs(z) < 4.0), z
+    note = [n for n in fit.notes if "far from 1" in n]
+    assert len(note) == 1 and "of the x, y, z gyros are" in note[0] and "180/π" in note[0], note
+
+
+def test_moves_that_identify_nothing_at_their_solution_are_left_out_with_the_reason():
+    """Where the moves' information is singular at the fitted scale factors, the fit stops with a reason naming
+    what to check, not numpy's 'Singular matrix'; fit_recording notes it and keeps the poses' fit."""
+    from plansim.fit.moves import MovesNotFitted, _solve_information
+
+    with pytest.raises(MovesNotFitted, match="--units"):
+        _solve_information(np.diag([1.0, 0.0]), np.eye(2), np.diag([-50.9, 7.1e4, 1.0]))
+    assert np.allclose(_solve_information(np.diag([2.0, 4.0]), np.eye(2), np.eye(3)), np.diag([0.5, 0.25]))

@@ -39,7 +39,7 @@ from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.fit.identify import Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
-from plansim.fit.moves import find_transitions, fit_moves
+from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
 from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
 from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.kernels.layout import CHANNELS
@@ -868,8 +868,12 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      gain=gain, sources=sources)
     if moves:
         transitions, unused_moves = find_transitions(recording)
-        move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise, _Sources, _propagate,
-                             BETWEEN_LR_THRESHOLD, _chi2_verdict)
+        try:
+            move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise, _Sources, _propagate,
+                                 BETWEEN_LR_THRESHOLD, _chi2_verdict)
+        except MovesNotFitted as why:  # the poses' fit stands without them; say why
+            move_fit = None
+            result = dataclasses.replace(result, notes=result.notes + (str(why),))
         if move_fit is not None:
             unused_note = {k: v for k, v in unused.items() if "a move between poses" not in v}
             result = dataclasses.replace(result, moves=move_fit, unused=unused_note,

@@ -85,6 +85,32 @@ _STEP_GYRO, _STEP_ACCEL, _STEP_PARAMETER = 1e-7, 1e-6, 1e-7
 MIN_TRANSITIONS = 2
 #: the first solve starts from Kg = diag(±1, ±1, ±1), each sign pattern, and keeps the smallest χ²
 SIGN_STARTS = tuple((a, b, c) for a in (1.0, -1.0) for b in (1.0, -1.0) for c in (1.0, -1.0))
+#: … and from each pattern times these: the gyros' units mistaken, deg/s read as rad/s (a log in deg/s imported
+#: without --units), where a start at ±1 stops in a local minimum
+UNIT_STARTS = (1.0, math.degrees(1.0))
+#: … tried only where the starts before them end with a gyro scale factor K far from ±1, |K² − 1| above this
+#: (|K| outside 0.71–1.22; the test's log in deg/s read as rad/s ended at −0.056 and +0.44 from ±1; a MEMS gyro's
+#: scale factor is within a few per cent of 1)
+FAR_OFF = 0.5
+
+
+class MovesNotFitted(Exception):
+    """The moves between poses cannot be fitted on this recording (:func:`fit_moves`); the message says why, and
+    :func:`plansim.fit.fit_recording` notes it and goes on without them."""
+
+
+def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarray) -> np.ndarray:
+    """information⁻¹ · right, or :class:`MovesNotFitted` where the moves do not identify Kg at the solution *Kg*
+    (information singular to working precision)."""
+    values = np.linalg.eigvalsh(0.5 * (information + information.T))
+    if not values.size or values.min() <= 1e-12 * max(values.max(), 1e-300):
+        diagonal = ", ".join(f"{v:+.4g}" for v in np.diag(Kg))
+        raise MovesNotFitted(
+            "the moves between poses were left out: at the gyro scale factors that fit them best (Kg diagonal "
+            f"{diagonal}) they do not identify them — the angles the gyros integrate over the moves do not agree with "
+            "the change of gravity between the poses. Check the gyros' --units (deg/s or rad/s), --columns and "
+            "the axes' signs, and that the segment table's moves are whole turns between the poses")
+    return np.linalg.solve(information, right)
 
 
 @dataclass(frozen=True)
@@ -411,12 +437,17 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             return W @ J @ basis
 
         best = None
-        for start in np.atleast_3d(Kg_start).transpose(2, 0, 1) if np.ndim(Kg_start) == 3 else [Kg_start]:
-            z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
-            result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                                   max_nfev=200)
-            if best is None or result.cost < best.cost:
-                best = result
+        groups = Kg_start if isinstance(Kg_start, list) else [Kg_start]
+        for group in groups:  # a later group only where the earlier ones ended with a scale factor far from ±1
+            if best is not None and np.all(np.abs(np.diag(np.eye(3) + (basis @ best.x).reshape(3, 3)) ** 2 - 1.0)
+                                           <= FAR_OFF):
+                break
+            for start in np.atleast_3d(group).transpose(2, 0, 1) if np.ndim(group) == 3 else [group]:
+                z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
+                result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                                       max_nfev=200)
+                if best is None or result.cost < best.cost:
+                    best = result
         Kg = np.eye(3) + (basis @ best.x).reshape(3, 3)
         return Kg, W
 
@@ -430,7 +461,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             # from each sign of the three scale factors: a gyro wired with its sign flipped against the
             # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
             # stops in a local minimum (every move's miss of the order of its angle)
-            starts = np.stack([np.diag(signs) for signs in SIGN_STARTS], axis=2)
+            starts = [np.stack([unit * np.diag(signs) for signs in SIGN_STARTS], axis=2) for unit in UNIT_STARTS]
             Kg, W = solve(V, starts)
             continue
         if iteration == 1:
@@ -439,7 +470,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         r = moves.residuals(Kg, theta, means)
         Jz = jacobian @ basis
         Vinv = np.linalg.pinv(V)
-        hat = Jz @ np.linalg.solve(Jz.T @ Vinv @ Jz, Jz.T @ Vinv)
+        hat = Jz @ _solve_information(Jz.T @ Vinv @ Jz, Jz.T @ Vinv, Kg)
         if iteration == 1:
             residual_predicted = r
             dark = _dark_variance(r, V, hat, threshold)
@@ -450,7 +481,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     Vinv = np.linalg.pinv(V)
     Jz = jacobian @ basis
     information = Jz.T @ Vinv @ Jz
-    gain_z = np.linalg.solve(information, Jz.T @ Vinv)  # (rank, 2M)
+    gain_z = _solve_information(information, Jz.T @ Vinv, Kg)  # (rank, 2M)
     gain = np.zeros((len(PARAMETER_NAMES), 2 * n_moves))
     gain[KG_INDEX] = -basis @ gain_z  # Kg moves against the residual it explains
     mask = np.zeros(len(PARAMETER_NAMES), bool)
@@ -491,6 +522,17 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                      f"({', '.join(f'{Kg[a, a]:+.4g}' for a in flipped)}): its sign is opposite to the accelerometer "
                      "triad's — a gyro, or an accelerometer, wired or mapped with its axis flipped (check --columns "
                      "and the axes' signs)")
+    scaled = [a for a in range(3) if kg_mask[4 * a] and not 0.5 <= abs(Kg[a, a]) <= 2.0]
+    if scaled:
+        degrees = [a for a in scaled if abs(abs(Kg[a, a]) / math.degrees(1.0) - 1.0) < 0.02
+                   or abs(abs(Kg[a, a]) * math.degrees(1.0) - 1.0) < 0.02]
+        several = len(scaled) > 1
+        notes.append(f"the scale factor{'s' if several else ''} of the {', '.join('xyz'[a] for a in scaled)} "
+                     f"gyro{'s are' if several else ' is'} far from 1 ("
+                     + ", ".join(f"{Kg[a, a]:+.4g}" for a in scaled) + "): "
+                     + ("a factor of 180/π from 1, the gyros' units mistaken (deg/s read as rad/s, or the reverse; "
+                        "check --units)" if degrees else
+                        "check the gyros' --units and --scale, and that the moves are whole turns between the poses"))
     if dark > 0:
         notes.append(f"the moves' residuals scatter beyond the predicted noise: {math.degrees(math.sqrt(dark)):.3g} "
                      "deg per component between moves, estimated from them, enters every u (kind 'between')")
