@@ -13,7 +13,9 @@ gyro_scale_asymmetry       per gyro axis: (K+ − K−)/K, 1                    
 gyro_scale_nonlinearity    per gyro axis: quadratic 1/(rad/s), cubic 1/(rad/s)² gyro_nonlinearity_*
 gyro_g2_sensitivity        gyro i × (f_j f_k): rad/s per (m/s²)²              gyro_g2_sensitivity
 accel_quadratic            per accelerometer: K2, 1/(m/s²)                    accel_second_order
-bias_drift                 per channel: a linear drift in time, SI/s          (none)
+bias_drift                 per channel: a linear drift in time, SI/s; and,    (none)
+                           where the segments' temperatures differ, a bias
+                           linear in temperature, SI/°C (components ``gx_T``…)
 lever_arm                  accelerometer i × axis k: m                        accel_lever_arm
 =========================  =================================================  ======================
 
@@ -35,6 +37,9 @@ from plansim.kernels.layout import (
     EFF_GYRO_QUADRATIC,
 )
 
+#: the spread of the segments' temperatures (°C, largest − smallest) above which the drift has temperature
+#: components: a thermometer's resolution is about 0.1 °C
+TEMPERATURE_SPREAD = 0.1
 #: size of the unit step each signature is taken with, relative to the effect's unit (the kernel is linear in it)
 STEP = 1.0
 #: the catalogue's effect names, in the order they are reported
@@ -124,11 +129,23 @@ def signatures(fit) -> tuple[Signature, ...]:
                   geometry=k2[2]),
     ]
     times = np.asarray(fit.segment_times, dtype=float)
-    drift = np.zeros((S, 6, 6))
+    temperatures = np.array([float(s.temperature) for s in fit.model.schedule.segments])
+    # linear in temperature as well where the segments' temperatures differ (a temperature channel, or segments
+    # logged at different temperatures): the issue's "linear in time or temperature", the simulator's bias
+    # temperature coefficient (gyro_bias_temperature_coefficient, accel_bias_temperature_coefficient)
+    thermal = temperatures.size == S and np.ptp(temperatures) > TEMPERATURE_SPREAD
+    drift = np.zeros((S, 6, 12 if thermal else 6))
     for c in range(6):
         drift[:, c, c] = times - times.mean()
-    out.append(Signature("bias_drift", CHANNELS, "rad/s/s (gyros), m/s^2/s (accelerometers)", drift, None,
-                         "a bias that drifts linearly in time over the recording (per channel)", (0, 0, 0, 1, 1, 1)))
+        if thermal:
+            drift[:, c, 6 + c] = temperatures - temperatures.mean()
+    components = CHANNELS + (tuple(f"{c}_T" for c in CHANNELS) if thermal else ())
+    unit = "rad/s/s (gyros), m/s^2/s (accelerometers)" + ("; rad/s/degC, m/s^2/degC (the _T components)"
+                                                         if thermal else "")
+    out.append(Signature("bias_drift", components, unit, drift, None,
+                         "a bias that drifts linearly in time over the recording (per channel)"
+                         + (", or in the temperature" if thermal else ""),
+                         (0, 0, 0, 1, 1, 1) + ((2, 2, 2, 3, 3, 3) if thermal else ())))
     lever = _kernel_columns(fit, "lever", [(i, k) for i in range(3) for k in range(3)])
     out.append(Signature("lever_arm", tuple(f"{i}{k}" for i in AXES for k in AXES), "m", lever[0], "accel_lever_arm",
                          "accelerometer i sits off the turning axis: the centripetal acceleration ω×(ω×r)",
