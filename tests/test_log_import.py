@@ -15,6 +15,7 @@ import dataclasses
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -640,3 +641,28 @@ def test_space_separated_and_headerless_logs_as_imu_tk_and_matlab_write_them(tmp
     with_header = import_log(tmp_path / "dated_header.csv", time_column="time")
     np.testing.assert_array_equal(with_header.recording.samples, reference.recording.samples)
     assert with_header.table.preamble == ("2024,11,27",) and with_header.table.header_line == 2
+
+
+def test_many_tilted_poses_are_one_warning_that_lists_them(tmp_path):
+    """A hand-held session of poses spread over the sphere (plansim.simulate.hand_session, 12 poses): every pose more
+    than 15° from every axis is 'unknown' and listed, in one tilted_pose warning rather than one per pose; a log
+    with a few such poses (at most TILTED_LISTED_APART) gets one warning each."""
+    from plansim.io.log_import import TILTED_LISTED_APART
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    s = hand_session(consumer_unit(3), spread_poses(12, seed=3), seed=3, gravity=9.80, gyro_noise=8.7e-4,
+                     accel_noise=9.8e-3, rest=4.0, move=3.0)
+    log = tmp_path / "hand.csv"
+    write_synthetic(log, s.time, np.array(s.samples))
+    result = import_log(log, time_column="time")
+    unknown = [span for span in result.segmentation.spans if span.kind == "static" and span.orientation == "unknown"]
+    tilted = [w for w in result.warnings if w.name == "tilted_pose"]
+    assert len(unknown) > TILTED_LISTED_APART
+    assert len(tilted) == 1 and tilted[0].message.startswith(f"{len(unknown)} of the ")
+    assert len(re.findall(r"deg from [+-][xyz]\)", tilted[0].message)) == len(unknown)
+    # the first three poses alone: a warning each
+    cut = int(round(3 * 7.0 * 100.0)) - 150
+    write_synthetic(log, s.time[:cut], np.array(s.samples)[:cut])
+    few = import_log(log, time_column="time")
+    unknown = [span for span in few.segmentation.spans if span.kind == "static" and span.orientation == "unknown"]
+    assert len([w for w in few.warnings if w.name == "tilted_pose"]) == len(unknown) <= TILTED_LISTED_APART

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from plansim.estimate.segmentation import (
+    APPROXIMATE_TILT,
     AXES,
     DEFAULT_MIN_STATIC,
     DEFAULT_WINDOW,
@@ -84,6 +85,10 @@ VERTICAL_TURN_CONE = math.radians(10.0)
 #: and a rate outside it is most often a time column in another unit than --time-unit says (ms read as s: 1000 Hz
 #: reads as 1 Hz)
 PLAUSIBLE_SAMPLE_RATE = (1.0, 1e5)
+
+
+#: up to this many tilted poses are warned of one by one; more, in one warning that lists them
+TILTED_LISTED_APART = 3
 
 
 @dataclass(frozen=True)
@@ -624,12 +629,20 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
             text = (f"{channel} reads {shown:.6g}, at its full scale of {rails[s.channel]:g} {unit_names[s.channel]} "
                     f"(--full-scale), on lines {first}-{last}: a turn over it has no angle")
         warnings.append(LogWarning("saturated", text + in_pose))
-    for span in statics:
-        if span.orientation == "unknown":
+    tilted = [span for span in statics if span.orientation == "unknown"]
+    if len(tilted) <= TILTED_LISTED_APART:
+        for span in tilted:
             warnings.append(LogWarning("tilted_pose", f"the static span on lines {table.lines[span.start]}-"
                                                       f"{table.lines[span.stop - 1]} is tilted "
                                                       f"{math.degrees(span.tilt):.1f} deg from {span.up}: orientation "
                                                       "'unknown'"))
+    else:  # a session of poses spread over the sphere (imu_tk's): one warning, every span in it
+        spans = "; ".join(f"{table.lines[span.start]}-{table.lines[span.stop - 1]} ({math.degrees(span.tilt):.1f} "
+                          f"deg from {span.up})" for span in tilted)
+        warnings.append(LogWarning("tilted_pose", f"{len(tilted)} of the {len(statics)} static spans are tilted more "
+                                                  f"than {math.degrees(APPROXIMATE_TILT):.0f} deg from every axis, "
+                                                  f"orientation 'unknown' (poses spread over the sphere, as a "
+                                                  f"hand-held session places them, expect it); lines {spans}"))
     for span in statics:
         rate, force = span.mean[:3], span.mean[3:]
         magnitude = float(np.linalg.norm(rate))
