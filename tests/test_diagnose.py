@@ -723,5 +723,13 @@ def test_a_bias_that_follows_the_temperature_is_a_drift_in_temperature():
     size = d.sizes["bias_drift"]
     j = size["components"].index("gz_T")
     assert abs(size["value"][j] - coefficient) < 3 * size["u"][j], (size["value"][j], size["u"][j])
+    # --learned writes it as the simulator's gyro bias temperature coefficient; the time components have no field
+    from plansim.config import parse_scenario
+    from plansim.diagnose.learned import learned_document
+
+    document = learned_document(d, load_scenario("jjf2003"), "the warm-up")
+    learned = parse_scenario(document, source="learned")
+    assert learned.effects.gyro_bias_temperature_coefficient[2] == pytest.approx(size["value"][j], rel=1e-12)
+    assert "Not written (no scenario field): bias_drift (gx gy gz ax ay az)" in document["description"]
     plain = fit_recording(Recording(s.samples, s.schedule, {"source": "simulated"}, timestamps=s.time), site)
     assert {g.effect: g for g in signatures(plain)}["bias_drift"].components == ("gx", "gy", "gz", "ax", "ay", "az")

@@ -21,7 +21,8 @@ What goes where (values written in SI with their unit, so that loading gives bac
 ``[mimu.effects]``               each selected effect's fitted components (the lever arm: added to the
                                  base scenario's, which the fit was told)
 ``description``                  what was learned from which recording, and what could not be written
-                                 (``bias_drift`` has no scenario field)
+                                 (``bias_drift`` in time has no scenario field; in temperature it is the
+                                 ``*_bias_temperature_coefficient`` of ``[mimu.effects]``)
 ===============================  ======================================================================
 """
 
@@ -44,11 +45,16 @@ EFFECT_FIELDS = {
                             for j, b in enumerate("xyz")},
     "accel_quadratic": {f"{a}": ("accel_second_order", i, None) for i, a in enumerate("xyz")},
     "lever_arm": {f"{a}{b}": ("accel_lever_arm", i, j) for i, a in enumerate("xyz") for j, b in enumerate("xyz")},
+    # the drift's temperature components are the simulator's bias temperature coefficients; its time components
+    # have no field
+    "bias_drift": {**{f"{c}_T": ("gyro_bias_temperature_coefficient", i, None) for i, c in enumerate(CHANNELS[:3])},
+                   **{f"{c}_T": ("accel_bias_temperature_coefficient", i, None) for i, c in enumerate(CHANNELS[3:])}},
 }
 #: the SI unit each [mimu.effects] field is written in
 EFFECT_UNITS = {"gyro_asymmetry": "1", "gyro_nonlinearity_quadratic": "1/(rad/s)",
                 "gyro_nonlinearity_cubic": "1/(rad/s)^2", "gyro_g2_sensitivity": "rad/s/(m/s^2)^2",
-                "accel_second_order": "1/(m/s^2)", "accel_lever_arm": "m"}
+                "accel_second_order": "1/(m/s^2)", "accel_lever_arm": "m",
+                "gyro_bias_temperature_coefficient": "rad/s/degC", "accel_bias_temperature_coefficient": "m/s^2/degC"}
 #: the base scenario's value is the fit's known input for these fields (added to), a guess for the others
 ADDED_TO_BASE = {"accel_lever_arm"}
 #: [mimu.noise] keys from the data's noise per kind of channel: (white, bias instability, rate random walk)
@@ -126,11 +132,17 @@ def learned_document(diagnosis, base, recording_name: str = "the recording") -> 
     skipped = []
     for effect in diagnosis.selected:
         size = diagnosis.sizes.get(effect)
-        if effect not in EFFECT_FIELDS or size is None:
+        fields = EFFECT_FIELDS.get(effect, {})
+        unwritten = [] if size is None else [c for c in size["components"] if c not in fields]
+        if size is None or len(unwritten) == len(size["components"]):
             skipped.append(effect)
             continue
+        if unwritten:
+            skipped.append(f"{effect} ({' '.join(unwritten)})")
         for component, value in zip(size["components"], size["value"]):
-            name, i, j = EFFECT_FIELDS[effect][component]
+            if component not in fields:
+                continue
+            name, i, j = fields[component]
             array = changed.setdefault(name, base_effects[name].copy())
             index = i if j is None else (i, j)
             array[index] = (array[index] + value) if name in ADDED_TO_BASE else value
