@@ -292,6 +292,14 @@ def _component_statistics(fit, g: _Geometry, Z: np.ndarray, channel: np.ndarray,
     return values, null_values
 
 
+def _noise_equivalent_sizes(g: _Geometry, Z: np.ndarray) -> np.ndarray:
+    """(m,) each whitened, projected column z's size of non-centrality 1 (module docstring): √(uᵀ M u)/‖z‖,
+    u = z/‖z‖, M = P⊥ W V Wᵀ P⊥; inf where ‖z‖ = 0."""
+    norm = np.linalg.norm(Z, axis=0)
+    safe = np.where(norm > 0, norm, 1.0)
+    return np.where(norm > 0, g.spread(Z / safe) / safe, np.inf)
+
+
 def _rests_on_one_segment(fit, g: _Geometry, ideal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Which candidate components rest on one segment (:data:`ONE_SEGMENT_COSINE`), judged on the schedule's
     geometry as the excitation is: the ideal sensor's columns *ideal* (6S, m), each channel's rows scaled by its
@@ -399,8 +407,7 @@ def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_D
         usable &= ~lone
         # noise-equivalent size: the size at which the component alone gives its 1-dof score a non-centrality of 1,
         # sqrt(uᵀ M u)/‖z‖ with z = P⊥ W x, u = z/‖z‖ and M = P⊥ W V Wᵀ P⊥ the score's null covariance
-        spread = g.spread(Z / np.where(surviving > 0, surviving, 1.0))
-        nes = np.where(usable, spread / np.where(surviving > 0, surviving, 1.0), np.inf)
+        nes = np.where(usable, _noise_equivalent_sizes(g, Z), np.inf)
         if np.any(usable):
             u, s, _ = np.linalg.svd(Z[:, usable], full_matrices=False)
             basis = u[:, s > ALIAS_TOLERANCE * np.linalg.norm(Z[:, usable], axis=0).min()]
@@ -855,12 +862,12 @@ def noncentrality(fit, delta) -> float:
         raise ValueError("delta: must be finite")
     delta[~rows] = 0.0
     g = _Geometry(fit)
-    z = g.project(g.W @ delta.ravel())
-    norm = float(np.linalg.norm(z))
-    if norm <= ALIAS_TOLERANCE * max(float(np.linalg.norm(g.W @ delta.ravel())), 1e-300):
+    whitened = g.W @ delta.ravel()
+    z = g.project(whitened)
+    if np.linalg.norm(z) <= ALIAS_TOLERANCE * max(float(np.linalg.norm(whitened)), 1e-300):
         return 0.0
-    spread = float(g.spread((z / norm)[:, None])[0])
-    return (norm / spread) ** 2 if spread > 0 else math.inf
+    size = float(_noise_equivalent_sizes(g, z[:, None])[0])
+    return 1.0 / size**2 if size > 0 else math.inf
 
 
 def null_residuals(fit, draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:

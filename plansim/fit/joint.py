@@ -135,8 +135,6 @@ def between_segment_noise(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, 
     channel-by-channel terms were 0.64, 1.91 and 1.34 mg on ax, ay and az; together 0.59, 0.06 and 0.10 mg
     (test).
     """
-    from scipy.optimize import minimize_scalar
-
     R = np.eye(residual.size) - hat
     C = R @ V @ R.T
     variance, taus, dof, ratio = np.zeros(6), np.zeros(6), np.zeros(6), np.ones(6)
@@ -165,17 +163,9 @@ def between_segment_noise(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, 
             z2 = (Q.T @ y) ** 2
             if lam.max() <= 0:
                 continue
-
-            def negative_log_likelihood(log_ratio, lam=lam, z2=z2, scale=scale):
-                s2 = scale * math.exp(log_ratio)
-                return 0.5 * float(np.sum(np.log1p(s2 * lam) + z2 / (1.0 + s2 * lam)))
-
-            # σ² relative to the predicted scale; search over 12 decades below to 6 above
-            result = minimize_scalar(negative_log_likelihood, bounds=(-12 * math.log(10), 6 * math.log(10)),
-                                     method="bounded")
-            log_likelihood = -float(result.fun)
+            s2, log_likelihood = _reml_variance(lam, z2, scale)  # relative to the predicted scale
             if log_likelihood > best[2]:
-                best = (scale * math.exp(result.x), tau, log_likelihood)
+                best = (s2, tau, log_likelihood)
         gain = best[2] + 0.5 * float(y @ y)  # log-likelihood ratio against σ² = 0
         if best[0] > 0 and 2.0 * gain > BETWEEN_LR_THRESHOLD:
             variance[c], taus[c] = best[0], best[1]
@@ -192,9 +182,8 @@ def _joint_between_variances(residual, C, R, rows, times, variance, taus) -> np.
     """The between-segment variances of the channels that took one, re-estimated together: the restricted
     likelihood of every fitted row's residual, covariance C + Σ_c σ_c² R E_c Σ(τ_c) E_cᵀ Rᵀ (E_c placing channel
     c's segments), maximised over the σ_c² by coordinate ascent (:data:`JOINT_BETWEEN_SWEEPS` sweeps, each a
-    one-dimensional search as the channel-by-channel one, the others held), each τ_c as that estimate chose it."""
-    from scipy.optimize import minimize_scalar
-
+    one-dimensional search as the channel-by-channel one (:func:`_reml_variance`), the others held), each τ_c as
+    that estimate chose it."""
     on = np.flatnonzero(variance > 0)
     values, vectors = np.linalg.eigh(0.5 * (C + C.T))
     keep = values > 1e-9 * values.max()
@@ -217,16 +206,23 @@ def _joint_between_variances(residual, C, R, rows, times, variance, taus) -> np.
                 out[c] = 0.0
                 continue
             z2 = (Q.T @ (L @ y)) ** 2
-            scale = 1.0 / lam.max()
-
-            def negative_log_likelihood(log_ratio, lam=lam, z2=z2, scale=scale):
-                s2 = scale * math.exp(log_ratio)
-                return 0.5 * float(np.sum(np.log1p(s2 * lam) + z2 / (1.0 + s2 * lam)))
-
-            result = minimize_scalar(negative_log_likelihood, bounds=(-12 * math.log(10), 6 * math.log(10)),
-                                     method="bounded")
-            out[c] = scale * math.exp(result.x) if result.fun < negative_log_likelihood(-30.0) else 0.0
+            s2, log_likelihood = _reml_variance(lam, z2, 1.0 / lam.max())
+            out[c] = s2 if log_likelihood > -0.5 * float(np.sum(z2)) else 0.0  # against σ_c² = 0
     return out
+
+
+def _reml_variance(lam: np.ndarray, z2: np.ndarray, scale: float) -> tuple[float, float]:
+    """The σ² that maximises the restricted log-likelihood −½ Σ_i [log(1 + σ²λ_i) + z_i²/(1 + σ²λ_i)] of a whitened
+    residual with squared components *z2* along the eigenvectors of an added term of eigenvalues *lam*, searched
+    from 12 decades below *scale* to 6 above; (σ², its log-likelihood). σ² = 0 gives −½ Σ z_i²."""
+    from scipy.optimize import minimize_scalar
+
+    def negative_log_likelihood(log_ratio):
+        s2 = scale * math.exp(log_ratio)
+        return 0.5 * float(np.sum(np.log1p(s2 * lam) + z2 / (1.0 + s2 * lam)))
+
+    result = minimize_scalar(negative_log_likelihood, bounds=(-12 * math.log(10), 6 * math.log(10)), method="bounded")
+    return scale * math.exp(result.x), -float(result.fun)
 
 
 def _add_between_segment_noise(sources: _Sources, slow: BetweenSegmentNoise, rows: np.ndarray,

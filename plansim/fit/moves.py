@@ -428,19 +428,21 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         values = np.maximum(values, 1e-14 * values.max())
         W = (vectors / np.sqrt(values)).T
 
+        def kg(z):
+            return np.eye(3) + (basis @ z).reshape(3, 3)
+
         def fun(z):
-            return W @ moves.residuals(np.eye(3) + (basis @ z).reshape(3, 3), theta, means)
+            return W @ moves.residuals(kg(z), theta, means)
 
         def jac(z):
-            Kg = np.eye(3) + (basis @ z).reshape(3, 3)
+            Kg = kg(z)
             J = np.vstack([moves.one(m, Kg, theta, means, details=True)[1]["jac"] for m in range(n_moves)])
             return W @ J @ basis
 
         best = None
         groups = Kg_start if isinstance(Kg_start, list) else [Kg_start]
         for group in groups:  # a later group only where the earlier ones ended with a scale factor far from ±1
-            if best is not None and np.all(np.abs(np.diag(np.eye(3) + (basis @ best.x).reshape(3, 3)) ** 2 - 1.0)
-                                           <= FAR_OFF):
+            if best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF):
                 break
             for start in np.atleast_3d(group).transpose(2, 0, 1) if np.ndim(group) == 3 else [group]:
                 z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
@@ -448,8 +450,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                                        max_nfev=200)
                 if best is None or result.cost < best.cost:
                     best = result
-        Kg = np.eye(3) + (basis @ best.x).reshape(3, 3)
-        return Kg, W
+        return kg(best.x), W
 
     Kg = np.eye(3)
     dark = 0.0
