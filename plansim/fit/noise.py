@@ -21,8 +21,12 @@ For each channel (gx gy gz ax ay az):
    scatter shows. In a static segment, the error is taken given where its samples fall on the levels
    (:func:`quantisation_error_given_levels`), averaged over what the static segments' level counts say
    of the channel's noise before the quantiser (:func:`quantised_noise_posterior`; the scatter cannot tell
-   it below q/2, and a point estimate of it understates the error: below). A turning segment takes its
-   scatter less q²/12 (Sheppard) as its dither.
+   it below q/2, and a point estimate of it understates the error: below). A turning segment on a table is
+   taken the same way, its noise σ widened by its own sweep (the trigonometric polynomial in the angle) and,
+   where its samples fall on three levels or more, by its scatter less q²/12 (Sheppard: the table's rate
+   jitter dithers). On one or two levels that scatter is no dither: a level near a step's edge toggles between
+   two codes with a scatter up to q/2 whatever σ (:func:`_turning_dither`). A turn by hand takes its scatter
+   less q²/12.
 
 **The variance of a segment mean** of duration T is then the Allan variance at τ = T — the mean square
 difference between two adjacent such means — from the fitted model: N²/T + (2 ln 2/π)B² + K²T/3. The
@@ -710,9 +714,11 @@ def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_wh
     notes = []
     within = np.zeros((S, 6))
     within_dof = np.zeros(S)
+    sweep = np.zeros((S, 6))
     for k, (s, x) in enumerate(zip(segments, segment_samples)):
         if s.is_rotating and s.rate_known:
             within[k], within_dof[k] = _turning_scatter(x, s.rate, s.sample_rate)
+            sweep[k] = _turning_sweep(x, s.rate, s.sample_rate)
         elif x.shape[0] > 1:
             within[k], within_dof[k] = np.std(x, axis=0, ddof=1), x.shape[0] - 1
     everything = np.concatenate(segment_samples, axis=0)
@@ -791,8 +797,33 @@ def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_wh
                     if ch.quantisation_step > 0 and static and any(conditionals) else None
                     for c, ch in enumerate(channels)]
     shared = _Shared(segment_samples, segments, tuple(channels), within, within_dof, shaken, rms, static,
-                     sigma_before, pooled, tuple(notes))
+                     sigma_before, pooled, tuple(notes), sweep)
     return tuple(_mean_variance(shared, bool(c)) for c in conditionals)
+
+
+def _turning_dither(shared, k: int, c: int, sigmas: np.ndarray) -> np.ndarray:
+    """The noise before the quantiser of turning segment *k*, channel *c*, for each σ of the static segments'
+    posterior: that σ with the segment's sweep (the trigonometric polynomial in the table angle, e.g. gravity
+    turned by the platform's tilt) added in quadrature; and, where the samples fall on three levels or more, at
+    least the scatter less q²/12 (Sheppard: the table's rate jitter dithers the quantiser). Samples on one or two
+    levels say nothing of a σ below q/2: a level that sits near a step's edge toggles between two codes with a
+    scatter up to q/2 whatever σ, and Sheppard's correction would read that as dither."""
+    step = shared.channels[c].quantisation_step
+    out = np.sqrt(np.asarray(sigmas, dtype=float) ** 2 + shared.sweep[k, c] ** 2)
+    table = _level_table(shared.segment_samples[k][:, c], step)
+    if table is None or table[0].size >= 3:
+        out = np.maximum(out, math.sqrt(max(shared.within[k, c] ** 2 - step**2 / 12.0, 0.0)))
+    return out
+
+
+def _turning_sweep(values: np.ndarray, rate: float, sample_rate: float) -> np.ndarray:
+    """R.m.s. (6,) of a turning segment's trigonometric polynomial in the angle (:func:`turning_design`) about its
+    mean: how far the signal itself sweeps the quantiser's levels."""
+    n = values.shape[0]
+    if n <= 2 + 2 * TURNING_HARMONICS:
+        return np.zeros(values.shape[1])
+    fitted = values - turning_residuals(values, rate, sample_rate)
+    return np.std(fitted, axis=0)
 
 
 @dataclass(frozen=True)
@@ -810,6 +841,7 @@ class _Shared:
     sigma_before: list
     pooled: list
     notes: tuple
+    sweep: np.ndarray
 
 
 def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
@@ -841,7 +873,7 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             own_quantisation = 0.0
             if ch.quantisation_step > 0:
-                if s.is_rotating or sigma_before[c] is None or not conditional:
+                if (s.is_rotating and not s.rate_known) or sigma_before[c] is None or not conditional:
                     # turning: the signal itself sweeps the levels; its scatter less q²/12 (Sheppard)
                     dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
                     quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
@@ -851,7 +883,10 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
                     # The quantiser's harmonics stand for up to q²/12 of it (shared by segments at one level);
                     # beyond that (a segment that toggles rarely: its mean off by most of a step) the excess is
                     # the segment's own error
-                    given = quantisation_error_given_levels(ch.quantisation_step, x[:, c], *sigma_before[c],
+                    sigmas, weights = sigma_before[c]
+                    if s.is_rotating:
+                        sigmas = _turning_dither(shared, k, c, sigmas)
+                    given = quantisation_error_given_levels(ch.quantisation_step, x[:, c], sigmas, weights,
                                                             pooled=pooled[c].get(k))
                     quantisation[k, c] = min(given, ch.quantisation_step**2 / 12.0)
                     own_quantisation = given - quantisation[k, c]
