@@ -553,6 +553,10 @@ class NoiseEstimate:
     quantisation_variance: np.ndarray  # (S, 6) the part of mean_variance due to a non-dithered quantiser
     quantisation_sigma: np.ndarray  # (S, 6) the noise σ per sample before the quantiser (dithering it)
     notes: tuple[str, ...] = ()
+    #: (S, 6) the mean square quantisation error of each segment mean over a level unknown within its step, before
+    #: its counts are looked at (σ averaged over its posterior): what the error's size is independently of where
+    #: this recording's levels happen to fall (plansim.fit.joint takes the uncertainty of the levels from it)
+    quantisation_prior_variance: np.ndarray | None = None
 
 
 def turning_design(n: int, rate: float, sample_rate: float) -> np.ndarray:
@@ -854,6 +858,7 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
     variance = np.zeros((S, 6))
     variance_dof = np.full((S, 6), math.inf)
     quantisation = np.zeros((S, 6))
+    prior = np.zeros((S, 6))
     dither = np.zeros((S, 6))
     static_dof = max(sum(segment_samples[k].shape[0] - 1 for k in static), 1)
     slow_dof = max(len(static) - 1, 1)
@@ -877,6 +882,7 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
                     # turning: the signal itself sweeps the levels; its scatter less q²/12 (Sheppard)
                     dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
                     quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
+                    prior[k, c] = quantisation[k, c]
                 else:
                     # static: the error given where the samples fall, averaged over the sensor's σ as all the
                     # static segments' level counts give it.
@@ -891,9 +897,11 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
                     quantisation[k, c] = min(given, ch.quantisation_step**2 / 12.0)
                     own_quantisation = given - quantisation[k, c]
                     dither[k, c] = dither_for_error(ch.quantisation_step, quantisation[k, c])
+                    prior[k, c] = float(np.sum(weights * quantisation_error_variance(ch.quantisation_step, sigmas))
+                                        / np.sum(weights))
             floor = (RELATIVE_FLOOR * rms[c]) ** 2
             total = white + slow + quantisation[k, c] + own_quantisation + floor
             variance[k, c] = total
             denominator = white**2 / white_dof + slow**2 / slow_dof
             variance_dof[k, c] = total**2 / denominator if denominator > 0 else math.inf
-    return NoiseEstimate(channels, within, variance, variance_dof, quantisation, dither, shared.notes)
+    return NoiseEstimate(channels, within, variance, variance_dof, quantisation, dither, shared.notes, prior)
