@@ -21,12 +21,13 @@ For each channel (gx gy gz ax ay az):
    scatter shows. In a static segment, the error is taken given where its samples fall on the levels
    (:func:`quantisation_error_given_levels`), averaged over what the static segments' level counts say
    of the channel's noise before the quantiser (:func:`quantised_noise_posterior`; the scatter cannot tell
-   it below q/2, and a point estimate of it understates the error: below). A turning segment on a table is
-   taken the same way, its noise σ widened by its own sweep (the trigonometric polynomial in the angle) and,
-   where its samples fall on three levels or more, by its scatter less q²/12 (Sheppard: the table's rate
-   jitter dithers). On one or two levels that scatter is no dither: a level near a step's edge toggles between
-   two codes with a scatter up to q/2 whatever σ (:func:`_turning_dither`). A turn by hand takes its scatter
-   less q²/12.
+   it below q/2, and a point estimate of it understates the error: below). An accelerometer in a turning
+   segment on a table is taken the same way, its noise σ widened by its own sweep (the trigonometric
+   polynomial in the angle) and, where its samples fall on three levels or more, by its scatter less q²/12
+   (Sheppard). On one or two levels that scatter is no dither: a level near a step's edge toggles between two
+   codes with a scatter up to q/2 whatever σ (:func:`_turning_dither`). A gyro in a turning segment, and any
+   channel in a turn by hand, takes its scatter less q²/12: the rate's jitter is noise before the gyro's
+   quantiser that the static segments do not show and one or two levels cannot tell.
 
 **The variance of a segment mean** of duration T is then the Allan variance at τ = T — the mean square
 difference between two adjacent such means — from the fitted model: N²/T + (2 ln 2/π)B² + K²T/3. The
@@ -806,12 +807,14 @@ def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_wh
 
 
 def _turning_dither(shared, k: int, c: int, sigmas: np.ndarray) -> np.ndarray:
-    """The noise before the quantiser of turning segment *k*, channel *c*, for each σ of the static segments'
-    posterior: that σ with the segment's sweep (the trigonometric polynomial in the table angle, e.g. gravity
-    turned by the platform's tilt) added in quadrature; and, where the samples fall on three levels or more, at
-    least the scatter less q²/12 (Sheppard: the table's rate jitter dithers the quantiser). Samples on one or two
-    levels say nothing of a σ below q/2: a level that sits near a step's edge toggles between two codes with a
-    scatter up to q/2 whatever σ, and Sheppard's correction would read that as dither."""
+    """The noise before the quantiser of turning segment *k*, accelerometer channel *c*, for each σ of the static
+    segments' posterior: that σ with the segment's sweep (the trigonometric polynomial in the table angle, e.g.
+    gravity turned by the platform's tilt) added in quadrature; and, where the samples fall on three levels or
+    more, at least the scatter less q²/12 (Sheppard). Samples on one or two levels say nothing of a σ below q/2:
+    a level that sits near a step's edge toggles between two codes with a scatter up to q/2 whatever σ, and
+    Sheppard's correction would read that as dither. (A gyro's is not taken so: the table's rate jitter is noise
+    before its quantiser that the static segments do not show. Taken so, on `coarse_quantisation` nulls, whose
+    8-bit gyros no noise dithers, the lack of fit fired on 14 of 100 instead of 2.)"""
     step = shared.channels[c].quantisation_step
     out = np.sqrt(np.asarray(sigmas, dtype=float) ** 2 + shared.sweep[k, c] ** 2)
     table = _level_table(shared.segment_samples[k][:, c], step)
@@ -878,7 +881,8 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
                 slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
             own_quantisation = 0.0
             if ch.quantisation_step > 0:
-                if (s.is_rotating and not s.rate_known) or sigma_before[c] is None or not conditional:
+                if (s.is_rotating and (not s.rate_known or channel_kind(c) == "gyro")) or sigma_before[c] is None \
+                        or not conditional:
                     # turning: the signal itself sweeps the levels; its scatter less q²/12 (Sheppard)
                     dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
                     quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
