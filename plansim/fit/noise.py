@@ -883,13 +883,15 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
             if ch.quantisation_step > 0:
                 if (s.is_rotating and (not s.rate_known or channel_kind(c) == "gyro")) or sigma_before[c] is None \
                         or not conditional:
-                    # turning: the signal itself sweeps the levels; its scatter less q²/12 (Sheppard)
+                    # a gyro turning (the rate's jitter dithers it), a turn by hand, or the model over a level
+                    # unknown within its step: the scatter less q²/12 (Sheppard)
                     dither[k, c] = math.sqrt(max(within[k, c] ** 2 - ch.quantisation_step**2 / 12.0, 0.0))
                     quantisation[k, c] = float(quantisation_error_variance(ch.quantisation_step, dither[k, c]))
                     prior[k, c] = quantisation[k, c]
                 else:
-                    # static: the error given where the samples fall, averaged over the sensor's σ as all the
-                    # static segments' level counts give it.
+                    # static, or an accelerometer turning on a table (σ widened by its sweep): the error given
+                    # where the samples fall, averaged over the sensor's σ as all the static segments' level
+                    # counts give it.
                     # The quantiser's harmonics stand for up to q²/12 of it (shared by segments at one level);
                     # beyond that (a segment that toggles rarely: its mean off by most of a step) the excess is
                     # the segment's own error
