@@ -838,11 +838,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                          f"{len(noise_segments)} that are not moves; pass recording_noise(recording) of this "
                          "recording")
     keep = [noise_segments.index(k) for k in used]
-    noise = NoiseEstimate(all_noise.channels, all_noise.within_std[keep], all_noise.mean_variance[keep],
-                          all_noise.mean_variance_dof[keep], all_noise.quantisation_variance[keep],
-                          all_noise.quantisation_sigma[keep], all_noise.notes,
-                          None if all_noise.quantisation_prior_variance is None
-                          else all_noise.quantisation_prior_variance[keep])
+    noise = all_noise.subset(keep)
 
     m = observed.ravel()
     times = _middle_times(recording, used)

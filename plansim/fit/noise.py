@@ -559,6 +559,14 @@ class NoiseEstimate:
     #: this recording's levels happen to fall (plansim.fit.joint takes the uncertainty of the levels from it)
     quantisation_prior_variance: np.ndarray | None = None
 
+    def subset(self, rows) -> NoiseEstimate:
+        """The same estimate for the segments *rows* (indices into the S given), in that order."""
+        return NoiseEstimate(self.channels, self.within_std[rows], self.mean_variance[rows],
+                             self.mean_variance_dof[rows], self.quantisation_variance[rows],
+                             self.quantisation_sigma[rows], self.notes,
+                             None if self.quantisation_prior_variance is None
+                             else self.quantisation_prior_variance[rows])
+
 
 def turning_design(n: int, rate: float, sample_rate: float) -> np.ndarray:
     """(n, 1 + 2·TURNING_HARMONICS) columns 1, cos hθ, sin hθ (h = 1 … TURNING_HARMONICS) of a turning segment's
@@ -591,15 +599,17 @@ def turning_residuals(values: np.ndarray, rate: float, sample_rate: float) -> np
     return (flat - basis @ (basis.T @ flat)).reshape(values.shape)
 
 
-def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tuple[np.ndarray, int]:
-    """Scatter (6,) of a turning segment's samples about a degree-2 trigonometric polynomial in the angle."""
+def _turning_scatter(values: np.ndarray, rate: float, sample_rate: float) -> tuple[np.ndarray, int, np.ndarray]:
+    """Scatter (6,) of a turning segment's samples about a degree-2 trigonometric polynomial in the angle
+    (:func:`turning_design`), its degrees of freedom, and the polynomial's r.m.s. (6,) about its mean: how far the
+    signal itself sweeps the quantiser's levels (0 for a segment too short to fit it)."""
     n = values.shape[0]
     columns = 1 + 2 * TURNING_HARMONICS
     if n <= columns + 1:
-        return np.std(values, axis=0, ddof=1) if n > 1 else np.zeros(6), max(n - 1, 1)
+        return (np.std(values, axis=0, ddof=1) if n > 1 else np.zeros(6)), max(n - 1, 1), np.zeros(values.shape[1])
     residual = turning_residuals(values, rate, sample_rate)
     dof = n - columns
-    return np.sqrt(np.sum(residual**2, axis=0) / dof), dof
+    return np.sqrt(np.sum(residual**2, axis=0) / dof), dof, np.std(values - residual, axis=0)
 
 
 def stated_steps(scenario) -> np.ndarray:
@@ -722,8 +732,7 @@ def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_wh
     sweep = np.zeros((S, 6))
     for k, (s, x) in enumerate(zip(segments, segment_samples)):
         if s.is_rotating and s.rate_known:
-            within[k], within_dof[k] = _turning_scatter(x, s.rate, s.sample_rate)
-            sweep[k] = _turning_sweep(x, s.rate, s.sample_rate)
+            within[k], within_dof[k], sweep[k] = _turning_scatter(x, s.rate, s.sample_rate)
         elif x.shape[0] > 1:
             within[k], within_dof[k] = np.std(x, axis=0, ddof=1), x.shape[0] - 1
     everything = np.concatenate(segment_samples, axis=0)
@@ -821,16 +830,6 @@ def _turning_dither(shared, k: int, c: int, sigmas: np.ndarray) -> np.ndarray:
     if table is None or table[0].size >= 3:
         out = np.maximum(out, math.sqrt(max(shared.within[k, c] ** 2 - step**2 / 12.0, 0.0)))
     return out
-
-
-def _turning_sweep(values: np.ndarray, rate: float, sample_rate: float) -> np.ndarray:
-    """R.m.s. (6,) of a turning segment's trigonometric polynomial in the angle (:func:`turning_design`) about its
-    mean: how far the signal itself sweeps the quantiser's levels."""
-    n = values.shape[0]
-    if n <= 2 + 2 * TURNING_HARMONICS:
-        return np.zeros(values.shape[1])
-    fitted = values - turning_residuals(values, rate, sample_rate)
-    return np.std(fitted, axis=0)
 
 
 @dataclass(frozen=True)
