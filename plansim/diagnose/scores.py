@@ -642,35 +642,43 @@ def _profile_likelihood_ratios(fit, g: _Geometry, WS: np.ndarray, channel: np.nd
     for c in np.unique(channel):
         cols = np.flatnonzero(channel == c)
         segments = np.flatnonzero(fitted[:, c])
-        shape_of = {tau: Wp[:, segments * 6 + c] @ time_correlation(times[segments], tau)
-                    @ Wp[:, segments * 6 + c].T for tau in BETWEEN_CORRELATION_TIMES}
+        A = Wp[:, segments * 6 + c]  # N_c(τ) = A C(τ) Aᵀ, C(τ) the segments' correlation in time
         M0 = M
         if slow is not None and slow.variance[c] > 0:
-            M0 = M - slow.variance[c] * shape_of[float(slow.correlation_time[c])]
+            C = time_correlation(times[segments], float(slow.correlation_time[c]))
+            M0 = M - slow.variance[c] * (A @ C @ A.T)
         values, vectors = np.linalg.eigh(0.5 * (M0 + M0.T))
         ok = values > 1e-10 * max(values.max(), 1e-300)
         T = vectors[:, ok] / np.sqrt(values[ok])
+        # In the basis that diagonalises T N_c T, every direction outside N_c's range (rank ≤ the channel's
+        # segments) has λ = 0 and w = 1 at every σ²: its sums are taken once (the basis's rotation leaves them
+        # as they are in T's), and each grid point adds only the range's (w − 1) terms.
+        z, Z, X, TA = T.T @ g.r, T.T @ null, T.T @ WS[:, cols], T.T @ A
+        zz, ZZ, XX, Xz, XZ = float(z @ z), np.sum(Z**2, axis=0), np.sum(X**2, axis=0), X.T @ z, X.T @ Z
         best0, best0_null = -np.inf, np.full(B, -np.inf)
         best1, best1_null = np.full(cols.size, -np.inf), np.full((cols.size, B), -np.inf)
         best_size = np.zeros(cols.size)
         for tau in BETWEEN_CORRELATION_TIMES:
-            lam, Q = np.linalg.eigh(T.T @ shape_of[tau] @ T)
-            lam = np.maximum(lam, 0.0)
-            if lam.max() <= 0:
+            # the range of T N_c T = (TA L)(TA L)ᵀ, C(τ) = L Lᵀ: the left singular vectors of TA L
+            d, U = np.linalg.eigh(time_correlation(times[segments], tau))
+            P, s, _ = np.linalg.svd(TA @ (U * np.sqrt(np.maximum(d, 0.0))), full_matrices=False)
+            lam = s**2
+            if lam.size == 0 or lam.max() <= 0:
                 continue
-            G = (T @ Q).T
-            z, Z, X = G @ g.r, G @ null, G @ WS[:, cols]
+            zp, Zp, Xp = P.T @ z, P.T @ Z, P.T @ X
+            zp2, Zp2, Xp2 = zp**2, Zp**2, Xp**2
             for t in STEP_PROFILE_GRID:
                 w = 1.0 / (1.0 + (t / lam.max()) * lam)
+                dw = w - 1.0
                 half_log_det = 0.5 * float(np.sum(np.log(1.0 / w)))
-                l0 = -half_log_det - 0.5 * float(w @ z**2)
-                l0_null = -half_log_det - 0.5 * (w @ Z**2)
-                wX = X * w[:, None]
-                information = np.sum(wX * X, axis=0)
+                l0 = -half_log_det - 0.5 * (zz + float(dw @ zp2))
+                l0_null = -half_log_det - 0.5 * (ZZ + dw @ Zp2)
+                information = XX + dw @ Xp2
                 information = np.where(information > 0, information, np.inf)
-                cross = wX.T @ z
+                dX = Xp * dw[:, None]
+                cross = Xz + dX.T @ zp
                 l1 = l0 + 0.5 * cross**2 / information
-                l1_null = l0_null[None, :] + 0.5 * (wX.T @ Z) ** 2 / information[:, None]
+                l1_null = l0_null[None, :] + 0.5 * (XZ + dX.T @ Zp) ** 2 / information[:, None]
                 better = l1 > best1
                 best_size = np.where(better, cross / information, best_size)
                 best1 = np.maximum(best1, l1)
