@@ -39,6 +39,16 @@ def test_a_small_null_run_and_its_report(tmp_path, capsys):
     assert set(fired) == {"selection", "lack_of_fit", "unexplained_segment_level", "within_segment"}
     assert (sum(fired.values()) > 0) == (data["null"]["false_alarms"] > 0)
     assert sum(data["null"]["falsely_selected"].values()) >= fired["selection"]
+    # the parameters' errors per group of eq. (1)/(2), pooled: on one recording whose 39 parameters all have a u,
+    # the groups' coverages weighted by their counts are the whole's, and the counts are the 39
+    groups = data["null"]["by_group"]
+    assert set(groups) == {"Kg", "Bg", "G", "Ka", "Ba", "P"}
+    assert sum(g["values"] for g in groups.values()) == 39
+    pooled = sum(g["coverage_95"] * g["values"] for g in groups.values()) / 39
+    assert pooled == pytest.approx(data["null"]["coverage_95"], abs=1e-12)
+    pooled_rms = np.sqrt(sum(g["rms_z"] ** 2 * g["values"] for g in groups.values()) / 39)
+    assert pooled_rms == pytest.approx(data["null"]["rms_z"], rel=1e-12)
+    assert "r.m.s. z and 95 % coverage: all" in capsys.readouterr().out
     assert check_json(run_diagnose_check.__globals__["CheckReport"]("x", 0.05))["null"] == {}
     assert main(["diagnose-check", "--sizes", "2,x", "--quiet"]) == 2
     assert "--sizes '2,x'" in capsys.readouterr().err

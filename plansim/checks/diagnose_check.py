@@ -53,7 +53,7 @@ from plansim.io.recording_data import segment_first_samples
 from plansim.io.scenario_file import apply_overrides
 from plansim.kernels.layout import ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP
 from plansim.kernels.quantiser import quantise
-from plansim.model.parameters import PARAMETER_INDEX
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETERS
 from plansim.runner import simulate_and_record
 from plansim.simulate.arguments import kernel_arguments
 from plansim.simulate.chunks import simulate_recording
@@ -65,6 +65,8 @@ FIELDS = {"gyro_scale_asymmetry": "gyro_asymmetry", "gyro_scale_nonlinearity": N
 #: effects outside the catalogue, added to the samples (:func:`_add_out_of_catalogue`); the lever arm the fit is
 #: not told is run with the catalogue effects
 OUT_OF_CATALOGUE = ("bias_step", "clock_fast", "noise_burst", "scale_change", "segment_offset")
+#: each parameter's group (Kg, Bg, G, Ka, Ba, P), in the order of the fit's estimates
+PARAMETER_GROUP = tuple(spec.group for spec in PARAMETERS)
 #: the catalogue effects injected (the lever arm at a fixed 5 mm, the others at each size)
 CATALOGUE_CASES = ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivity", "accel_quadratic",
                    "bias_drift", "lever_arm")
@@ -162,7 +164,26 @@ def _run(scenario, recording, truth, alpha, null_draws, seed):
         zz = (m.estimate[ok] - truth[ok]) / m.u[ok]
         k = np.array([coverage_factor(nu) for nu in m.dof[ok]])
         z[label] = (float(np.sqrt(np.mean(zz**2))), float(np.mean(np.abs(zz) <= k)))
+        each = np.full((len(PARAMETER_GROUP), 2), np.nan)  # per parameter: z, and 1.0 where |z| ≤ k
+        each[ok, 0], each[ok, 1] = zz, np.abs(zz) <= k
+        z[f"{label}_each"] = each
     return d, z
+
+
+def _by_group(each: list) -> dict:
+    """The parameters' errors pooled over recordings, per group of eq. (1)/(2) (Kg, Bg, G, Ka, Ba, P): r.m.s. of
+    z = (estimate − truth)/u, the fraction within the 95 % coverage interval, and the number of values (a group's
+    values within one recording are correlated, so its binomial tolerance is wider than the count suggests)."""
+    each = np.asarray(each, dtype=float)  # (recordings, parameters, 2)
+    out = {}
+    for group in dict.fromkeys(PARAMETER_GROUP):
+        cols = [k for k, g in enumerate(PARAMETER_GROUP) if g == group]
+        z, covered = each[:, cols, 0], each[:, cols, 1]
+        ok = np.isfinite(z)
+        if np.any(ok):
+            out[group] = {"rms_z": float(np.sqrt(np.mean(z[ok] ** 2))), "coverage_95": float(np.mean(covered[ok])),
+                          "values": int(np.count_nonzero(ok))}
+    return out
 
 
 def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes=(2.0, 5.0, 10.0),
@@ -195,7 +216,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
             progress(done, total)
 
     # the null
-    alarms, selections, z_before = 0, 0, []
+    alarms, selections, z_before, each_before = 0, 0, [], []
     by_family = {"selection": 0, "lack_of_fit": 0, "unexplained_segment_level": 0, "within_segment": 0}
     falsely_selected: dict[str, int] = {}
     reference = None
@@ -213,13 +234,15 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         for effect in d.selected:
             falsely_selected[effect] = falsely_selected.get(effect, 0) + 1
         z_before.append(z["before"])
+        each_before.append(z["before_each"])
         tick()
     report.null = {"recordings": null, "false_alarms": alarms, "rate": alarms / null,
                    "selections": selections, "selection_rate": selections / null,
                    "binomial_99_upper_count": int(binom.ppf(0.99, null, alpha)),
                    "by_family": by_family, "falsely_selected": falsely_selected,
                    "rms_z": float(np.mean([v[0] for v in z_before])),
-                   "coverage_95": float(np.mean([v[1] for v in z_before]))}
+                   "coverage_95": float(np.mean([v[1] for v in z_before])),
+                   "by_group": _by_group(each_before)}
     if reference is None or per_effect == 0:
         return report
     nes = {c.effect: c for c in reference.candidates}

@@ -48,6 +48,9 @@ def _cmd_diagnose_check(args) -> int:
         fired = ", ".join(f"{k} {v}" for k, v in n["by_family"].items())
         wrong = ", ".join(f"{k} {v}" for k, v in n["falsely_selected"].items()) or "none"
         print(f"  by family (a recording may fire several): {fired}; selected: {wrong}")
+        groups = "; ".join(f"{g} {v['rms_z']:.2f}, {v['coverage_95']:.3f}" for g, v in n["by_group"].items())
+        print(f"  parameters of the base fit against the truth, r.m.s. z and 95 % coverage: all {n['rms_z']:.2f}, "
+              f"{n['coverage_95']:.3f}; {groups}")
         for e in data["effects"]:
             k = "" if e["times_noise_equivalent"] is None else f" x{e['times_noise_equivalent']:g}"
             print(f"{e['effect']}[{e['component']}]{k}: detection {e['detection']:.2f}, attribution "
