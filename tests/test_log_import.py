@@ -666,3 +666,20 @@ def test_many_tilted_poses_are_one_warning_that_lists_them(tmp_path):
     few = import_log(log, time_column="time")
     unknown = [span for span in few.segmentation.spans if span.kind == "static" and span.orientation == "unknown"]
     assert len([w for w in few.warnings if w.name == "tilted_pose"]) == len(unknown) <= TILTED_LISTED_APART
+
+
+def test_a_shake_at_the_rail_is_one_saturated_warning_in_counts(tmp_path):
+    """A 6 Hz shake on x clipped at the 16-bit rail hits it once per swing: one warning for the episode, its
+    rail in counts and in SI."""
+    t, x = synthetic_log(seconds_rest=6.0)
+    n_turn = 200
+    k = np.arange(n_turn)
+    x[600:600 + n_turn, 3] += 25.0 * np.sin(2 * np.pi * 6.0 * k / 100.0) * np.sin(np.pi * k / n_turn) ** 2
+    counts = np.clip(np.round(x / np.r_[[math.radians(1 / 16.4)] * 3, [9.80665 / 16384] * 3]), -32768, 32767)
+    write_synthetic(tmp_path / "log.csv", t, counts)
+    result = import_log(tmp_path / "log.csv", time_column="time", units="deg/s,g", scale="16.4,16384")
+    stretches = [s for s in result.segmentation.saturation if s.channel == 3]
+    assert len(stretches) > 2
+    saturated = [w.message for w in result.warnings if w.name == "saturated"]
+    assert len(saturated) == 1 and f"in {len(stretches)} stretches" in saturated[0]
+    assert all("counts (" in m and "m/s^2)" in m for m in saturated)

@@ -239,3 +239,52 @@ def test_two_equal_samples_at_a_peak_are_not_a_rail_unless_the_value_is_held_twi
     assert stuck_runs(twice, 12.0, 1.0) == [(3, 5), (11, 13)]
     # entered and left by one step (a slow peak of a quantised channel): never a rail
     assert stuck_runs(np.array([10.0, 11.0, 12.0, 12.0, 12.0, 12.0, 11.0]), 12.0, 1.0) == []
+
+
+def test_an_isolated_glitch_row_is_cut_out_of_the_poses_not_the_poses_out_of_the_log():
+    """A logger's row of six exact zeros (first row, near a pose's end, mid-pose) and a one-channel dropout: each
+    is found, no static span holds it, and the poses come out as without it (a pose cut or trimmed around it)."""
+    rng = np.random.default_rng(11)
+    rest = static_noise("white", 6.0, rng)
+    turning = static_noise("white", 3.0, rng)
+    turning[:, 2] += math.radians(120.0) * np.sin(np.pi * np.arange(turning.shape[0]) / turning.shape[0]) ** 2
+    x = np.concatenate([rest, turning, static_noise("white", 6.0, rng)])
+    clean = segment_log(x, None, FS)
+    assert clean.glitches == ()
+    poses = [(s.start, s.stop) for s in clean.of_kind("static")]
+    for row, channels in ((0, slice(0, 6)), (poses[0][1] - 8, slice(0, 6)), (300, slice(0, 6)),
+                          (poses[1][0] + 5, slice(5, 6))):
+        bad = x.copy()
+        bad[row, channels] = 0.0
+        result = segment_log(bad, None, FS)
+        assert result.glitches == (row,)
+        statics = result.of_kind("static")
+        assert not any(s.start <= row < s.stop for s in statics)
+        # the same poses: pieces of one pose joined back, within a window of the clean extents
+        joined = []
+        for s in statics:
+            if joined and joined[-1][1] == row and s.start == row + 1:
+                joined[-1] = (joined[-1][0], s.stop)
+            else:
+                joined.append((s.start, s.stop))
+        assert len(joined) == len(poses)
+        for (a, b), (c, d) in zip(joined, poses):
+            assert abs(a - c) <= result.window and abs(b - d) <= result.window
+        assert all(s.kind != "static" for s in result.spans if s.start <= row < s.stop), row
+
+
+def test_the_rate_of_a_quantised_jittery_clock_is_its_mean_rate():
+    """99.7 Hz, 0.5 ms of jitter, stamps rounded to 0.1 ms: the median step is 10.0 ms (100 Hz); the mean
+    period over the steps that are not gaps gives the true rate, and a gap is still found."""
+    rng = np.random.default_rng(12)
+    n = 6000
+    t = np.sort(np.arange(n) / 99.7 + rng.normal(0.0, 5e-4, n))
+    t = np.round(t * 1e4) / 1e4
+    assert np.median(np.diff(t)) == pytest.approx(0.01)
+    report = analyse_time(t, n)
+    assert report.sample_rate == pytest.approx(99.7, abs=0.01)
+    assert report.gaps == ()
+    gapped = np.delete(t, np.arange(3000, 3200))  # 200 samples missing
+    report = analyse_time(gapped, gapped.size)
+    assert report.sample_rate == pytest.approx(99.7, abs=0.01)
+    assert [k for k, _ in report.gaps] == [3000] and report.missing_samples == 200

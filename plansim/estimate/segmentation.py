@@ -23,6 +23,11 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    clipped samples) and the noise of a *w*-sample gyro mean, s = 1.4826 · MAD(m(t + w) − m(t)) / √2 (a
    robust overlapping Allan deviation at τ = *w* samples; at least σ/√w, which it equals for white
    noise, and larger for correlated noise).
+4b. **Isolated glitch rows** (:func:`isolated_glitches`): a row of six exact zeros between rows that are not, or
+   a sample far off both neighbours (``GLITCH_SIGMA`` σ, ``GLITCH_TAIL`` × the largest such deviation in ``Q``,
+   ``GLITCH_RATIO`` × the neighbours' own variation, those neighbours quiet). The detector and a turn's integral
+   take such a row as the mean of its neighbours; no static span holds one (a pose is cut at it, a piece shorter
+   than a window trimmed off), and ``Segmentation.glitches`` lists them.
 5. **Quiet samples.** A sample is quiet when, over its window, Σ_accel var/σ² and Σ_gyro var/σ² are each
    at most the larger of ``VARIANCE_FACTOR`` × 3 (3 is the expected sum at rest) and the median of that
    sum in ``Q`` plus ``SPREAD_FACTOR`` robust standard deviations of it (wider for correlated or
@@ -138,6 +143,18 @@ SATURATION_RUN = 3
 #: converter's rail is not its part's nominal range: a "±2000 °/s" 16-bit gyro at its nominal 16.4 LSB/(°/s) tops
 #: out at 32767 / 16.4 = 1998.0 °/s, 0.1 % below it
 FULL_SCALE_MARGIN = 5e-3
+#: an isolated glitch row (step 4b): a channel's sample is further than this many σ from the mean of its two
+#: neighbours...
+GLITCH_SIGMA = 20.0
+#: ... and further than this many times the largest such deviation in the quiet stretch (heavy-tailed noise shows
+#: its tails there too) ...
+GLITCH_TAIL = 30.0
+#: ... and further than this many times its neighbours' own variation (|x[k+1] − x[k−1]|, |x[k−1] − x[k−2]|,
+#: |x[k+2] − x[k+1]|): a step or a motion onset moves the neighbours too ...
+GLITCH_RATIO = 5.0
+#: ... while that variation is at most this many times the largest in the quiet stretch (and at least 10 σ): the
+#: neighbours are quiet (a knock in a hand-made move, one sample wide, is motion, not a glitch)
+GLITCH_QUIET = 2.0
 #: robust standard deviation from the median absolute deviation of a normal distribution
 MAD_TO_SIGMA = 1.482602218505602
 
@@ -153,8 +170,9 @@ class TimeReport:
     sample_rate : float
         The nominal sample rate used, Hz (given, or estimated).
     estimated_rate : float
-        1 / median time step, Hz, or the samples over the span where the clock is coarser than the sampling
-        (more samples than clock steps); NaN without a time column.
+        The number of time steps that are not breaks (gaps, dropped samples) over their summed duration — 1 / the
+        mean period, so a clock quantised or jittering about the period gives the true mean rate — Hz; NaN
+        without a time column.
     jitter_rms, jitter_max : float
         RMS and largest deviation of a time step from 1 / sample_rate, gaps excluded, s.
     gaps : tuple of (int, float)
@@ -198,9 +216,11 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     samples : int
         N, the number of samples.
     sample_rate : float or None
-        The nominal rate, Hz; ``None``: 1 / the median time step, or (N − 1)/span where the span holds more than
-        :data:`COARSE_CLOCK_FACTOR` times the samples that step implies (a clock coarser than the sampling: its
-        steps of 0 are reported as ``repeated``, and a gap is then a step of more than ``GAP_FACTOR`` clock steps).
+        The nominal rate, Hz; ``None``: the mean rate over the time steps that are not breaks (their number over
+        their summed duration). Breaks are found against the median step, or against (N − 1)/span where the span
+        holds more than :data:`COARSE_CLOCK_FACTOR` times the samples that step implies (a clock coarser than the
+        sampling: its steps of 0 are reported as ``repeated``, and a gap is then a step of more than
+        ``GAP_FACTOR`` clock steps): a step longer than ``GAP_FACTOR`` times that period.
     """
     if time is None:
         if sample_rate is None:
@@ -231,6 +251,12 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     glitch = np.zeros_like(gap)
     glitch[1:] = (dt[:-1] == 0) & (dt[:-1] + dt[1:] <= (1.0 + GAP_FACTOR) * step)
     gap &= ~glitch
+    # the rate: the mean period over the steps that are not breaks (gaps and dropped samples), not 1 / the median
+    # step, which a clock quantised to about the period's jitter pins to a whole number of its ticks
+    if np.any(~gap) and float(np.sum(dt[~gap])) > 0:
+        estimated = float(np.count_nonzero(~gap)) / float(np.sum(dt[~gap]))
+        nominal = estimated if sample_rate is None else float(sample_rate)
+        period = 1.0 / nominal
     breaks = [(int(k) + 1, float(dt[k]), max(round(dt[k] * nominal) - 1, 1)) for k in np.flatnonzero(gap)]
     gaps = tuple((k, d) for k, d, m in breaks if m > DROPPED_MAX)
     missing = int(sum(m for _, _, m in breaks if m > DROPPED_MAX))
@@ -325,7 +351,8 @@ class Segmentation:
     ``min_static`` are in samples; ``variance_threshold`` the bounds on the summed variance ratios
     (accelerometers, gyros) and
     ``rate_threshold`` (3,) the gyro offset, rad/s, beyond which a quiet run is a steady turn;
-    ``saturation`` lists the stuck stretches; ``steady_turns`` the quiet runs that were steady turns.
+    ``saturation`` lists the stuck stretches; ``steady_turns`` the quiet runs that were steady turns;
+    ``glitches`` the isolated glitch rows (step 4b), in no static span.
     """
 
     spans: tuple[Span, ...]
@@ -336,6 +363,7 @@ class Segmentation:
     rate_threshold: np.ndarray
     saturation: tuple[Saturation, ...]
     steady_turns: tuple[tuple[int, int], ...]
+    glitches: tuple[int, ...] = ()
 
     def of_kind(self, kind: str) -> list[Span]:
         return [span for span in self.spans if span.kind == kind]
@@ -490,6 +518,19 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     start = _quiet_stretch(np.sum(var / typical, axis=1), quiet_length, near_gap)
     quiet = slice(start, start + quiet_length)
 
+    # 4b. isolated glitch rows (a logger's zero row, a dropout): the detector sees each as the mean of its
+    # neighbours, and no static span holds one (they are cut out of the poses below)
+    glitch = isolated_glitches(x, quiet, _sigma(var[quiet], w, floor), full_scale)
+    logged = x
+    if glitch.any():
+        x = x.copy()
+        rows = np.flatnonzero(glitch)
+        below, above = np.maximum(rows - 1, 0), np.minimum(rows + 1, n - 1)
+        below = np.where(rows == 0, above, below)
+        above = np.where(rows == n - 1, below, above)
+        x[rows] = 0.5 * (x[below] + x[above])
+        mean, var = moving_mean_variance(x, w)
+
     # 4. the noise in it; then once more with each sample clipped to CLIP σ about the nearer of the means of
     # the w samples before it and the w samples after it, so that an isolated spike cannot make a window look
     # like motion, while a step (near one of the two means) is not smeared and a ramp (the means follow it)
@@ -564,12 +605,31 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
                          f"{variance_threshold[1]:.3g} (gyros) over windows of {w} samples "
                          "and the gyro output within the rest threshold (docs/measured-data.md)")
 
+    # 4b. no static span holds a glitch row: a pose is cut at each, and a piece shorter than a window is left to
+    # the motion beside it (a pose trimmed)
+    held_pieces = set()
+    if glitch.any():
+        pieces = []
+        for a, b in static_runs:
+            cuts = np.flatnonzero(glitch[a:b]) + a
+            for lo, hi in zip(np.concatenate(([a], cuts + 1)).tolist(), np.concatenate((cuts, [b])).tolist()):
+                if hi - lo >= w:
+                    pieces.append((lo, hi))
+                    if (a, b) in held:
+                        held_pieces.add((lo, hi))
+        static_runs = pieces
+    else:
+        held_pieces = set(held)
+    if not static_runs:
+        raise ValueError(f"too few static samples: every span at rest is cut by isolated glitch rows into pieces "
+                         f"shorter than a window of {w} samples")
+
     # 7-10. poses, motion, steady rates, saturation
     statics = []
     for a, b in static_runs:
         m = x[a:b].mean(axis=0)
         up, tilt = nearest_axis(m[3:])
-        shake = float(np.max(np.std(x[a:b, :3], axis=0) / sigma[:3])) if (a, b) in held else math.nan
+        shake = float(np.max(np.std(x[a:b, :3], axis=0) / sigma[:3])) if (a, b) in held_pieces else math.nan
         # a pose joined from pieces holds the samples between them too (at most a window of them)
         statics.append(Span("static", a, b, m, up=up, tilt=tilt,
                             orientation="approximate" if tilt <= APPROXIMATE_TILT else "unknown", held=shake))
@@ -579,13 +639,30 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     for span in statics + [None]:
         lo = 0 if previous is None else previous.stop
         hi = n if span is None else span.start
-        if hi > lo:
+        if hi > lo and _cut_at_glitch(glitch[lo:hi], w, previous, span):
+            spans.append(Span("move", lo, hi, logged[lo:hi].mean(axis=0), up=(previous or span).up,
+                              reason="isolated glitch row(s) cut out of the pose around them (step 4b)"))
+        elif hi > lo:
             spans.append(_motion(x, times, lo, hi, previous, span, gap_starts, saturation, steady))
         if span is not None:
             spans.append(span)
         previous = span
     return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
-                        tuple(steady))
+                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()))
+
+
+def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span | None) -> bool:
+    """Whether the motion between the static spans *before* and *after* (either may be None) is only what step 4b
+    cut out of a pose: glitch rows alone, or glitch rows and pieces shorter than a window (*w* samples) at an end
+    of the log or between two spans in the same pose."""
+    if glitch.all():
+        return True
+    if not glitch.any() or np.count_nonzero(~glitch) >= 2 * w:
+        return False
+    if before is None or after is None:
+        return True
+    f, g = before.mean[3:], after.mean[3:]
+    return float(np.dot(f, g)) >= math.cos(SAME_POSE) * float(np.linalg.norm(f) * np.linalg.norm(g))
 
 
 def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray,
@@ -681,6 +758,51 @@ def _one_sided_reference(x: np.ndarray, w: int) -> np.ndarray:
         after = np.where(k < n - 1, (sums[hi] - sums[k + 1]) / n_after, np.inf) + centre
         out[:, c] = np.where(np.abs(x[:, c] - before) <= np.abs(x[:, c] - after), before, after)
     return out
+
+
+def isolated_glitches(x: np.ndarray, quiet: slice, sigma: np.ndarray,
+                      full_scale: np.ndarray | None = None) -> np.ndarray:
+    """Rows of *x* that are isolated glitches (step 4b of the module docstring).
+
+    Parameters
+    ----------
+    x : (N, 6) array
+        The samples, SI.
+    quiet : slice
+        The quietest stretch ``Q`` (step 3): the largest deviation of a sample from its neighbours' mean there
+        sets how heavy the noise's tails are.
+    sigma : (6,) array
+        Each channel's noise per sample (step 4), SI.
+    full_scale : (6,) array or None
+        Declared full scales (NaN where not known): a sample at its rail is a reading, never a glitch.
+
+    Returns
+    -------
+    (N,) bool array
+        True for a glitch row: all six channels exactly 0 while a neighbour row is not, or some channel further
+        from the mean of its two neighbours (the one neighbour at an end of the log) than :data:`GLITCH_SIGMA` σ,
+        :data:`GLITCH_TAIL` times the largest such deviation in ``Q`` and :data:`GLITCH_RATIO` times the
+        neighbours' own variation, that variation being quiet (at most :data:`GLITCH_QUIET` times its largest in
+        ``Q``, or 10 σ if more).
+    """
+    n = x.shape[0]
+    glitch = np.zeros(n, dtype=bool)
+    if n < 4:
+        return glitch
+    zero = np.all(x == 0.0, axis=1)
+    glitch |= zero & ~np.concatenate(([False], zero[:-1])) & ~np.concatenate((zero[1:], [False]))
+    padded = np.concatenate((x[2:0:-1], x, x[-2:-4:-1]))  # mirrored: an end's one neighbour stands for both
+    before, after = padded[1:-3], padded[3:-1]
+    deviation = np.abs(x - 0.5 * (before + after))
+    variation = np.maximum.reduce([np.abs(after - before), np.abs(before - padded[:-4]),
+                                   np.abs(padded[4:] - after)])
+    tail = np.max(deviation[quiet], axis=0)
+    threshold = np.maximum(GLITCH_SIGMA * sigma, GLITCH_TAIL * tail)
+    quiet_neighbours = variation <= np.maximum(10.0 * sigma, GLITCH_QUIET * np.max(variation[quiet], axis=0))
+    far = (deviation > threshold) & (deviation > GLITCH_RATIO * variation) & quiet_neighbours
+    if full_scale is not None:
+        far &= ~(np.abs(x) >= (1.0 - FULL_SCALE_MARGIN) * np.where(np.isnan(full_scale), np.inf, full_scale))
+    return glitch | np.any(far, axis=1)
 
 
 def _sigma(variance: np.ndarray, w: int, floor: np.ndarray) -> np.ndarray:

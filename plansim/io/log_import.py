@@ -73,7 +73,12 @@ FULL_SCALE_EXCEEDED = 0.02
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
-                 "rest_turning_about_vertical")
+                 "rest_turning_about_vertical", "glitch")
+#: up to this many glitch rows are listed by line in the warning
+GLITCHES_LISTED = 10
+#: two saturated stretches of one channel at most this many detector windows apart are one episode (a shake hits
+#: the rail once per swing): one warning for it
+SATURATION_EPISODE_WINDOWS = 1
 #: a static pose whose gyro output is at least this (rad/s) and points along its own specific force (within
 #: :data:`VERTICAL_TURN_CONE`) is warned of as possibly a steady turn about the vertical: the one turn that leaves
 #: the accelerometers steady, which the detector (step 6) can tell from rest only against a rest elsewhere in the log
@@ -615,19 +620,33 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         raise ValueError(f"{where}: at rest the accelerometers read {at_rest:.3f} m/s^2 (median over "
                          f"{len(statics)} static span(s)); expected about {STANDARD_GRAVITY} m/s^2 (1 g). Are the "
                          f"accelerometer columns, units or scale right? (read as {unit_text})")
-    for s in segmentation.saturation:
-        first, last = table.lines[s.start], table.lines[s.stop - 1]
-        shown = s.value / factors[s.channel] * divisors[s.channel] + offsets[s.channel]  # as the file has it
-        channel = f"channel {CHANNELS[s.channel]} ({table.names[s.channel]})"
-        pose = next((span for span in statics if span.start < s.stop and s.start < span.stop), None)
+    if segmentation.glitches:
+        rows = segmentation.glitches
+        listed = ", ".join(str(table.lines[k]) for k in rows[:GLITCHES_LISTED]) + (", …" if len(rows) >
+                                                                                   GLITCHES_LISTED else "")
+        warnings.append(LogWarning("glitch", f"{len(rows)} isolated glitch row(s) (all six channels exactly 0, or "
+                                             "a sample far off both its neighbours), on line(s) " + listed + ": kept "
+                                             "in the recording as logged, but in no static pose (a pose is cut or "
+                                             "trimmed around each); the detector and a turn's integral take each as "
+                                             "the mean of its neighbours"))
+    for episode in _saturation_episodes(segmentation.saturation, SATURATION_EPISODE_WINDOWS * segmentation.window):
+        c, start, stop = episode[0].channel, episode[0].start, max(s.stop for s in episode)
+        first, last = table.lines[start], table.lines[stop - 1]
+        extent = f"lines {first}-{last} ({(stop - start) / timing.sample_rate:.3g} s)"
+        values = sorted({s.value for s in episode})
+        shown = " and ".join(_as_logged(v, c, factors, divisors, offsets, unit_names, counts_per_unit is not None)
+                             for v in values)
+        channel = f"channel {CHANNELS[c]} ({table.names[c]})"
+        stretches = "" if len(episode) == 1 else f" in {len(episode)} stretches"
+        pose = next((span for span in statics if span.start < stop and start < span.stop), None)
         in_pose = ("" if pose is None else f"; inside the static pose on lines {table.lines[pose.start]}-"
                    f"{table.lines[pose.stop - 1]}, whose mean it clips: remove that segment from the table")
         if rails is None:
-            text = (f"{channel} stuck at {shown:.6g} (its extreme) on lines {first}-{last}: a rail? A turn over it "
-                    "has no angle")
+            text = (f"{channel} stuck at {shown} (its extreme){stretches} on {extent}: a rail? A turn "
+                    "over it has no angle")
         else:
-            text = (f"{channel} reads {shown:.6g}, at its full scale of {rails[s.channel]:g} {unit_names[s.channel]} "
-                    f"(--full-scale), on lines {first}-{last}: a turn over it has no angle")
+            text = (f"{channel} reads {shown}, at its full scale of {rails[c]:g} {unit_names[c]} (--full-scale)"
+                    f"{stretches}, on {extent}: a turn over it has no angle")
         warnings.append(LogWarning("saturated", text + in_pose))
     tilted = [span for span in statics if span.orientation == "unknown"]
     if len(tilted) <= TILTED_LISTED_APART:
@@ -740,6 +759,27 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         raise ValueError(f"{where}: {exc}") from None
     return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings),
                         zero_counts)
+
+
+def _saturation_episodes(saturation, apart: int) -> list[list]:
+    """The saturated stretches grouped per channel into episodes: a stretch at most *apart* samples after the
+    previous one of its channel belongs to the same episode. In order of each episode's first sample."""
+    episodes: dict[int, list[list]] = {}
+    for s in sorted(saturation, key=lambda s: (s.channel, s.start)):
+        mine = episodes.setdefault(s.channel, [])
+        if mine and s.start - max(t.stop for t in mine[-1]) <= apart:
+            mine[-1].append(s)
+        else:
+            mine.append([s])
+    return sorted((e for mine in episodes.values() for e in mine), key=lambda e: (e[0].start, e[0].channel))
+
+
+def _as_logged(value: float, c: int, factors, divisors, offsets, unit_names, counts: bool) -> str:
+    """A channel's SI *value* as the file has it, with its unit: counts (and the SI value), or the --units unit."""
+    si_unit = "rad/s" if c < 3 else "m/s^2"
+    if counts:
+        return f"{value / factors[c] * divisors[c] + offsets[c]:.6g} counts ({value:.6g} {si_unit})"
+    return f"{value / factors[c]:.6g} {unit_names[c]}"
 
 
 def _segment(span: Span, number: int, sample_rate: float, temperature: float) -> Segment:
