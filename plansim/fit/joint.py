@@ -37,7 +37,7 @@ from threadpoolctl import threadpool_limits
 
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
-from plansim.fit.identify import Identifiability, identifiability
+from plansim.fit.identify import NULL_TOLERANCE, RANK_TOLERANCE, Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
 from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
@@ -51,6 +51,12 @@ from plansim.uncertainty.metrology.propagation import combine
 #: model holds it at its nominal value, 1 or 0): 1 %, the scale-factor error and misalignment a MEMS gyro's
 #: data sheet allows (docs/fitting.md); its effect is ≤ 0.01·7.3e-5 rad/s on a segment mean
 HELD_KG_UNCERTAINTY = 0.01
+#: standard uncertainty of the symmetric part of a pair of Ka's cross-couplings (Ka_ij = Ka_ji: a shear of the
+#: triad) that poses placed by hand do not determine (at first order a tilt of an axis-aligned pose is a
+#: cross-coupling) but that still moves what the fit uses (a pose a few degrees off its axis; the moves' gravity
+#: directions): held at 0 with this Type B uncertainty, 1 %, the cross-axis sensitivity a MEMS accelerometer's data
+#: sheet allows (docs/fitting.md)
+HELD_KA_UNCERTAINTY = 0.01
 #: two-sided probability outside which a χ² (fit, or between-segment comparison) is flagged
 CHI2_FLAG_PROBABILITY = 0.01
 
@@ -308,6 +314,9 @@ class FitResult:
     #: inputs of the means (sensitivity columns, u, ν, kind): what the moves' fit carries on (:mod:`plansim.fit.moves`)
     gain: np.ndarray | None = field(default=None, repr=False)
     sources: object = field(default=None, repr=False)
+    #: inputs propagated through the gain but not weighed by (an accelerometer cross-coupling held at 0 where poses
+    #: placed by hand leave it with their tilts: HELD_KA_UNCERTAINTY); the moves map them as they map ``sources``
+    held_sources: object = field(default=None, repr=False)
     #: the gyros from the moves between poses (:func:`plansim.fit.moves.fit_moves`); None without two usable moves
     moves: object = None
 
@@ -425,6 +434,16 @@ class _Sources:
         self.u.append(float(u))
         self.dof.append(float(dof))
         self.kind.append(kind)
+
+    def joined(self, other: _Sources) -> _Sources:
+        """These sources and *other*'s (the same size), as a new set."""
+        out = _Sources(self.size)
+        for source in (self, other):
+            out.columns += source.columns
+            out.u += source.u
+            out.dof += source.dof
+            out.kind += source.kind
+        return out
 
     def matrix(self) -> np.ndarray:
         """(6S, n) sensitivity × u."""
@@ -577,6 +596,89 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
     for k in held:
         sources.add(jacobian[:, k], HELD_KG_UNCERTAINTY, math.inf, "held")
     return sources
+
+
+def _held_cross_couplings(ident: Identifiability, J: np.ndarray) -> list[tuple[int, int]]:
+    """The pairs (Ka_ij, Ka_ji) whose symmetric part — both moved alike, a shear of the accelerometer triad — the
+    recording's poses placed by hand do not determine (its direction, over the 39 parameters and the tilts, is not
+    in the design's row space at the nominal point: :class:`plansim.fit.identify.Identifiability`) but that still
+    moves the means (*J*). The antisymmetric part is a rotation of the triad, which the poses' tilts take up
+    whole: a frame, not an error (the moves report Kg's cross-couplings relative to the triad)."""
+    out = []
+    for a, b in ((f"Ka{x}{y}", f"Ka{y}{x}") for x, y in ("xy", "xz", "yz")):
+        i, j = PARAMETER_INDEX[a], PARAMETER_INDEX[b]
+        if a in ident.identified and b in ident.identified:
+            continue
+        direction = np.zeros(ident.scale.size)
+        direction[[i, j]] = 1.0
+        scaled = direction * ident.scale
+        size = float(np.linalg.norm(scaled))
+        if size == 0.0 or not np.any(J[:, i] + J[:, j]):
+            continue
+        within = ident.row_space.T @ (ident.row_space @ scaled)
+        if float(np.linalg.norm(scaled - within)) > NULL_TOLERANCE * size:
+            out.append((i, j))
+    return out
+
+
+def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank: int,
+                pairs: list[tuple[int, int]]) -> list[float]:
+    """The standard uncertainty of each held pair's symmetric part (:func:`_held_cross_couplings`):
+    :data:`HELD_KA_UNCERTAINTY`, or less where the poses' tilts give the data a hold on it.
+
+    At the fitted tilts, second-order terms can determine what the nominal point could not, and the fit frees
+    those combinations when χ² drops by more than its 99 % quantile. Where it did not, a pair's symmetric part
+    is below about √χ²₀.₉₉ times the u it would have had freed (from the design at the fitted tilts, under the
+    fit's weights): uniform within that bound, its standard uncertainty is the bound/√3, if that is below the
+    data sheet's. Where the fit freed them (*rank* above *nominal_rank*), the gain carries them and the bound is
+    that u."""
+    local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
+                            nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
+    out = [HELD_KA_UNCERTAINTY] * len(pairs)
+    if local.rank <= nominal_rank:
+        return out
+    design = np.hstack([model.parameter_jacobian(earth_rate=True, tilts=tilts),
+                        model.tilt_jacobian(theta, tilts)]) @ local.basis
+    X = W @ design
+    information = X.T @ X
+    covariance = local.basis @ np.linalg.pinv(information) @ local.basis.T
+    factor = 1.0 if rank > nominal_rank else math.sqrt(_chi2_quantile(local.rank - nominal_rank, 0.99) / 3.0)
+    for k, (a, b) in enumerate(pairs):
+        v = np.zeros(covariance.shape[0])
+        v[[a, b]] = 0.5  # the symmetric part (Ka_ij + Ka_ji)/2
+        freed = math.sqrt(max(float(v @ covariance @ v), 0.0))
+        out[k] = min(HELD_KA_UNCERTAINTY, factor * freed)
+    return out
+
+
+def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.ndarray) -> np.ndarray:
+    """The basis of the fit's steps with the *held* parameters' rows zero, where that spans what *basis* spans.
+
+    At the nominal point a hand-placed pose's tilt and an accelerometer's cross-coupling move the means alike, so
+    the determined combinations mix the two, and a step along them moves both. The combination the data cannot
+    determine then stays wherever the start put it: the start's tilts, which are read from the data themselves.
+    The fit's answer, and its gain on the means, would depend on that start (a cross-coupling of 0.005 moved Ba by
+    twice what the gain said). Held at its nominal value (0) instead, the parameter is what the fit says it is,
+    the tilts carry the combination, and the gain is the fit's derivative; the parameter's own Type B uncertainty
+    (HELD_KA_UNCERTAINTY) goes through that gain. Returns *basis* unchanged where the zeroed one loses rank on
+    *design* (the design at the nominal point, with the tilts' columns)."""
+    if not held:
+        return basis
+    fixed = basis.copy()
+    fixed[held] = 0.0
+    u, sv, _ = np.linalg.svd(fixed, full_matrices=False)
+    keep = sv > RANK_TOLERANCE * max(sv.max(initial=0.0), 1e-300)
+    if int(keep.sum()) != rank:
+        return basis
+    candidate = u[:, keep] * sv[keep]
+    steps = design @ candidate
+    norms = np.linalg.norm(steps, axis=0)
+    if np.any(norms <= 0):
+        return basis
+    singular = np.linalg.svd(steps / norms, compute_uv=False)
+    if int(np.sum(singular > RANK_TOLERANCE * singular.max())) != rank:
+        return basis
+    return candidate
 
 
 def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "") -> Method:
@@ -829,6 +931,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      "misalignment is fitted (two nuisance parameters)")
     held = [PARAMETER_INDEX[p.name] for p in PARAMETERS
             if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
+    held_cross = _held_cross_couplings(ident, J) if model.n_tilts else []
 
     # noise: every segment that is not a move (any pose at rest shows the sensors' noise)
     noise_segments = _noise_segments(schedule)
@@ -843,6 +946,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     m = observed.ravel()
     times = _middle_times(recording, used)
     basis = ident.basis
+    if model.n_tilts:
+        basis = _held_at_nominal(basis, sorted({k for pair in held_cross for k in pair}), ident.rank,
+                                 np.hstack([model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts),
+                                            model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)])[rows])
     theta, tilts, levels = theta0, tilts0, None
     slow = None
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
@@ -893,7 +1000,11 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                       coupled=model.n_tilts > 0)
             if not np.any(slow.variance > 0):
                 break
-    joint = _propagate(METHOD_JOINT, gain, sources, mask)
+    held_sources = _Sources(len(m))
+    bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross) if held_cross else []
+    for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
+        held_sources.add(J[:, a] + J[:, b], u, math.inf, "held")
+    joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
@@ -956,7 +1067,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      covariance=V, whitening=W, design=design, rows=rows,
                      segment_times=times, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
-                     gain=gain, sources=sources)
+                     gain=gain, sources=sources, held_sources=held_sources)
     if moves:
         transitions, unused_moves = find_transitions(recording)
         try:

@@ -40,6 +40,10 @@ Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kern
   directly, are correlated through the data, and this carries the correlation);
 - the Earth rate during the move, which the linear interpolation of the bias does not follow: a rate of up
   to Ω_E about an axis not known, Type B, u = Ω_E/√3 per axis, held over the move;
+- the symmetric part of each pair of Ka's cross-couplings the joint fit holds at 0 (poses placed by hand near the
+  axes do not determine the triad's shear, which bends each pose's gravity direction): its Type B uncertainty
+  (:data:`plansim.fit.joint.HELD_KA_UNCERTAINTY`, the joint fit's ``held_sources``) through ∂r/∂m + ∂r/∂θ·A like
+  the joint fit's inputs, but not into the weights;
 - noise between moves beyond all of that (a hand that shakes at the ends of a pose, timing, effects beyond
   eq. (1)): one variance per residual component, estimated by restricted maximum likelihood and taken when
   2·Δlog L passes :data:`plansim.fit.joint.BETWEEN_LR_THRESHOLD`, as the joint fit's noise between segments.
@@ -50,7 +54,8 @@ out in the frame where Ka's cross-couplings take the joint fit's values. Where t
 identify them (poses placed by hand: held at 0), Kg's cross-couplings are the gyros' misalignment relative to
 the accelerometer triad, not to the case; to first order they estimate Kg_ij − (Ka_ij − Ka_ji)/2. They are
 then reported with that frame and are not counted as identified; the scale factors Kg_ii do not depend on
-it (to first order) and are. docs/fitting.md.
+the triad's rotation (to first order) and are. They do depend on its shear (the symmetric part), which is why
+that part's held uncertainty is carried. docs/fitting.md.
 
 The moves read the accelerometers with the antisymmetric part of each such pair of Ka's cross-couplings
 removed (the joint fit may leave it anywhere in its null space: a common rotation of every pose is a rotation
@@ -385,6 +390,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     slow_dof = max(float(min(ch.static_segments for ch in gyro_noise)) - 1.0, 1.0)
     joint_gain = fit.gain  # (39, 6S)
     joint_sources = fit.sources
+    held_sources = fit.held_sources if fit.held_sources is not None else sources_class(joint_gain.shape[1])
 
     def build(Kg, dark):
         sources = sources_class(2 * n_moves)
@@ -416,12 +422,15 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         total = mean_sensitivity(Kg) + joint_sensitivity(Kg) @ joint_gain  # L = ∂r/∂m + ∂r/∂θ·A
         for column, u, dof, kind in zip(joint_sources.columns, joint_sources.u, joint_sources.dof, joint_sources.kind):
             sources.add(total @ column, u, dof, kind)
+        held = sources_class(2 * n_moves)  # propagated, not weighed by (the joint fit's held_sources)
+        for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
+            held.add(total @ column, u, dof, kind)
         if dark > 0:
             for i in range(2 * n_moves):
                 column = np.zeros(2 * n_moves)
                 column[i] = 1.0
                 sources.add(column, math.sqrt(dark), max(2 * n_moves - basis.shape[1], 1), "between")
-        return sources, jacobian, angles
+        return sources, jacobian, angles, held
 
     def solve(V, Kg_start):
         values, vectors = np.linalg.eigh(0.5 * (V + V.T))
@@ -456,7 +465,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     dark = 0.0
     V_predicted = None
     for iteration in range(3):
-        sources, jacobian, angles = build(Kg, dark)
+        sources, jacobian, angles, _ = build(Kg, dark)
         V = sources.covariance()
         if iteration == 0:
             # from each sign of the three scale factors: a gyro wired with its sign flipped against the
@@ -477,7 +486,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             dark = _dark_variance(r, V, hat, threshold)
             if dark == 0.0:
                 break
-    sources, jacobian, angles = build(Kg, dark)
+    sources, jacobian, angles, held = build(Kg, dark)
     V = sources.covariance()
     Vinv = np.linalg.pinv(V)
     Jz = jacobian @ basis
@@ -487,7 +496,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     gain[KG_INDEX] = -basis @ gain_z  # Kg moves against the residual it explains
     mask = np.zeros(len(PARAMETER_NAMES), bool)
     mask[KG_INDEX[kg_mask]] = True
-    method = propagate(METHOD_MOVES, gain, sources, mask)
+    method = propagate(METHOD_MOVES, gain, sources.joined(held), mask)
     estimate = np.full(len(PARAMETER_NAMES), math.nan)
     estimate[KG_INDEX[kg_mask]] = Kg.ravel()[kg_mask]
     method = type(method)(METHOD_MOVES, estimate, method.u, method.dof, method.contributions,
