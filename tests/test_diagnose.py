@@ -731,5 +731,13 @@ def test_a_bias_that_follows_the_temperature_is_a_drift_in_temperature():
     learned = parse_scenario(document, source="learned")
     assert learned.effects.gyro_bias_temperature_coefficient[2] == pytest.approx(size["value"][j], rel=1e-12)
     assert "Not written (no scenario field): bias_drift (gx gy gz ax ay az)" in document["description"]
+    # given the recording's temperatures, the schedule runs over the range that showed the coefficient
+    logged = [seg.temperature for seg in segments]
+    warm = parse_scenario(learned_document(d, load_scenario("jjf2003"), "the warm-up", temperatures=logged),
+                          source="learned")
+    ramp = [seg.temperature for seg in warm.schedule.segments]  # linear from start to end over the base's test
+    assert logged[0] - 1e-9 <= min(ramp) and max(ramp) <= logged[-1] + 1e-9
+    assert np.ptp(ramp) > 0.9 * (logged[-1] - logged[0]) > 0
+    assert learned.schedule.segments[-1].temperature == pytest.approx(20.0)  # without them: the base's
     plain = fit_recording(Recording(s.samples, s.schedule, {"source": "simulated"}, timestamps=s.time), site)
     assert {g.effect: g for g in signatures(plain)}["bias_drift"].components == ("gx", "gy", "gz", "ax", "ay", "az")

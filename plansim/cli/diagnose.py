@@ -50,10 +50,14 @@ def _write_learned(result, args, path) -> None:
 
     from plansim.config.scenario import parse_scenario
     from plansim.diagnose.learned import learned_document
+    from plansim.io.recording import read_recording
     from plansim.io.scenario_file import load_scenario
 
     base = load_scenario(args.scenario if args.scenario is not None else "jjf2003")
-    document = learned_document(result, base, recording_name=os.path.basename(args.recording))
+    recording = read_recording(args.recording)
+    temperatures = [s.temperature for s in recording.schedule.segments if s.temperature is not None]
+    document = learned_document(result, base, recording_name=os.path.basename(args.recording),
+                                temperatures=temperatures)
     parse_scenario(document, source=str(args.learned))
     with open(path, "wb") as fh:
         fh.write(tomli_w.dumps(document).encode())

@@ -74,7 +74,12 @@ def _base_values(scenario) -> dict:
     return {name: np.array(getattr(e, name), dtype=float) for name in EFFECT_UNITS}
 
 
-def learned_document(diagnosis, base, recording_name: str = "the recording") -> dict:
+#: the recording's temperatures are written to the schedule where its segments' differ by more than this, °C (the
+#: drift's temperature components are tested above the same spread: plansim.diagnose.catalogue)
+TEMPERATURE_SPREAD = 0.1
+
+
+def learned_document(diagnosis, base, recording_name: str = "the recording", temperatures=None) -> dict:
     """The scenario document (a dict for TOML) of the world *diagnosis* found, on top of scenario *base*.
 
     Parameters
@@ -85,6 +90,11 @@ def learned_document(diagnosis, base, recording_name: str = "the recording") -> 
         identify.
     recording_name : str
         Named in the description (provenance).
+    temperatures : sequence of float, optional
+        The recording's segment temperatures, °C, in time order: where they differ by more than
+        :data:`TEMPERATURE_SPREAD`, the schedule's ``temperature_start`` and ``temperature_end`` become the first
+        and the last (a bias's temperature coefficient found in the data is then simulated over the range that
+        showed it); otherwise the base scenario's stay.
 
     Returns
     -------
@@ -150,6 +160,14 @@ def learned_document(diagnosis, base, recording_name: str = "the recording") -> 
         unit = EFFECT_UNITS[name]
         effects[name] = ([_si(x, unit) for x in array] if array.ndim == 1
                          else [[_si(x, unit) for x in row] for row in array])
+    logged = np.asarray([] if temperatures is None else temperatures, dtype=float)
+    logged = logged[np.isfinite(logged)]
+    ramp = ""
+    if logged.size and float(logged.max() - logged.min()) > TEMPERATURE_SPREAD:
+        schedule = document.setdefault("schedule", {})
+        schedule["temperature_start"] = _si(logged[0], "degC")
+        schedule["temperature_end"] = _si(logged[-1], "degC")
+        ramp = f" The schedule's temperature goes from {logged[0]:.3g} to {logged[-1]:.3g} °C, as the recording's did."
     found = ", ".join(diagnosis.selected) if diagnosis.selected else "no catalogue effect"
     note = (f"Learned by plansim diagnose from {recording_name}: {len(learned)} of 39 parameters identified "
             f"(truth = the estimate after the refit, truth_spread = its standard uncertainty), the noise of "
@@ -157,7 +175,7 @@ def learned_document(diagnosis, base, recording_name: str = "the recording") -> 
             f"data, the site; found: {found}.")
     if skipped:
         note += f" Not written (no scenario field): {', '.join(skipped)}."
-    note += f" Turntable, acquisition, schedule and reduction from the base scenario {base.name!r}."
+    note += f" Turntable, acquisition, schedule and reduction from the base scenario {base.name!r}." + ramp
     document["description"] = note
     document["name"] = f"learned-{base.name}"
     return document
