@@ -144,7 +144,9 @@ def diagnose_report(d) -> str:
     if False in taus:
         lines.append("  independent from segment to segment (correlated over 0 s): an input that differs from pose to "
                      "pose and that the model gets wrong (the site's latitude or gravity; the table's errors larger "
-                     "than its grade) or noise the segments cannot show")
+                     "than its grade" + ("; a turn by hand whose angle in the segment table is not what the hand "
+                                         "turned: the fit takes it as exact" if d.before.hand_axes else "")
+                     + ") or noise the segments cannot show")
     lines += _within_lines(d)
     if d.undithered:
         lines.append(f"Note: the segment means of {', '.join(d.undithered)} are mostly a quantiser's error that the "
