@@ -43,7 +43,8 @@ Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kern
 - the symmetric part of each pair of Ka's cross-couplings the joint fit holds at 0 (poses placed by hand near the
   axes do not determine the triad's shear, which bends each pose's gravity direction): its Type B uncertainty
   (:data:`plansim.fit.joint.HELD_KA_UNCERTAINTY`, the joint fit's ``held_sources``) through ∂r/∂m + ∂r/∂θ·A like
-  the joint fit's inputs, but not into the weights;
+  the joint fit's inputs, and into the moves' weights (it makes their misses correlated: left out, the χ² of a
+  start with two gyro axes flipped came out below the true one's, :data:`SIGN_EVIDENCE`);
 - noise between moves beyond all of that (a hand that shakes at the ends of a pose, timing, effects beyond
   eq. (1)): one variance per residual component, estimated by restricted maximum likelihood and taken when
   2·Δlog L passes :data:`plansim.fit.joint.BETWEEN_LR_THRESHOLD`, as the joint fit's noise between segments.
@@ -97,6 +98,10 @@ UNIT_STARTS = (1.0, math.degrees(1.0))
 #: (|K| outside 0.71–1.22; the test's log in deg/s read as rad/s ended at −0.056 and +0.44 from ±1; a MEMS gyro's
 #: scale factor is within a few per cent of 1)
 FAR_OFF = 0.5
+#: a start with some gyro axes flipped is taken over the gyros as wired only where its χ² is lower by more than
+#: this (the 99 % point of χ² with 1 degree of freedom): with poses near the six axes a half turn of the gyro
+#: triad about one axis maps every pose's gravity onto itself, and the moves cannot tell it from none
+SIGN_EVIDENCE = 6.63
 
 
 class MovesNotFitted(Exception):
@@ -422,7 +427,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         total = mean_sensitivity(Kg) + joint_sensitivity(Kg) @ joint_gain  # L = ∂r/∂m + ∂r/∂θ·A
         for column, u, dof, kind in zip(joint_sources.columns, joint_sources.u, joint_sources.dof, joint_sources.kind):
             sources.add(total @ column, u, dof, kind)
-        held = sources_class(2 * n_moves)  # propagated, not weighed by (the joint fit's held_sources)
+        held = sources_class(2 * n_moves)  # the joint fit's held_sources (its gain, not its weights, took them)
         for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
             held.add(total @ column, u, dof, kind)
         if dark > 0:
@@ -448,7 +453,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             J = np.vstack([moves.one(m, Kg, theta, means, details=True)[1]["jac"] for m in range(n_moves)])
             return W @ J @ basis
 
-        best = None
+        best, plain = None, None
         groups = Kg_start if isinstance(Kg_start, list) else [Kg_start]
         for group in groups:  # a later group only where the earlier ones ended with a scale factor far from ±1
             if best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF):
@@ -457,16 +462,22 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                 z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
                 result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                                        max_nfev=200)
+                plain = result if plain is None else plain  # the first start: every gyro as wired, K near +1
                 if best is None or result.cost < best.cost:
                     best = result
+        # a flipped pair of axes (a half turn of the gyro triad) that fits no better than the gyros as wired is not
+        # taken: poses near the six axes cannot tell the two apart (each gravity direction is its own image)
+        if best is not plain and np.all(np.diag(kg(plain.x)) > 0) and \
+                2.0 * (plain.cost - best.cost) <= SIGN_EVIDENCE:
+            best = plain
         return kg(best.x), W
 
     Kg = np.eye(3)
     dark = 0.0
     V_predicted = None
     for iteration in range(3):
-        sources, jacobian, angles, _ = build(Kg, dark)
-        V = sources.covariance()
+        sources, jacobian, angles, held = build(Kg, dark)
+        V = sources.joined(held).covariance()
         if iteration == 0:
             # from each sign of the three scale factors: a gyro wired with its sign flipped against the
             # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
@@ -487,6 +498,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             if dark == 0.0:
                 break
     sources, jacobian, angles, held = build(Kg, dark)
+    sources = sources.joined(held)
     V = sources.covariance()
     Vinv = np.linalg.pinv(V)
     Jz = jacobian @ basis
@@ -496,7 +508,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     gain[KG_INDEX] = -basis @ gain_z  # Kg moves against the residual it explains
     mask = np.zeros(len(PARAMETER_NAMES), bool)
     mask[KG_INDEX[kg_mask]] = True
-    method = propagate(METHOD_MOVES, gain, sources.joined(held), mask)
+    method = propagate(METHOD_MOVES, gain, sources, mask)
     estimate = np.full(len(PARAMETER_NAMES), math.nan)
     estimate[KG_INDEX[kg_mask]] = Kg.ravel()[kg_mask]
     method = type(method)(METHOD_MOVES, estimate, method.u, method.dof, method.contributions,
