@@ -314,8 +314,8 @@ class FitResult:
     #: inputs of the means (sensitivity columns, u, ν, kind): what the moves' fit carries on (:mod:`plansim.fit.moves`)
     gain: np.ndarray | None = field(default=None, repr=False)
     sources: object = field(default=None, repr=False)
-    #: inputs propagated through the gain but not weighed by (an accelerometer cross-coupling held at 0 where poses
-    #: placed by hand leave it with their tilts: HELD_KA_UNCERTAINTY); the moves map them as they map ``sources``
+    #: inputs propagated through the gain but not weighed by (the triad's shear held at 0 where poses placed by hand
+    #: leave it with their tilts: HELD_KA_UNCERTAINTY); the moves map them as they map ``sources``, and weigh by them
     held_sources: object = field(default=None, repr=False)
     #: the gyros from the moves between poses (:func:`plansim.fit.moves.fit_moves`); None without two usable moves
     moves: object = None
