@@ -364,7 +364,42 @@ class _Use:
     hand_axes: tuple
 
 
-def _segment_use(schedule: Schedule) -> _Use:
+#: a turn fitted by its rate must hold it: its mean rate may differ from its median (the steady rate) by at most
+#: 5 standard errors of the median, half the samples' smallest step (a quantiser's code) and this fraction of the
+#: rate (a table's rate error, with room)
+STEADY_RATE_FRACTION = 1e-4
+
+
+def _unsteady(samples: np.ndarray) -> str | None:
+    """Why a turn's gyro output about its axis, *samples* (n,), does not hold one rate, or None where it does.
+
+    A spin-up or a stop inside the segment pulls the mean rate, which the fit compares with the table's, away
+    from the steady rate the table held (the median): by about half the ramps' share of the segment, 1 % of the
+    rate for ramps over 2 % of it, ten times what a MEMS gyro's scale factor is calibrated to. The mean may differ
+    from the median by 5 standard errors of the median (1.2533·σ/√n, σ robust), half the smallest step between
+    the samples' values (a quantiser's code, which moves the mean and not the median) and
+    :data:`STEADY_RATE_FRACTION` of the rate."""
+    x = np.asarray(samples, dtype=float)
+    n = x.size
+    if n < 20:
+        return None
+    median = float(np.median(x))
+    sigma = 1.482602218505602 * float(np.median(np.abs(x - median)))
+    levels = np.unique(x)
+    step = float(np.min(np.diff(levels))) if levels.size > 1 else 0.0
+    allowed = 5.0 * 1.2533 * sigma / math.sqrt(n) + 0.5 * step + STEADY_RATE_FRACTION * abs(median)
+    shift = float(np.mean(x)) - median
+    if abs(shift) <= allowed:
+        return None
+    return (f"its rate is not steady: its mean rate is {abs(shift) / max(abs(median), 1e-300):.2%} off its median "
+            f"({math.degrees(median):.5g} deg/s), more than noise and quantisation allow (a spin-up or a stop inside "
+            "the segment), so it is not the table's rate; trim the segment to the steady part, or give its angle "
+            "instead of its rate")
+
+
+def _segment_use(schedule: Schedule, recording=None) -> _Use:
+    """Which segments the fit uses, and how (:class:`_Use`); with *recording*, a turn fitted by its rate is used
+    only where its samples hold one rate (:func:`_unsteady`)."""
     used, unused, model_segments, gyro_only, hand_axes = [], {}, [], [], set()
     for k, s in enumerate(schedule.segments):
         if s.test == "move":
@@ -386,6 +421,11 @@ def _segment_use(schedule: Schedule) -> _Use:
             continue
         duration = s.samples / s.sample_rate
         by_angle = not (s.rate_known and on_table) and s.angle_known
+        why = None if by_angle or recording is None else \
+            _unsteady(recording.segment_samples(k)[:, "xyz".index(s.rate_axis[1])])
+        if why is not None:
+            unused[k] = why
+            continue
         rate = s.angle / duration if by_angle else s.rate  # the mean rate: ∫ω dt = angle, whatever the profile
         model_segments.append(dataclasses.replace(s, rate=rate, heading=s.heading if s.heading_known else 0.0,
                                                   orientation="known"))
@@ -878,7 +918,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     if turntable is None:
         turntable, turntable_source = TABLE_1_TURNTABLE, turntable_source or "JJF 2003 Table 1"
     schedule = recording.schedule
-    use = _segment_use(schedule)
+    use = _segment_use(schedule, recording)
     used, unused = use.used, use.unused
     notes = []
     if not used:
