@@ -437,3 +437,19 @@ def test_moves_that_identify_nothing_at_their_solution_are_left_out_with_the_rea
     with pytest.raises(MovesNotFitted, match="--units"):
         _solve_information(np.diag([1.0, 0.0]), np.eye(2), np.diag([-50.9, 7.1e4, 1.0]))
     assert np.allclose(_solve_information(np.diag([2.0, 4.0]), np.eye(2), np.eye(3)), np.diag([0.5, 0.25]))
+
+
+def test_a_turn_about_the_vertical_tells_the_moves_nothing():
+    """A motion whose integrated turn lies along gravity leaves gravity where it was: the moves cannot see its
+    angle, so a recording whose every motion is one (a rate table turning about the vertical) has its moves left
+    out with that reason (an independent simulator's rate test had spent 141 s of a 149 s fit searching sign
+    patterns over them, and ended by advising the user to check the gyros' units). Within 20° of the vertical."""
+    from plansim.fit.moves import VERTICAL_TURN, _about_vertical
+
+    up = np.array([0.0, 0.0, 1.0])
+    assert _about_vertical(np.array([0.0, 0.0, 20.0 * math.pi]), up)  # ten turns about z, z up
+    assert _about_vertical(np.array([0.0, 0.0, -math.pi / 2]), -up)  # either sense, z down
+    tilted = 20.0 * math.pi * np.array([math.sin(VERTICAL_TURN + 0.01), 0.0, math.cos(VERTICAL_TURN + 0.01)])
+    assert not _about_vertical(tilted, up)
+    assert not _about_vertical(np.array([math.pi, 0.0, 0.0]), up)  # a turn about a horizontal axis
+    assert not _about_vertical(np.zeros(3), up)

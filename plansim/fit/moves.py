@@ -280,10 +280,23 @@ class _Moves:
         # ∂r/∂Kg_ab = −Eᵀ Σ_k (S_k M)[:, a] ω̂_k[b]
         jac = -np.einsum("xi,kxa,kb->iab", E, SM, rates).reshape(2, 9)
         angle = float(np.linalg.norm(_log_rotation(rotation)))
-        return r, dict(jac=jac, SM=SM, S_sum=E.T @ sens.sum(axis=0), SM_sum=E.T @ SM.sum(axis=0), angle=angle)
+        integral = np.sum(rates * np.asarray(self.dt[m], dtype=float)[:, None], axis=0)  # the turn, rad, body axes
+        return r, dict(jac=jac, SM=SM, S_sum=E.T @ sens.sum(axis=0), SM_sum=E.T @ SM.sum(axis=0), angle=angle,
+                       about_vertical=_about_vertical(integral, u_i))
 
     def residuals(self, Kg, theta, means) -> np.ndarray:
         return np.concatenate([self.one(m, Kg, theta, means) for m in range(len(self.transitions))])
+
+
+#: a motion whose integrated turn lies within this of the start pose's gravity turns about the vertical, rad
+VERTICAL_TURN = math.radians(20.0)
+
+
+def _about_vertical(integral: np.ndarray, gravity: np.ndarray) -> bool:
+    """Whether a motion's integrated turn (3,) lies along gravity (3,, unit) within :data:`VERTICAL_TURN`: it then
+    leaves gravity where it was throughout, and tells the moves nothing of the gyros' scale factors."""
+    size = float(np.linalg.norm(integral))
+    return size > 0 and abs(float(integral @ gravity)) >= math.cos(VERTICAL_TURN) * size
 
 
 def _log_rotation(R: np.ndarray) -> np.ndarray:
@@ -345,9 +358,15 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
 
     # identifiability of Kg from the moves: ∂r/∂Kg at Kg = I on the recorded motion
     design = np.zeros((2 * n_moves, len(PARAMETER_NAMES)))
+    vertical = []
     for m in range(n_moves):
         _, d = moves.one(m, np.eye(3), theta, means, details=True)
         design[2 * m:2 * m + 2, KG_INDEX] = d["jac"]
+        vertical.append(d["about_vertical"])
+    if all(vertical):
+        raise MovesNotFitted("the moves between poses were left out: every one turns about the vertical, which leaves "
+                             "gravity where it was, so they cannot tell the gyros' scale factors (a table's rates or "
+                             "the turns' angles can, in the joint fit)")
     ident = identifiability(design, what="the moves between poses")
     kg_mask = ident.mask[KG_INDEX]
     if not kg_mask.any():
