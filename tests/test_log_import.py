@@ -373,7 +373,7 @@ def test_a_declared_full_scale_finds_a_steady_turn_held_at_the_rail(tmp_path, ca
     clipped sample of a fast peak is found too, and a log that reads beyond its declared full scale is refused."""
     fs = 100.0
     rng = np.random.default_rng(3)
-    n_rest, n_ramp, n_hold = 400, 50, 300
+    n_rest, n_ramp, n_hold = 400, 50, 165  # clipped, it turns 450 deg: near a whole number of quarter turns
     n = 2 * n_rest + 2 * n_ramp + n_hold
     x = rng.normal(size=(n, 6)) * np.r_[[0.1] * 3, [0.01] * 3]  # gyros in deg/s
     x[:, 5] += 9.81

@@ -149,6 +149,21 @@ def test_a_turn_between_two_rests_is_a_rotation_with_its_steady_rate():
     assert result.steady_turns and rotation.orientation == "approximate"
 
 
+def test_a_turn_too_long_for_its_quarter_turn_to_be_told_is_a_move():
+    """A rate table's steady turn of 830 deg at 100 deg/s: 10 deg + 5 % of it passes half a quarter turn, so the
+    nearest whole number of quarter turns (810 deg) is no reference; it is a move, saying why (an independent
+    simulator's 5891 deg turn had been labelled 5850 deg, and the fit read chi2/dof 3e5). A full turn is still a
+    rotation (test above)."""
+    rng = np.random.default_rng(8)
+    turning = static_noise("white", 8.3, rng)
+    turning[:, 2] += math.radians(100.0)
+    x = np.vstack([static_noise("white", 20.0, rng), turning, static_noise("white", 20.0, rng)])
+    result = segment_log(x, None, FS)
+    assert [s.kind for s in result.spans] == ["static", "move", "static"]
+    assert "too far for the nearest whole number of quarter turns" in result.spans[1].reason
+    assert math.degrees(result.spans[1].integrated[2]) == pytest.approx(830.0, abs=5.0)
+
+
 def test_no_rest_at_all_is_too_few_static_samples():
     rng = np.random.default_rng(8)
     x = static_noise("white", 30.0, rng)

@@ -60,9 +60,10 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    between the two spans' mean gyro outputs) is integrated over time. The motion is a *rotation* when
    (a) the integral lies along one body axis (the other two components together at most
    ``OFF_AXIS_FRACTION`` of it), (b) it is within ``10° + 5 %`` of a whole number of quarter turns (the
-   nominal angle, not zero), (c) the unit ends with the same axis up as it started, and (d) the turn is
-   about the vertical (the axis within 20° of the mean specific force) or is a whole number of full
-   turns. Anything else is a *move*: the unit was carried from one pose to another and no reference
+   nominal angle, not zero), and that tolerance is below half a quarter turn (beyond about 700°, a table's
+   steady turns, the nearest quarter turn cannot be told), (c) the unit ends with the same axis up as it
+   started, and (d) the turn is about the vertical (the axis within 20° of the mean specific force) or is a
+   whole number of full turns. Anything else is a *move*: the unit was carried from one pose to another and no reference
    says by how much. A motion that holds a time gap or a saturated sample is a move too: its integral
    is not known.
 9. **Steady rate.** Where a rotation holds one steady turn (step 6) of at least half its duration, its
@@ -891,6 +892,10 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
         return move(f"not about one body axis: the other axes turned {math.degrees(off):.1f} deg against "
                     f"{math.degrees(main):+.1f} deg about {AXES[axis]}", integrated, axis)
     nominal = (math.pi / 2) * round(main / (math.pi / 2))
+    if ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal) >= math.pi / 4:
+        return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: too far for the nearest whole number "
+                    "of quarter turns to be told (10 deg + 5 % of it passes half a quarter turn); give the turn's "
+                    "angle, or the table's rate over its steady part", integrated, axis)
     if abs(main - nominal) > ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal):
         return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: not near a whole number of quarter "
                     "turns", integrated, axis)
