@@ -275,3 +275,37 @@ def test_a_cold_start_interrupted_leaves_no_compile_process(folders, tmp_path, s
     _assert_ended_by(process, signum, err)
     assert not os.path.exists(f"/proc/{compiler[0]}"), "the compile process outlived its parent"
     assert sorted(os.listdir(work)) == []
+
+
+def test_a_signal_whose_exception_is_swallowed_still_stops_the_commit(tmp_path):
+    """A SIGTERM whose handler runs inside a ``__del__`` (or a garbage collector's weakref callback) raises there, and
+    Python only reports it as unraisable ("Exception ignored"): the command would run to its end and commit its
+    outputs with exit status 0 (seen once in CI, `plansim run` under SIGTERM). The handler remembers the signal, and
+    the commit raises it again: nothing is left, and the command ends as terminated."""
+    from plansim.cli.common import Interrupted, signals_as_exceptions
+    from plansim.io.files import OutputSet
+
+    class Dropped:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGTERM)
+            deadline = time.monotonic() + 5.0
+            while time.monotonic() < deadline:  # the handler runs here, inside __del__, and its exception is lost
+                pass
+
+    swallowed = []
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: swallowed.append(unraisable.exc_type)
+    target = tmp_path / "out.json"
+    try:
+        with signals_as_exceptions():
+            with pytest.raises(Interrupted) as raised:
+                with OutputSet() as outputs:
+                    with open(outputs.stage(target, "--out", (".json",)), "w") as fh:
+                        fh.write("{}")
+                    Dropped()  # collected at once: its __del__ runs now
+                    outputs.commit()
+    finally:
+        sys.unraisablehook = hook
+    assert swallowed == [Interrupted]  # the exception was indeed swallowed on the way
+    assert raised.value.signum == signal.SIGTERM
+    assert os.listdir(tmp_path) == []

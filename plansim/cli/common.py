@@ -8,6 +8,8 @@ import signal
 import sys
 import threading
 
+from plansim.io.files import forget_signals, note_signal
+
 EXIT_BAD_INPUT = 2
 EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
 #: the signals that end a command cleanly, and the word it says
@@ -28,7 +30,9 @@ class Interrupted(KeyboardInterrupt):
 
 
 def _raise_interrupted(signum, frame):
-    raise Interrupted(signum)
+    exc = Interrupted(signum)
+    note_signal(exc)  # raised again before any output is committed, should this one be swallowed
+    raise exc
 
 
 @contextlib.contextmanager
@@ -43,6 +47,7 @@ def signals_as_exceptions():
         yield
         return
     previous = {}
+    forget_signals()
     try:
         for signum in SIGNAL_WORDS:
             if signal.getsignal(signum) is not signal.SIG_IGN:
@@ -51,6 +56,7 @@ def signals_as_exceptions():
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        forget_signals()
 
 
 def _silence_stdout() -> None:

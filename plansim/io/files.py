@@ -52,6 +52,30 @@ def _remove(path: str) -> None:
 _DEFERRED_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
+#: the exception a signal raised (``plansim.cli.common.Interrupted``), kept until the command ends: raised inside a
+#: garbage collector's callback or a ``__del__``, Python prints "Exception ignored" and goes on, and the command
+#: would run to its end and commit its outputs as if no signal had come (seen once in CI: a SIGTERM during
+#: ``plansim run`` swallowed by a WeakValueDictionary callback, the run finished with exit status 0)
+_PENDING: list[BaseException] = []
+
+
+def note_signal(exc: BaseException) -> None:
+    """Remember the exception a signal raised, so that :func:`raise_pending_signal` raises it again."""
+    _PENDING.append(exc)
+
+
+def forget_signals() -> None:
+    """Forget the signals remembered (a command starts or has ended)."""
+    _PENDING.clear()
+
+
+def raise_pending_signal() -> None:
+    """Raise again the exception of a signal that came while the command ran (:data:`_PENDING`), if any: what
+    :meth:`OutputSet.commit` does before it renames anything."""
+    if _PENDING:
+        raise _PENDING[0]
+
+
 @contextlib.contextmanager
 def signals_deferred():
     """Hold SIGINT and SIGTERM back in this thread while renaming or removing files, deliver them after.
@@ -210,6 +234,7 @@ class OutputSet:
         """Rename every staged file onto its target (with the permissions an ordinary ``open`` gives)."""
         if self.committed:
             return
+        raise_pending_signal()  # a signal whose exception was swallowed on the way: nothing is committed
         with signals_deferred():
             self._rename_all()
             self.committed = True
