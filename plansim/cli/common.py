@@ -48,6 +48,15 @@ def signals_as_exceptions():
         return
     previous = {}
     forget_signals()
+    hook = sys.unraisablehook
+
+    def quiet(unraisable):
+        # a signal's exception raised where Python cannot raise it (a __del__, a weakref callback): the handler
+        # remembered it (raised again before any output is committed), so it is not printed as "Exception ignored"
+        if not isinstance(unraisable.exc_value, Interrupted):
+            hook(unraisable)
+
+    sys.unraisablehook = quiet
     try:
         for signum in SIGNAL_WORDS:
             if signal.getsignal(signum) is not signal.SIG_IGN:
@@ -56,6 +65,7 @@ def signals_as_exceptions():
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        sys.unraisablehook = hook
         forget_signals()
 
 
