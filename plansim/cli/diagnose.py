@@ -34,7 +34,7 @@ def _cmd_diagnose(args) -> int:
             diagnosis_figure(result, outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES),
                              format=os.path.splitext(args.plot)[1].lstrip("."))
         if args.learned is not None:
-            _write_learned(result, args, outputs.stage(args.learned, "--learned", (".toml",)))
+            _write_learned(result, recording, args, outputs.stage(args.learned, "--learned", (".toml",)))
         outputs.commit()
     if args.json:
         print(json.dumps(diagnosis_json(result), indent=2))
@@ -43,21 +43,18 @@ def _cmd_diagnose(args) -> int:
     return 0
 
 
-def _write_learned(result, args, path) -> None:
+def _write_learned(result, recording, args, path) -> None:
     """The learned scenario (plansim.diagnose.learned), parsed back before it is written: a document the scenario
     reader refuses is never left behind."""
     import tomli_w
 
     from plansim.config.scenario import parse_scenario
     from plansim.diagnose.learned import learned_document
-    from plansim.io.recording import read_recording
     from plansim.io.scenario_file import load_scenario
 
     base = load_scenario(args.scenario if args.scenario is not None else "jjf2003")
-    recording = read_recording(args.recording)
-    temperatures = [s.temperature for s in recording.schedule.segments if s.temperature is not None]
     document = learned_document(result, base, recording_name=os.path.basename(args.recording),
-                                temperatures=temperatures)
+                                temperatures=[s.temperature for s in recording.schedule.segments])
     parse_scenario(document, source=str(args.learned))
     with open(path, "wb") as fh:
         fh.write(tomli_w.dumps(document).encode())

@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 
+from plansim.diagnose.catalogue import TEMPERATURE_SPREAD
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 
@@ -74,11 +75,6 @@ def _base_values(scenario) -> dict:
     return {name: np.array(getattr(e, name), dtype=float) for name in EFFECT_UNITS}
 
 
-#: the recording's temperatures are written to the schedule where its segments' differ by more than this, °C (the
-#: drift's temperature components are tested above the same spread: plansim.diagnose.catalogue)
-TEMPERATURE_SPREAD = 0.1
-
-
 def learned_document(diagnosis, base, recording_name: str = "the recording", temperatures=None) -> dict:
     """The scenario document (a dict for TOML) of the world *diagnosis* found, on top of scenario *base*.
 
@@ -92,7 +88,8 @@ def learned_document(diagnosis, base, recording_name: str = "the recording", tem
         Named in the description (provenance).
     temperatures : sequence of float, optional
         The recording's segment temperatures, °C, in time order: where they differ by more than
-        :data:`TEMPERATURE_SPREAD`, the schedule's ``temperature_start`` and ``temperature_end`` become the first
+        :data:`plansim.diagnose.catalogue.TEMPERATURE_SPREAD` (the spread above which the drift has temperature
+        components), the schedule's ``temperature_start`` and ``temperature_end`` become the first
         and the last (a bias's temperature coefficient found in the data is then simulated over the range that
         showed it); otherwise the base scenario's stay.
 
