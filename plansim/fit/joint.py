@@ -37,6 +37,7 @@ from threadpoolctl import threadpool_limits
 
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
+from plansim.estimate.segmentation import MAD_TO_SIGMA
 from plansim.fit.identify import NULL_TOLERANCE, RANK_TOLERANCE, Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
@@ -384,7 +385,7 @@ def _unsteady(samples: np.ndarray) -> str | None:
     if n < 20:
         return None
     median = float(np.median(x))
-    sigma = 1.482602218505602 * float(np.median(np.abs(x - median)))
+    sigma = MAD_TO_SIGMA * float(np.median(np.abs(x - median)))
     levels = np.unique(x)
     step = float(np.min(np.diff(levels))) if levels.size > 1 else 0.0
     allowed = 5.0 * 1.2533 * sigma / math.sqrt(n) + 0.5 * step + STEADY_RATE_FRACTION * abs(median)

@@ -446,15 +446,15 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         total = mean_sensitivity(Kg) + joint_sensitivity(Kg) @ joint_gain  # L = ∂r/∂m + ∂r/∂θ·A
         for column, u, dof, kind in zip(joint_sources.columns, joint_sources.u, joint_sources.dof, joint_sources.kind):
             sources.add(total @ column, u, dof, kind)
-        held = sources_class(2 * n_moves)  # the joint fit's held_sources (its gain, not its weights, took them)
-        for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
-            held.add(total @ column, u, dof, kind)
         if dark > 0:
             for i in range(2 * n_moves):
                 column = np.zeros(2 * n_moves)
                 column[i] = 1.0
                 sources.add(column, math.sqrt(dark), max(2 * n_moves - basis.shape[1], 1), "between")
-        return sources, jacobian, angles, held
+        # the joint fit's held_sources (its gain, not its weights, took them): here weighed by and propagated
+        for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
+            sources.add(total @ column, u, dof, kind)
+        return sources, jacobian, angles
 
     def solve(V, Kg_start):
         values, vectors = np.linalg.eigh(0.5 * (V + V.T))
@@ -495,8 +495,8 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     dark = 0.0
     V_predicted = None
     for iteration in range(3):
-        sources, jacobian, angles, held = build(Kg, dark)
-        V = sources.joined(held).covariance()
+        sources, jacobian, angles = build(Kg, dark)
+        V = sources.covariance()
         if iteration == 0:
             # from each sign of the three scale factors: a gyro wired with its sign flipped against the
             # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
@@ -516,8 +516,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             dark = _dark_variance(r, V, hat, threshold)
             if dark == 0.0:
                 break
-    sources, jacobian, angles, held = build(Kg, dark)
-    sources = sources.joined(held)
+    sources, jacobian, angles = build(Kg, dark)
     V = sources.covariance()
     Vinv = np.linalg.pinv(V)
     Jz = jacobian @ basis
