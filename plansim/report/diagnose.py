@@ -133,14 +133,13 @@ def diagnose_report(d) -> str:
     # a drift in temperature is a candidate where the recording logged a temperature that varied
     thermal = any(c.endswith("_T") for s in d.candidates if s.effect == "bias_drift" for c in s.components)
     if True in taus:
+        advice = "repeat a pose at the end of the run, or " + (
+            "let the temperature move further" if thermal else "log the temperature") + ", to tell them apart"
+        if thermal and "bias_drift" not in d.selected:
+            advice = ("the bias's drift in the logged temperature was tested beside its drift in time (the candidates "
+                      "above) and is not significant: " + advice)
         lines.append("  correlated in time, taken up as slow noise: slow noise and a slow effect (a bias that follows "
-                     "the temperature, a warm-up, a drift) look alike in this recording; " + (
-                         "the bias's drift in the logged temperature was tested beside its drift in time (the "
-                         "candidates above) and is not significant: repeat a pose at the end of the run, or let the "
-                         "temperature move further, to tell them apart" if thermal and "bias_drift" not in d.selected
-                         else "repeat a pose at the end of the run, or let the temperature move further, to tell them "
-                         "apart" if thermal else
-                         "repeat a pose at the end of the run, or log the temperature, to tell them apart"))
+                     "the temperature, a warm-up, a drift) look alike in this recording; " + advice)
     if False in taus:
         lines.append("  independent from segment to segment (correlated over 0 s): an input that differs from pose to "
                      "pose and that the model gets wrong (the site's latitude or gravity; the table's errors larger "
