@@ -11,7 +11,9 @@
 
 from __future__ import annotations
 
+import csv
 import dataclasses
+import io
 import json
 import math
 import os
@@ -81,24 +83,33 @@ def test_a_simulated_log_gives_back_its_segments(tmp_path):
         # documented tolerance: inside the true rest, at most half a window + 1 sample short at each end
         assert a <= span.start <= a + half + 1, (span.start, a)
         assert b - half - 1 <= span.stop <= b, (span.stop, b)
-    rotations = result.segmentation.of_kind("rotation")
-    assert [(r.axis, round(math.degrees(r.angle))) for r in rotations] == [(0, 360), (1, -360)]
-    for r, (rate, seconds) in zip(rotations, ((60.0, 6.0), (-45.0, 8.0))):
-        # the integral and the steady rate measure the unit's own scale factor (about 1 +- 0.3 %)
-        assert math.degrees(r.integrated[r.axis]) == pytest.approx(rate * seconds, rel=0.005)
+    # each table turn is a steady turn: its steady part is a rotation with its measured rate and no angle (the
+    # table's rate is the reference, and not in the log), between the moves where the rate changes
+    spans = result.segmentation.spans
+    rotations = [k for k, span in enumerate(spans) if span.kind == "rotation"]
+    assert [spans[k].axis for k in rotations] == [0, 1]
+    for k, (rate, seconds) in zip(rotations, ((60.0, 6.0), (-45.0, 8.0))):
+        r = spans[k]
+        assert math.isnan(r.angle) and r.orientation == "approximate"
+        # the steady rate measures the unit's own scale factor (about 1 +- 0.3 %)
         assert math.degrees(r.steady_rate) == pytest.approx(rate, rel=0.005)
-        assert r.orientation == "approximate"
+        assert [spans[k - 1].kind, spans[k + 1].kind] == ["move", "move"]
+        # the three pieces hold the whole turn: their integrals add up to it
+        whole = sum(float(spans[j].integrated[r.axis]) for j in (k - 1, k, k + 1))
+        assert math.degrees(whole) == pytest.approx(rate * seconds, rel=0.005)
+        assert r.samples >= (seconds * 100.0) - result.segmentation.window - 2
     # the recording holds every sample, in segments, with the log's clock
     rec = result.recording
     np.testing.assert_allclose(rec.samples, recording.samples, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(rec.time, recording.time, rtol=0, atol=1e-9)
     segments = rec.schedule.segments
-    assert [s.test for s in segments] == ["static", "rotation", "static", "move", "static", "move", "static",
-                                          "rotation", "static", "move", "static", "move", "static", "move", "static"]
+    assert [s.test for s in segments] == ["static", "move", "rotation", "move", "static", "move", "static",
+                                          "move", "static", "move", "rotation", "move", "static", "move", "static",
+                                          "move", "static", "move", "static"]
     for s in segments:
-        assert math.isnan(s.heading) and s.rate_known == (s.test == "static")
-    assert all(s.orientation == "approximate" for s in segments if s.test == "static")
-    assert [math.degrees(s.angle) for s in segments if s.test == "rotation"] == [360.0, -360.0]
+        assert math.isnan(s.heading) and s.rate_known == (s.test == "static") and not s.angle_known
+    assert all(s.orientation == "approximate" for s in segments if s.test in ("static", "rotation"))
+    assert [s.label.endswith("give the table's rate") for s in segments if s.test == "rotation"] == [True, True]
     assert result.warnings == ()
     assert rec.attrs["sample_rate_hz"] == pytest.approx(100.0, rel=1e-9)
     assert rec.attrs["time_gaps"] == 0 and rec.attrs["import_warnings"] == "none"
@@ -683,3 +694,67 @@ def test_a_shake_at_the_rail_is_one_saturated_warning_in_counts(tmp_path):
     saturated = [w.message for w in result.warnings if w.name == "saturated"]
     assert len(saturated) == 1 and f"in {len(stretches)} stretches" in saturated[0]
     assert all("counts (" in m and "m/s^2)" in m for m in saturated)
+
+
+def _rate_table_log(rates_deg_s, scale: float, seed: int, rest_s: float = 6.0, ramp_s: float = 1.0,
+                    steady_s: float = 5.0, fs: float = 100.0):
+    """A rate-table log about z (up), written here without plansim's simulator: rests of *rest_s* between turns
+    that spin up linearly over *ramp_s*, hold each rate for *steady_s* and stop as they started. The table's rate
+    is exact (its jitter is far below the gyro's noise: the turn is as quiet as a rest); the z gyro reads *scale*
+    times it plus a bias of 0.2 deg/s; white noise 0.05 deg/s and 0.005 m/s^2 per sample. Returns time and samples
+    (gyros in deg/s)."""
+    rng = np.random.default_rng(seed)
+    ramp = np.linspace(0.0, 1.0, int(ramp_s * fs), endpoint=False)
+    rest = np.zeros(int(rest_s * fs))
+    profile = [rest]
+    for rate in rates_deg_s:
+        profile += [rate * ramp, np.full(int(steady_s * fs), float(rate)), rate * ramp[::-1], rest]
+    rate = np.concatenate(profile)
+    x = np.zeros((rate.size, 6))
+    x[:, 2] = scale * rate + 0.2
+    x[:, :3] += 0.05 * rng.standard_normal((rate.size, 3))
+    x[:, 5] = 9.80
+    x[:, 3:] += 0.005 * rng.standard_normal((rate.size, 3))
+    return np.arange(rate.size) / fs, x
+
+
+def test_a_rate_table_log_is_fitted_once_the_table_rates_are_given(tmp_path, capsys):
+    """A user's rate-table log: rests between turns at +-63 and +-100 deg/s with their spin-ups and stops (whole
+    turns of +-441 and +-700 deg). Before: the quietest stretch, a steady turn (a table's rate jitter is below the
+    gyro's noise), was taken for the rest, every rest for a turn, and the import found one pose; and a 441 deg turn
+    was labelled 450 deg (within 10 deg + 5 %), 2 % off. Now each steady part is a rotation with its measured rate and
+    no angle, the user fills in the rates the table held, and `plansim fit` gives the z gyro's scale factor within
+    its stated uncertainty (|z| < 3.3, a 0.1 % two-sided test) and leaves the other 38 parameters not identified."""
+    rates = [63, -63, 100, -100]
+    scale = 1.003
+    t, x = _rate_table_log(rates, scale, seed=21)
+    log = tmp_path / "table.csv"
+    write_synthetic(log, t, x)
+    rec = tmp_path / "rec.csv"
+    assert main(["import", str(log), "--out", str(rec), "--time", "time", "--units", "deg/s,m/s^2"]) == 0
+    out = capsys.readouterr().out
+    assert "give the table's rate" in out and "give each one the rate the table held" in out
+    recording = read_recording(rec)
+    tests = [s.test for s in recording.schedule.segments]
+    assert tests == ["static"] + ["move", "rotation", "move", "static"] * len(rates)
+    steady = [s for s in recording.schedule.segments if s.test == "rotation"]
+    assert all(not s.rate_known and not s.angle_known and s.rate_axis == "+z" for s in steady)
+    # the user fills in the table's rates, both columns of the pair
+    table = rec.with_name("rec.segments.csv")
+    lines = table.read_text(encoding="utf-8").splitlines()
+    header = lines[1].split(",")
+    given = iter(rates)
+    rows = list(csv.reader(io.StringIO("\n".join(lines[1:]))))
+    for row in rows[1:]:
+        if row[header.index("test")] == "rotation":
+            rate = next(given)
+            row[header.index("rate_deg_s")], row[header.index("rate_rad_s")] = str(rate), repr(math.radians(rate))
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows(rows)
+    table.write_text(lines[0] + "\n" + buffer.getvalue(), encoding="utf-8")
+    assert main(["fit", str(rec), "--latitude", "40", "--height", "50", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["identified"] == ["Kgzz"]
+    kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
+    assert abs(kgzz["estimate"] - scale) < 3.3 * kgzz["u"], kgzz
+    assert kgzz["u"] < 1e-4

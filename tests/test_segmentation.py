@@ -132,7 +132,10 @@ def test_a_clock_coarser_than_the_sampling_and_a_misstamped_sample():
     assert [k for k, _ in analyse_time(glitch, 1000).gaps] == [600]
 
 
-def test_a_turn_between_two_rests_is_a_rotation_with_its_steady_rate():
+def test_a_steady_turn_between_two_rests_is_a_rotation_with_its_rate_and_no_angle():
+    """A table holding -90 deg/s for 4 s about z (up): its steady part is a rotation with its measured rate and no
+    angle (step 9: the table's rate is the reference), the few samples where the windows straddle the rest and the
+    turn are moves, and the three pieces' integrals add up to the whole turn."""
     rng = np.random.default_rng(7)
     rest = static_noise("white", 5.0, rng)
     rate = math.radians(-90.0)  # -360 deg in 4 s about z, which points up
@@ -140,28 +143,82 @@ def test_a_turn_between_two_rests_is_a_rotation_with_its_steady_rate():
     turning[:, 2] += rate
     x = np.vstack([rest, turning, static_noise("white", 5.0, rng)])
     result = segment_log(x, None, FS)
-    kinds = [s.kind for s in result.spans]
-    assert kinds == ["static", "rotation", "static"]
-    rotation = result.spans[1]
-    assert rotation.axis == 2 and rotation.angle == pytest.approx(-2 * math.pi)
-    assert math.degrees(rotation.integrated[2]) == pytest.approx(-360.0, abs=0.5)
+    assert [s.kind for s in result.spans] == ["static", "move", "rotation", "move", "static"]
+    rotation = result.spans[2]
+    assert rotation.axis == 2 and math.isnan(rotation.angle) and rotation.orientation == "approximate"
     assert math.degrees(rotation.steady_rate) == pytest.approx(-90.0, abs=0.05)
-    assert result.steady_turns and rotation.orientation == "approximate"
+    assert result.steady_turns == ((rotation.start, rotation.stop),)
+    assert all("steady turn" in s.reason for s in (result.spans[1], result.spans[3]))
+    whole = sum(float(s.integrated[2]) for s in result.spans[1:4])
+    assert math.degrees(whole) == pytest.approx(-360.0, abs=0.5)
+
+
+def _table_turn(rng, up_seconds: float, steady_seconds: float, rate_deg_s: float, then: float | None = None
+                ) -> np.ndarray:
+    """A table's turn about z (up): a linear spin-up over *up_seconds*, *steady_seconds* at the rate (and as long at
+    *then*, reached by a ramp as long), the same stop; the table's rate jitters by half the gyro's noise (a steady
+    turn as quiet as a rest could be taken for the quiet stretch, which step 3 takes to be at rest)."""
+    ramp = np.linspace(0.0, 1.0, int(up_seconds * FS), endpoint=False)
+    level = np.ones(int(steady_seconds * FS))
+    profile = np.concatenate([ramp, level])
+    if then is not None:
+        profile = np.concatenate([profile, 1.0 + (then / rate_deg_s - 1.0) * ramp, then / rate_deg_s * level])
+    profile = np.concatenate([profile, profile[-1] * ramp[::-1]])
+    turning = static_noise("white", profile.size / FS, rng)
+    jitter = np.r_[False, np.diff(profile) == 0.0] & (profile > 0.0)  # where the table holds a rate
+    turning[:, 2] += math.radians(rate_deg_s) * profile + jitter * math.radians(0.1) * rng.standard_normal(profile.size)
+    return turning
+
+
+def test_a_table_turn_is_not_labelled_with_the_nearest_quarter_turn():
+    """A table's -567 deg turn (1.5 s spin-up, 7.5 s at -63 deg/s, 1.5 s stop) is within 10 deg + 5 % of -540 deg,
+    the label it had, and a fit that took it read chi2/dof in the thousands (an independent simulator's rate test).
+    Now its steady part is a rotation with the table's rate to give, and the spin-up and stop are moves; so is a
+    turn too long for its quarter turn to be told (830 deg), and a turn with two steady rates is two rotations."""
+    rng = np.random.default_rng(8)
+    for turn, rates in ((_table_turn(rng, 1.5, 7.5, -63.0), [-63.0]), (_table_turn(rng, 1.0, 7.8, 100.0), [100.0]),
+                        (_table_turn(rng, 1.0, 5.0, 20.0, then=50.0), [20.0, 50.0])):
+        x = np.vstack([static_noise("white", 20.0, rng), turn, static_noise("white", 20.0, rng)])
+        result = segment_log(x, None, FS)
+        kinds = [s.kind for s in result.spans]
+        assert kinds == ["static"] + ["move", "rotation"] * len(rates) + ["move", "static"]
+        rotations = result.of_kind("rotation")
+        assert [math.degrees(r.steady_rate) for r in rotations] == pytest.approx(rates, abs=0.05)
+        assert all(math.isnan(r.angle) for r in rotations)
+        whole = sum(float(s.integrated[2]) for s in result.spans[1:-1])
+        assert whole == pytest.approx(float(np.sum(turn[:, 2]) / FS), abs=math.radians(0.5))
 
 
 def test_a_turn_too_long_for_its_quarter_turn_to_be_told_is_a_move():
-    """A rate table's steady turn of 830 deg at 100 deg/s: 10 deg + 5 % of it passes half a quarter turn, so the
-    nearest whole number of quarter turns (810 deg) is no reference; it is a move, saying why (an independent
-    simulator's 5891 deg turn had been labelled 5850 deg, and the fit read chi2/dof 3e5). A full turn is still a
-    rotation (test above)."""
+    """A turn of 830 deg that holds no steady rate: 10 deg + 5 % of it passes half a quarter turn, so the nearest
+    whole number of quarter turns (810 deg) is no reference; it is a move, saying why (an independent simulator's
+    5891 deg turn had been labelled 5850 deg, and the fit read chi2/dof 3e5). A full turn is still a rotation
+    (test_a_turn_by_hand_is_labelled_with_its_quarter_turns)."""
     rng = np.random.default_rng(8)
     turning = static_noise("white", 8.3, rng)
-    turning[:, 2] += math.radians(100.0)
+    t = np.arange(turning.shape[0]) / FS
+    turning[:, 2] += math.radians(100.0) * (1.0 + 0.5 * np.sin(2.0 * math.pi * t / 0.83))  # never steady
     x = np.vstack([static_noise("white", 20.0, rng), turning, static_noise("white", 20.0, rng)])
     result = segment_log(x, None, FS)
-    assert [s.kind for s in result.spans] == ["static", "move", "static"]
+    assert [s.kind for s in result.spans] == ["static", "move", "static"] and not result.steady_turns
     assert "too far for the nearest whole number of quarter turns" in result.spans[1].reason
     assert math.degrees(result.spans[1].integrated[2]) == pytest.approx(830.0, abs=5.0)
+
+
+def test_a_turn_by_hand_is_labelled_with_its_quarter_turns():
+    """A hand turning 360 deg about z (up) in 4 s, never at one rate (its rate swings by half about its mean):
+    a rotation labelled -360 deg, with no steady rate."""
+    rng = np.random.default_rng(9)
+    turning = static_noise("white", 4.0, rng)
+    t = np.arange(turning.shape[0]) / FS
+    turning[:, 2] += math.radians(-90.0) * (1.0 - np.cos(2.0 * math.pi * t / 4.0))
+    x = np.vstack([static_noise("white", 5.0, rng), turning, static_noise("white", 5.0, rng)])
+    result = segment_log(x, None, FS)
+    assert [s.kind for s in result.spans] == ["static", "rotation", "static"] and not result.steady_turns
+    rotation = result.spans[1]
+    assert rotation.axis == 2 and rotation.angle == pytest.approx(-2 * math.pi)
+    assert math.isnan(rotation.steady_rate) and rotation.orientation == "approximate"
+    assert math.degrees(rotation.integrated[2]) == pytest.approx(-360.0, abs=0.5)
 
 
 def test_no_rest_at_all_is_too_few_static_samples():

@@ -47,7 +47,9 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    steady turn only when its output differs from the nearest rest's *along its own gravity* (a table with
    gravity steady turns about the vertical) by more than the threshold there plus that allowance times the
    change of specific force. A turn slower than the threshold cannot be told from rest by any detector
-   without a reference; the threshold is reported.
+   without a reference; the threshold is reported. The run taken to be at rest first is ``Q``'s, unless more
+   of the log's quiet samples agree with another run (:func:`_rest_by_agreement`: a table's steady turn is as
+   quiet as a rest, and ``Q`` can fall in one); the gyro bias b is then that run's.
 6b. **Poses held by hand.** Outside those runs, stretches of at least ``min_static`` where the
    accelerometers pass step 5 and hold one pose while the gyros do not (a hand's tremor: 1 °/s at 5 Hz tilts
    the unit by 0.03°) are poses too, when the attitude the gyros integrate about their mean swings by at
@@ -60,14 +62,17 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    between the two spans' mean gyro outputs) is integrated over time. The motion is a *rotation* when
    (a) the integral lies along one body axis (the other two components together at most
    ``OFF_AXIS_FRACTION`` of it), (b) it is within ``10° + 5 %`` of a whole number of quarter turns (the
-   nominal angle, not zero), and that tolerance is below half a quarter turn (beyond about 700°, a table's
-   steady turns, the nearest quarter turn cannot be told), (c) the unit ends with the same axis up as it
+   nominal angle, not zero), and that tolerance is below half a quarter turn (beyond about 700° the nearest
+   quarter turn cannot be told), (c) the unit ends with the same axis up as it
    started, and (d) the turn is about the vertical (the axis within 20° of the mean specific force) or is a
    whole number of full turns. Anything else is a *move*: the unit was carried from one pose to another and no reference
    says by how much. A motion that holds a time gap or a saturated sample is a move too: its integral
    is not known.
-9. **Steady rate.** Where a rotation holds one steady turn (step 6) of at least half its duration, its
-   measured rate is reported.
+9. **Steady turns.** Step 8 is for turns by hand against a stop. A motion between two static spans that holds
+   steady turns (step 6) is a table's, which need not stop on a quarter turn (a −567° turn would be labelled
+   −540°): each steady turn is a *rotation* of its own with its measured rate (``Span.steady_rate``) and no
+   angle (the table's rate, not in the log, is its reference), and the stretches around them (spin-up, change
+   of rate, stop) are *moves* (:func:`_motion_pieces`).
 10. **Saturation.** ``SATURATION_RUN`` or more equal consecutive samples at a channel's largest or smallest
     value in the log (two are enough where the value is held by two such runs or more: a rail reached twice),
     outside the static spans, entered or left by a step of more than ``SATURATION_STEP`` σ, at a value
@@ -86,6 +91,7 @@ simulation (tests/test_segmentation.py measures their false alarms on static noi
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -305,11 +311,13 @@ class Span:
     axis : int
         Motion: the body axis (0, 1, 2) of the largest integrated component (−1 when not known).
     angle : float
-        Rotation: the nominal angle about ``+axis``, rad, a whole number of quarter turns; NaN otherwise.
+        Rotation by hand: the nominal angle about ``+axis``, rad, a whole number of quarter turns; NaN otherwise
+        (a steady turn included).
     orientation : str
         ``"approximate"`` (static: tilt ≤ APPROXIMATE_TILT; rotation: about the vertical) or ``"unknown"``.
     steady_rate : float
-        Rotation: the measured steady rate about ``+axis``, rad/s; NaN when the turn is not steady.
+        Rotation: the measured steady rate about ``+axis``, rad/s, of a steady turn (step 9); NaN for a turn by
+        hand.
     reason : str
         Why a motion is a move (empty for the others).
     """
@@ -580,8 +588,15 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     if runs:
         first = min(range(len(runs)), key=lambda i: 0 if runs[i][0] <= start < runs[i][1]
                     else min(abs(runs[i][0] - start), abs(runs[i][1] - start)))
-        # the run that holds the quiet stretch is at rest by assumption (step 3)
+        # the run that holds the quiet stretch is at rest by assumption (step 3), unless more of the log agrees
+        # with another run (step 6: a table's steady turn is as quiet as a rest)
         holds_quiet = runs[first][0] <= start and start + quiet_length <= runs[first][1]
+        seed = _rest_by_agreement(runs, medians, forces, rate_threshold, first)
+        if seed != first:
+            first, holds_quiet = seed, True
+            a, b = runs[seed]
+            bias = clipped[a:b, :3].mean(axis=0)
+            noise = dataclasses.replace(noise, gyro_bias=bias)
         at_rest[first] = holds_quiet or bool(np.all(np.abs(medians[first] - bias) <= rate_threshold))
         for order in (range(first + 1, len(runs)), range(first - 1, -1, -1)):
             rests = [first] if at_rest[first] else []
@@ -644,7 +659,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
             spans.append(Span("move", lo, hi, logged[lo:hi].mean(axis=0), up=(previous or span).up,
                               reason="isolated glitch row(s) cut out of the pose around them (step 4b)"))
         elif hi > lo:
-            spans.append(_motion(x, times, lo, hi, previous, span, gap_starts, saturation, steady))
+            spans.extend(_motion_pieces(x, times, lo, hi, previous, span, gap_starts, saturation, steady))
         if span is not None:
             spans.append(span)
         previous = span
@@ -666,7 +681,28 @@ def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span 
     return float(np.dot(f, g)) >= math.cos(SAME_POSE) * float(np.linalg.norm(f) * np.linalg.norm(g))
 
 
-def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray,
+def _rest_by_agreement(runs: list[tuple[int, int]], medians: list, forces: list, rate_threshold: np.ndarray,
+                       quiet: int) -> int:
+    """The run taken to be at rest first (step 6): the one that the most samples of quiet runs agree with (a run
+    *j* agrees with run *i* when :func:`_at_rest` finds *j* at rest with *i* as the only rest), *quiet* (the run
+    nearest the quiet stretch) where it has as many as any.
+
+    The quiet stretch alone (step 3) cannot tell a rest from a table's steady turn: a table's rate jitter is far
+    below a MEMS gyro's noise, so the two are equally quiet, and a log of rests between table turns had been read
+    with one turn at rest and every rest turning. The rests of a log agree with each other (one bias, up to the
+    g-sensitivity between poses) and a turn agrees only with turns at its own rate, so the rests win wherever they
+    hold more of the log than the turns at any one rate. Where every run agrees with the quiet one (a log of
+    poses), this is the quiet one."""
+    sizes = np.array([b - a for a, b in runs])
+    support = [int(sum(sizes[j] for j in range(len(runs)) if _at_rest(j, [i], medians, forces, None, rate_threshold)))
+               for i in range(len(runs))]
+    best = max(support)
+    if support[quiet] == best:
+        return quiet
+    return min((i for i in range(len(runs)) if support[i] == best), key=lambda i: abs(i - quiet))
+
+
+def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray | None,
              rate_threshold: np.ndarray) -> bool:
     """Step 6 for run *i*, given the runs found at rest so far (*rests*, nearest first).
 
@@ -859,9 +895,71 @@ def stuck_runs(values: np.ndarray, value: float, jump: float) -> list[tuple[int,
     return out
 
 
+def _integrate(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span, after: Span
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """∫ (gyro − bias) dt over ``[lo, hi)``, rad, with the bias linear in time between the static spans *before* and
+    *after*'s mean gyro outputs (each sample's rate held from it to the next sample, the last one to the start of
+    the next span); and that bias, (hi − lo, 3) rad/s."""
+    t_before = times[before.start:before.stop].mean()
+    t_after = times[after.start:after.stop].mean()
+    weight = (times[lo:hi] - t_before) / (t_after - t_before) if t_after > t_before else np.full(hi - lo, 0.5)
+    bias = before.mean[:3] + np.outer(weight, after.mean[:3] - before.mean[:3])
+    dt = np.diff(times[lo:hi + 1]) if hi < times.shape[0] else np.append(np.diff(times[lo:hi]), 0.0)
+    return np.sum((x[lo:hi, :3] - bias) * dt[:, None], axis=0), bias
+
+
+def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,
+                   gap_starts: np.ndarray, saturation: list[Saturation], steady: list[tuple[int, int]]
+                   ) -> list[Span]:
+    """The motion ``[lo, hi)`` between the static spans *before* and *after*: one span (:func:`_motion`), or, where
+    it holds steady turns (step 6) and a pose on both sides, each steady turn as a ``rotation`` of its own with its
+    measured rate and no angle, and the stretches around them (a table's spin-up, a change of rate, its stop) as
+    moves (step 9).
+
+    The nearest whole number of quarter turns is a reference for a turn by hand against a stop, not for a table
+    that turns at a rate for a time: a −567° table turn would be labelled −540° (within 10° + 5 %), and a fit that
+    took that angle would be 5 % off. The table's rate is the reference, and it holds only over the steady part."""
+    inside = [(a, b) for a, b in steady if a >= lo and b <= hi]
+    if not inside or before is None or after is None or np.any((gap_starts > lo) & (gap_starts <= hi)):
+        return [_motion(x, times, lo, hi, before, after, gap_starts, saturation)]
+    g = before.mean[3:]
+    pieces: list[Span] = []
+    edges = [lo] + [v for run in inside for v in run] + [hi]
+    for k in range(len(edges) - 1):
+        p, q = edges[k], edges[k + 1]
+        if q <= p:
+            continue
+        integrated, bias = _integrate(x, times, p, q, before, after)
+        axis = int(np.argmax(np.abs(integrated)))
+        mean = x[p:q].mean(axis=0)
+        if k % 2 == 0:  # around the steady turns
+            where = "a spin-up" if k == 0 else ("a stop" if q == hi else "a change of rate")
+            pieces.append(Span("move", p, q, mean, up=before.up, integrated=integrated, axis=axis,
+                               reason=f"{where} around a steady turn (step 9): no reference for its angle"))
+            continue
+        rate = x[p:q, :3].mean(axis=0) - bias.mean(axis=0)
+        off = float(np.hypot(*np.delete(rate, axis)))
+        vertical = math.acos(min(1.0, abs(float(g[axis])) / float(np.linalg.norm(g)))) <= VERTICAL_AXIS_TOLERANCE
+        if any(s.start < q and s.stop > p for s in saturation):
+            why = "a saturated sample inside: the steady rate is not known"
+        elif off > OFF_AXIS_FRACTION * abs(float(rate[axis])):
+            why = (f"a steady turn not about one body axis ({math.degrees(float(rate[axis])):+.4g} deg/s about "
+                   f"{AXES[axis]}, {math.degrees(off):.3g} deg/s about the other two)")
+        else:
+            why = ""
+        if why:
+            pieces.append(Span("move", p, q, mean, up=before.up, integrated=integrated, axis=axis, reason=why))
+        else:
+            pieces.append(Span("rotation", p, q, mean, up=before.up, integrated=integrated, axis=axis,
+                               orientation="approximate" if vertical else "unknown",
+                               steady_rate=float(rate[axis])))
+    return pieces
+
+
 def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,
-            gap_starts: np.ndarray, saturation: list[Saturation], steady: list[tuple[int, int]]) -> Span:
-    """Classify the motion ``[lo, hi)`` between the static spans *before* and *after* (either may be None)."""
+            gap_starts: np.ndarray, saturation: list[Saturation]) -> Span:
+    """Classify the motion ``[lo, hi)`` between the static spans *before* and *after* (either may be None), which
+    holds no steady turn (or cannot be split at one: :func:`_motion_pieces`)."""
     mean = x[lo:hi].mean(axis=0)
     up = before.up if before is not None else (after.up if after is not None else "")
 
@@ -875,14 +973,7 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
         return move("a time gap inside: the turn cannot be integrated")
     if any(s.start < hi and s.stop > lo for s in saturation):
         return move("a saturated sample inside: the turn cannot be integrated")
-    # the bias, linear in time between the two static spans' mean gyro outputs
-    t_before = times[before.start:before.stop].mean()
-    t_after = times[after.start:after.stop].mean()
-    weight = (times[lo:hi] - t_before) / (t_after - t_before) if t_after > t_before else np.full(hi - lo, 0.5)
-    bias = before.mean[:3] + np.outer(weight, after.mean[:3] - before.mean[:3])
-    # each sample's rate held from it to the next sample (the last one to the start of the next span)
-    dt = np.diff(times[lo:hi + 1]) if hi < times.shape[0] else np.append(np.diff(times[lo:hi]), 0.0)
-    integrated = np.sum((x[lo:hi, :3] - bias) * dt[:, None], axis=0)
+    integrated, _ = _integrate(x, times, lo, hi, before, after)
     axis = int(np.argmax(np.abs(integrated)))
     main = float(integrated[axis])
     off = float(np.hypot(*np.delete(integrated, axis)))
@@ -912,10 +1003,5 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
     if float(np.dot(expected, after.mean[3:])) < math.cos(VERTICAL_AXIS_TOLERANCE) * float(
             np.linalg.norm(expected) * np.linalg.norm(after.mean[3:])):
         return move("the gravity direction after the turn does not match the turn", integrated, axis)
-    steady_rate = math.nan
-    inside = [(a, b) for a, b in steady if a >= lo and b <= hi]
-    if len(inside) == 1 and (inside[0][1] - inside[0][0]) >= 0.5 * (hi - lo):
-        a, b = inside[0]
-        steady_rate = float(x[a:b, axis].mean() - bias[(a + b) // 2 - lo, axis])
     return Span("rotation", lo, hi, mean, up=before.up, integrated=integrated, axis=axis, angle=nominal,
-                orientation="approximate" if vertical else "unknown", steady_rate=steady_rate)
+                orientation="approximate" if vertical else "unknown")

@@ -413,7 +413,8 @@ def _segment_use(schedule: Schedule, recording=None) -> _Use:
             gyro_only.append(False)
             continue
         if not s.rate_known and not s.angle_known:
-            unused[k] = "a turn with neither its rate nor its angle: nothing to fit it against"
+            unused[k] = ("a turn with neither its rate nor its angle: nothing to fit it against (give the rate the "
+                         "table held, or the angle turned, in the segment table)")
             continue
         on_table = s.orientation == "known" and s.heading_known
         if not on_table and (s.orientation == "unknown" or s.rate_axis[1] != s.up[1]):

@@ -790,12 +790,14 @@ def _segment(span: Span, number: int, sample_rate: float, temperature: float) ->
                        span.up, heading=math.nan, orientation=span.orientation, **common)
     measured = math.degrees(float(span.integrated[span.axis])) if span.axis >= 0 else math.nan
     if span.kind == "rotation":
-        steady = (f", steady at {math.degrees(span.steady_rate):.4g} deg/s" if math.isfinite(span.steady_rate)
-                  else "")
-        return Segment(f"rotation {number}: {math.degrees(span.angle):+.0f} deg about +{AXES[span.axis]} (measured "
-                       f"{measured:+.2f} deg{steady})", "rotation", span.axis, span.up, heading=math.nan,
-                       rate=math.nan, rate_axis=f"+{AXES[span.axis]}", angle=span.angle,
-                       orientation=span.orientation, **common)
+        if math.isfinite(span.steady_rate):  # a steady turn: the table's rate is its reference, and not logged
+            label = (f"rotation {number}: steady at {math.degrees(span.steady_rate):+.5g} deg/s about "
+                     f"+{AXES[span.axis]} (measured; {measured:+.2f} deg): give the table's rate")
+        else:
+            label = (f"rotation {number}: {math.degrees(span.angle):+.0f} deg about +{AXES[span.axis]} (measured "
+                     f"{measured:+.2f} deg)")
+        return Segment(label, "rotation", span.axis, span.up, heading=math.nan, rate=math.nan,
+                       rate_axis=f"+{AXES[span.axis]}", angle=span.angle, orientation=span.orientation, **common)
     about = f"turned {measured:+.1f} deg about {AXES[span.axis]}" if span.axis >= 0 else "not integrated"
     return Segment(f"move {number}: {about}", "move", 0, span.up or "+z", heading=math.nan, rate=math.nan,
                    orientation="unknown", **common)
@@ -865,9 +867,15 @@ def format_summary(result: ImportResult) -> str:
                      f"{segment.label}")
     lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
                  "approximate for the static poses")
-    if counts["rotation"]:
+    rotations = seg.of_kind("rotation")
+    if any(not math.isfinite(r.steady_rate) for r in rotations):
         lines.append("  rotations: angle = the whole number of quarter turns nearest the measured integral (bias "
                      "removed); check it against what was done; rate = nan (not logged)")
+    if any(math.isfinite(r.steady_rate) for r in rotations):
+        lines.append("  steady turns: angle = nan and rate = nan (a table's rate is not in the log): give each one "
+                     "the rate the table held for the fit to use it (in the segment table, rate_deg_s and "
+                     "rate_rad_s, or one of them with the other column deleted); the moves beside them are the "
+                     "table's spin-up and stop")
     for warning in result.warnings:
         lines.append(f"  warning [{warning.name}]: {warning.message}")
     return "\n".join(lines)

@@ -296,8 +296,10 @@ def _read_table_csv(table_target: Path, procedure: str, notes: dict) -> Schedule
             deg = (number(k, row, deg_column, units.replace("rad", "deg"), nan_allowed) if deg_column in position
                    else None)
             if rad is not None and deg is not None and _disagree(rad, deg):
+                one_nan = (" (nan is 'not known': a value filled into one column of the pair must be filled into "
+                           "both, or the other column deleted)" if math.isnan(rad) != math.isnan(deg) else "")
                 raise ValueError(f"{where}: segment row {k}: {deg_column} = {deg!r} and {rad_column} = {rad!r} "
-                                 "disagree; give one of them or make them agree")
+                                 f"disagree{one_nan}; give one of them or make them agree")
             # the rad column is exact; the deg column converts the way a scenario file's "deg" does
             table[name].append(rad if rad is not None else deg * DEG)
     columns_for_messages = dict(_CSV_FIELD_COLUMNS)
