@@ -72,6 +72,34 @@ def test_a_lever_arm_is_not_identifiable_in_jjf2003_and_is_aliased_with_p():
         assert scores[effect].identifiable, effect
 
 
+def test_the_aliases_are_read_in_the_basis_the_fit_stepped_in():
+    """With poses placed by hand the fit steps in a basis with the held cross-couplings' rows at zero, not in its
+    identifiability basis; the aliases were mapped through the latter, so an independent simulator's 12-position
+    log listed `accel_quadratic` as aliased with gxx, gyy, gxz, gyx (it aliases with Baz). A parameter's own
+    whitened design column must alias with that parameter alone."""
+    from plansim.diagnose.scores import _aliases, _Geometry
+    from plansim.fit import Site
+    from plansim.io.recording import Recording
+    from plansim.schedule import Schedule
+
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=2, trial=0)
+    poses = [k for k, s in enumerate(recording.schedule.segments) if s.test == "multi_position"]
+    first = recording.first_sample
+    rows = np.concatenate([np.arange(first[k], first[k] + recording.schedule.segments[k].samples) for k in poses])
+    placed = tuple(dataclasses.replace(recording.schedule.segments[k], test="static", orientation="approximate",
+                                       heading=math.nan) for k in poses)
+    fit = fit_recording(Recording(recording.samples[rows], Schedule(placed), recording.attrs),
+                        Site(math.radians(39.9), 50.0, earth_rate=False), scenario.turntable)
+    assert fit.basis.shape[1] == fit.identifiability.rank
+    assert not np.allclose(fit.basis, fit.identifiability.basis)  # the held shear: another basis of the same span
+    geometry = _Geometry(fit)
+    J = fit.model.parameter_jacobian(tilts=fit.nuisance)
+    for name in ("Kaxx", "Bay", "gzz", "Bgx"):
+        k = PARAMETER_NAMES.index(name)
+        assert _aliases(fit, geometry, geometry.W @ J[:, k]) == (name,), name
+
+
 def test_excitation_is_decided_on_the_schedules_geometry_not_on_one_recordings_noise():
     """A lever arm across an accelerometer's own axis (components xy, xz …): for an ideal sensor turning about a
     body axis, ω×(ω×r) has no i-component from r_k, k ≠ i (closed form: ω_i ω_k r_k = 0), so the schedule does not

@@ -9,7 +9,7 @@ direction the base model already spans: the effect would alias into the paramete
 fraction ‖P⊥ W x‖/‖W x‖ is taken on the singular directions of P⊥·W·X_c; those below
 :data:`ALIAS_TOLERANCE` are dropped, and a candidate with none left is *not identifiable*: it gets no
 p-value and is never selected. Its ``aliased_with`` lists the parameters that would absorb it (the
-regression of W·x on X, mapped to the 39 parameters through the fit's identifiability basis, each in units
+regression of W·x on X, mapped to the 39 parameters through the basis the fit stepped in, each in units
 of its standard uncertainty), and two candidates whose surviving subspaces coincide (every principal
 angle's cosine above 1 − :data:`ALIAS_TOLERANCE`) are aliased with each other. Before that, a component whose
 column is below :data:`EXCITATION_TOLERANCE` of the largest in its unit group *for an ideal sensor in the same
@@ -348,8 +348,8 @@ def _aliases(fit, geometry: _Geometry, column: np.ndarray) -> tuple[str, ...]:
     if geometry.X.shape[1] == 0:
         return ()
     beta = np.linalg.lstsq(geometry.X, column, rcond=None)[0]
-    rank = fit.identifiability.basis.shape[1]
-    change = fit.identifiability.basis[: len(PARAMETER_NAMES)] @ beta[:rank]
+    basis = fit.basis  # the fit's own combinations: the columns of X (not always fit.identifiability.basis)
+    change = basis[: len(PARAMETER_NAMES)] @ beta[:basis.shape[1]]
     u = np.where(np.isfinite(fit.joint.u) & (fit.joint.u > 0), fit.joint.u, np.inf)
     scaled = np.abs(change) / u
     if not np.any(scaled > 0):

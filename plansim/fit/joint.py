@@ -304,6 +304,10 @@ class FitResult:
     design: np.ndarray | None = field(default=None, repr=False)
     rows: np.ndarray | None = field(default=None, repr=False)
     segment_times: np.ndarray | None = field(default=None, repr=False)
+    #: the basis (39 + nuisance, rank) of the fitted combinations, the first columns of ``design``: (θ, nuisance) −
+    #: their start = basis·z. Not always ``identifiability.basis``: with poses placed by hand the fit steps with
+    #: the held cross-couplings' rows at zero (:func:`_held_at_nominal`), or in the basis at the fitted tilts
+    basis: np.ndarray | None = field(default=None, repr=False)
     #: V without the between-segment noise estimated from the residuals (what the noise model predicts)
     covariance_predicted: np.ndarray | None = field(default=None, repr=False)
     #: the between-segment noise per channel the residuals show beyond the prediction (:func:`between_segment_noise`)
@@ -1015,7 +1019,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             working = work.covariance()
         W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
         theta, tilts, gain, design, gain_z, chi2, c = _solve(model, basis, theta0, tilts0, m, W, J, extra=E)
-        rank = ident.rank
+        rank, step_basis = ident.rank, basis
         if model.n_tilts:
             # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
             # accelerometer's cross-coupling): those combinations are freed when the data ask for them (χ² drops
@@ -1029,7 +1033,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                     second = None
                 if second is not None and chi2 - second[5] > _chi2_quantile(local.rank - rank, 0.99):
                     theta, tilts, gain, design, gain_z, chi2, c = second
-                    rank = local.rank
+                    rank, step_basis = local.rank, local.basis
         J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
         fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
@@ -1107,7 +1111,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes,
                      model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
                      covariance=V, whitening=W, design=design, rows=rows,
-                     segment_times=times, extra=extra_method,
+                     segment_times=times, basis=step_basis, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
                      gain=gain, sources=sources, held_sources=held_sources)
     if moves:
