@@ -724,7 +724,8 @@ def test_a_rate_table_log_is_fitted_once_the_table_rates_are_given(tmp_path, cap
     gyro's noise), was taken for the rest, every rest for a turn, and the import found one pose; and a 441 deg turn
     was labelled 450 deg (within 10 deg + 5 %), 2 % off. Now each steady part is a rotation with its measured rate and
     no angle, the user fills in the rates the table held, and `plansim fit` gives the z gyro's scale factor within
-    its stated uncertainty (|z| < 3.3, a 0.1 % two-sided test) and leaves the other 38 parameters not identified."""
+    its stated uncertainty (|z| < 3.3, a 0.1 % two-sided test), the table's rate errors in it, and leaves the other
+    38 parameters not identified."""
     rates = [63, -63, 100, -100]
     scale = 1.003
     t, x = _rate_table_log(rates, scale, seed=21)

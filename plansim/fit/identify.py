@@ -24,6 +24,11 @@ import numpy as np
 
 from plansim.model.parameters import PARAMETER_NAMES
 
+#: standard uncertainty of a Kg entry that a fit holds at its nominal value (1 or 0) while it still matters: one the
+#: recording does not identify but the Earth rate reaches, or one the moves between poses determine only weakly:
+#: 1 %, the scale-factor error and misalignment a MEMS gyro's data sheet allows (docs/fitting.md); its effect is
+#: ≤ 0.01·7.3e-5 rad/s on a segment mean
+HELD_KG_UNCERTAINTY = 0.01
 #: singular values below this fraction of the largest (of the column-scaled design) count as zero: the
 #: design's entries are exact sums of gravity and rates, so rounding leaves ~1e-15; 1e-9 keeps every
 #: genuine direction down to a rate point of 1e-9 of the largest

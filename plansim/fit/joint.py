@@ -38,7 +38,7 @@ from threadpoolctl import threadpool_limits
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.estimate.segmentation import MAD_TO_SIGMA
-from plansim.fit.identify import NULL_TOLERANCE, RANK_TOLERANCE, Identifiability, identifiability
+from plansim.fit.identify import HELD_KG_UNCERTAINTY, NULL_TOLERANCE, RANK_TOLERANCE, Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
 from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
@@ -48,10 +48,6 @@ from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETER
 from plansim.schedule.segments import Schedule
 from plansim.uncertainty.metrology.propagation import combine
 
-#: standard uncertainty of a Kg entry that the recording does not identify but the Earth rate reaches (the
-#: model holds it at its nominal value, 1 or 0): 1 %, the scale-factor error and misalignment a MEMS gyro's
-#: data sheet allows (docs/fitting.md); its effect is ≤ 0.01·7.3e-5 rad/s on a segment mean
-HELD_KG_UNCERTAINTY = 0.01
 #: standard uncertainty of the symmetric part of a pair of Ka's cross-couplings (Ka_ij = Ka_ji: a shear of the
 #: triad) that poses placed by hand do not determine (at first order a tilt of an axis-aligned pose is a
 #: cross-coupling) but that still moves what the fit uses (a pose a few degrees off its axis; the moves' gravity

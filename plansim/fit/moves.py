@@ -73,7 +73,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
-from plansim.fit.identify import identifiability
+from plansim.fit.identify import HELD_KG_UNCERTAINTY, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -98,6 +98,13 @@ UNIT_STARTS = (1.0, math.degrees(1.0))
 #: (|K| outside 0.71–1.22; the test's log in deg/s read as rad/s ended at −0.056 and +0.44 from ±1; a MEMS gyro's
 #: scale factor is within a few per cent of 1)
 FAR_OFF = 0.5
+#: a combination of Kg entries the moves determine no better than this standard uncertainty (dimensionless) at
+#: Kg = I, with the noise they predict and no between-move noise (the smallest u they could give), is not
+#: identified: a gyro's scale factor is within a few per cent of 1 and its cross-couplings within 1 %, so such a
+#: direction says nothing of the unit, and the fit wandered along it (an independent simulator's 12-position log,
+#: whose y axis was turned about only while vertical: Kgyy 5.33 ± 13.7, 0.497 ± 0.053, or the moves dropped with
+#: advice to check the gyros' units). The identified directions' u is 1e-5 to 1e-2 on the logs we have
+WEAK_DIRECTION_U = 0.1
 #: a start with some gyro axes flipped is taken over the gyros as wired only where its χ² is lower by more than
 #: this (the 99 % point of χ² with 1 degree of freedom): with poses near the six axes a half turn of the gyro
 #: triad about one axis maps every pose's gravity onto itself, and the moves cannot tell it from none
@@ -121,6 +128,38 @@ def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarra
             "the change of gravity between the poses. Check the gyros' --units (deg/s or rad/s), --columns and "
             "the axes' signs, and that the segment table's moves are whole turns between the poses")
     return np.linalg.solve(information, right)
+
+
+def _weak_entries(design: np.ndarray, V: np.ndarray, what: str) -> tuple[Identifiability, dict]:
+    """The moves' identifiability with the Kg entries they determine only weakly held at nominal.
+
+    *design* (2M, 39) is ∂r/∂θ at Kg = I (only the Kg columns non-zero) and *V* (2M, 2M) the residuals' covariance
+    there. With Q an orthonormal basis of what the moves determine (so that a unit step of z is a unit step of Kg),
+    the information Jzᵀ V⁺ Jz (Jz = ∂r/∂Kg · Q) has eigenvalues λ; while the smallest gives u = 1/√λ above
+    :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that direction is held (its column zeroed)
+    and the rest looked at again. Returns the identifiability of what is left and, per held entry, why."""
+    held: dict[str, str] = {}
+    ident = identifiability(design, what=what)
+    while True:
+        basis = ident.basis[KG_INDEX]
+        if basis.shape[1] == 0:
+            return ident, held
+        q, _ = np.linalg.qr(basis)
+        Jz = design[:, KG_INDEX] @ q
+        information = Jz.T @ np.linalg.pinv(V) @ Jz
+        values, vectors = np.linalg.eigh(0.5 * (information + information.T))
+        u = 1.0 / math.sqrt(max(float(values[0]), 1e-300))
+        if u <= WEAK_DIRECTION_U:
+            return ident, held
+        direction = np.abs(q @ vectors[:, 0])
+        k = int(np.argmax(direction))
+        held[KG_NAMES[k]] = (f"the moves determine it only weakly (u = {u:.3g} at Kg = I along the combination it "
+                             f"leads, above {WEAK_DIRECTION_U:g}): held at its nominal value with u = "
+                             f"{HELD_KG_UNCERTAINTY:g} (a turn about an axis that is vertical, or tilted by a few "
+                             "degrees, does not show its scale factor)")
+        design = design.copy()
+        design[:, KG_INDEX[k]] = 0.0
+        ident = identifiability(design, what=what)
 
 
 @dataclass(frozen=True)
@@ -416,6 +455,8 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     joint_sources = fit.sources
     held_sources = fit.held_sources if fit.held_sources is not None else sources_class(joint_gain.shape[1])
 
+    held_kg: list[int] = []
+
     def build(Kg, dark):
         sources = sources_class(2 * n_moves)
         jacobian = np.zeros((2 * n_moves, 9))
@@ -454,6 +495,8 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         # the joint fit's held_sources (its gain, not its weights, took them): here weighed by and propagated
         for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
             sources.add(total @ column, u, dof, kind)
+        for k in held_kg:  # the Kg entries held at nominal (_weak_entries)
+            sources.add(jacobian[:, k], HELD_KG_UNCERTAINTY, math.inf, "held")
         return sources, jacobian, angles
 
     def solve(V, Kg_start):
@@ -491,11 +534,23 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             best = plain
         return kg(best.x), W
 
+    # the entries the moves determine only weakly (WEAK_DIRECTION_U, from the information at Kg = I with the noise
+    # the moves predict) are held at nominal, with a Type B u that the moves weigh by and propagate
+    first = build(np.eye(3), 0.0)
+    ident, weak = _weak_entries(design, first[0].covariance(), "the moves between poses")
+    if weak:
+        held_kg.extend(KG_NAMES.index(name) for name in weak)
+        kg_mask = ident.mask[KG_INDEX]
+        if not kg_mask.any():
+            raise MovesNotFitted("the moves between poses were left out: " + next(iter(weak.values())))
+        basis = ident.basis[KG_INDEX]
+        first = build(np.eye(3), 0.0)
+
     Kg = np.eye(3)
     dark = 0.0
     V_predicted = None
     for iteration in range(3):
-        sources, jacobian, angles = build(Kg, dark)
+        sources, jacobian, angles = build(Kg, dark) if iteration else first
         V = sources.covariance()
         if iteration == 0:
             # from each sign of the three scale factors: a gyro wired with its sign flipped against the
@@ -546,7 +601,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         for b in range(3):
             name = f"Kg{'xyz'[a]}{'xyz'[b]}"
             if not kg_mask[3 * a + b]:
-                not_identified[name] = ident.not_identified.get(name, "the moves do not identify it")
+                not_identified[name] = weak.get(name) or ident.not_identified.get(name, "the moves do not identify it")
                 continue
             if a == b or (min(a, b), max(a, b)) not in symmetrise:
                 identified.append(name)
