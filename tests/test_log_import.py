@@ -756,6 +756,9 @@ def test_a_rate_table_log_is_fitted_once_the_table_rates_are_given(tmp_path, cap
     assert main(["fit", str(rec), "--latitude", "40", "--height", "50", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["identified"] == ["Kgzz"]
+    # the rates are the table's: its rate errors (JJF 2003 Table 1) are in u, its position errors are not (the unit
+    # was placed on it by hand)
+    assert "its rate errors only" in report["turntable"]
     kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
     assert abs(kgzz["estimate"] - scale) < 3.3 * kgzz["u"], kgzz
     assert kgzz["u"] < 1e-4

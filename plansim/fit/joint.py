@@ -929,10 +929,18 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     _refuse_constant_channels(recording)
     used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
     if all(s.orientation != "known" for s in used_schedule.segments):
-        # no segment on a table: its grade has nothing to act on (the hand placement is fitted instead)
+        # no pose on a table: its position errors have nothing to act on (the hand placement is fitted instead); a
+        # turn fitted by its given rate is the table's (an imported steady turn), whose rate errors stay
         zero = ErrorDistribution("uniform", 0.0)
-        turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
-        turntable_source = "none: every pose and turn is by hand (no table)"
+        if any(s.is_rotating and s.rate_known for s in used_schedule.segments):
+            turntable = dataclasses.replace(turntable, position_accuracy=zero, position_repeatability=zero,
+                                            axis_perpendicularity=zero, platform_tilt=zero,
+                                            fixture_perpendicularity=zero)
+            turntable_source = (f"{turntable_source}: its rate errors only (the turns' rates are the table's; every "
+                                "pose is placed by hand)")
+        else:
+            turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
+            turntable_source = "none: every pose and turn is by hand (no table)"
     model_schedule = Schedule(tuple(use.model_segments), procedure=schedule.procedure)
     rows = np.ones((len(used), 6), dtype=bool)
     rows[np.asarray(use.gyro_only, dtype=bool), 3:] = False  # a hand turn's accelerometers feel the hand
@@ -968,9 +976,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         notes.append(f"{int(model.placed.sum())} pose(s) placed by hand: each one's tilt from its nominal pose is "
                      "fitted (two nuisance parameters), and an unknown heading is averaged over")
     if use.hand_axes:
-        notes.append("turns by hand about " + ", ".join("xyz"[a] for a in use.hand_axes) + ": the mean rate is the "
-                     "reference angle over the duration, only the gyros are fitted, and each turned axis's "
-                     "misalignment is fitted (two nuisance parameters)")
+        notes.append("turns on a pose placed by hand about " + ", ".join("xyz"[a] for a in use.hand_axes) + ": the "
+                     "mean rate is the table's rate or the reference angle over the duration, only the gyros are "
+                     "fitted, and each turned axis's misalignment is fitted (two nuisance parameters)")
     held = [PARAMETER_INDEX[p.name] for p in PARAMETERS
             if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
     held_cross = _held_cross_couplings(ident, J) if model.n_tilts else []

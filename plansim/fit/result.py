@@ -16,7 +16,8 @@ from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
-JSON_KEYS = ("identified", "not_identified", "parameters", "noise", "residuals", "chi2_dof", "moves")
+JSON_KEYS = ("identified", "not_identified", "site", "turntable", "parameters", "noise", "residuals", "chi2_dof",
+             "moves")
 
 
 def _number(value: float):
@@ -62,6 +63,8 @@ def fit_json(result: FitResult) -> dict:
     return {
         "identified": list(result.identified),
         "not_identified": [{"name": name, "reason": reason} for name, reason in result.not_identified.items()],
+        "site": result.site.describe(),
+        "turntable": result.turntable_source,
         "parameters": parameters,
         "noise": noise,
         "residuals": residuals,
