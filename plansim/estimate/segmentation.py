@@ -895,6 +895,11 @@ def stuck_runs(values: np.ndarray, value: float, jump: float) -> list[tuple[int,
     return out
 
 
+def _vertical(force: np.ndarray, axis: int) -> bool:
+    """Body axis *axis* lies within :data:`VERTICAL_AXIS_TOLERANCE` of the specific force *force* (either sense)."""
+    return math.acos(min(1.0, abs(float(force[axis])) / float(np.linalg.norm(force)))) <= VERTICAL_AXIS_TOLERANCE
+
+
 def _integrate(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span, after: Span
                ) -> tuple[np.ndarray, np.ndarray]:
     """∫ (gyro − bias) dt over ``[lo, hi)``, rad, with the bias linear in time between the static spans *before* and
@@ -939,7 +944,7 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
             continue
         rate = x[p:q, :3].mean(axis=0) - bias.mean(axis=0)
         off = float(np.hypot(*np.delete(rate, axis)))
-        vertical = math.acos(min(1.0, abs(float(g[axis])) / float(np.linalg.norm(g)))) <= VERTICAL_AXIS_TOLERANCE
+        vertical = _vertical(g, axis)
         if any(s.start < q and s.stop > p for s in saturation):
             why = "a saturated sample inside: the steady rate is not known"
         elif off > OFF_AXIS_FRACTION * abs(float(rate[axis])):
@@ -994,7 +999,7 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
         return move(f"the pose changed from {before.up} up to {after.up} up: no reference for the angle",
                     integrated, axis)
     g = before.mean[3:]
-    vertical = math.acos(min(1.0, abs(float(g[axis])) / float(np.linalg.norm(g)))) <= VERTICAL_AXIS_TOLERANCE
+    vertical = _vertical(g, axis)
     full_turns = abs(nominal) % (2 * math.pi) < 1e-9
     if not vertical and not full_turns:
         return move(f"turned {math.degrees(main):+.1f} deg about the horizontal axis {AXES[axis]} without "

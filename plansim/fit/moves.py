@@ -130,16 +130,17 @@ def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarra
     return np.linalg.solve(information, right)
 
 
-def _weak_entries(design: np.ndarray, V: np.ndarray, what: str) -> tuple[Identifiability, dict]:
-    """The moves' identifiability with the Kg entries they determine only weakly held at nominal.
+def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str
+                  ) -> tuple[Identifiability, dict]:
+    """The moves' identifiability *ident* with the Kg entries they determine only weakly held at nominal.
 
-    *design* (2M, 39) is ∂r/∂θ at Kg = I (only the Kg columns non-zero) and *V* (2M, 2M) the residuals' covariance
-    there. With Q an orthonormal basis of what the moves determine (so that a unit step of z is a unit step of Kg),
-    the information Jzᵀ V⁺ Jz (Jz = ∂r/∂Kg · Q) has eigenvalues λ; while the smallest gives u = 1/√λ above
-    :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that direction is held (its column zeroed)
-    and the rest looked at again. Returns the identifiability of what is left and, per held entry, why."""
+    *design* (2M, 39) is ∂r/∂θ at Kg = I (only the Kg columns non-zero; *ident* its identifiability) and *V*
+    (2M, 2M) the residuals' covariance there. With Q an orthonormal basis of what the moves determine (so that a
+    unit step of z is a unit step of Kg), the information Jzᵀ V⁺ Jz (Jz = ∂r/∂Kg · Q) has eigenvalues λ; while
+    the smallest gives u = 1/√λ above :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that
+    direction is held (its column zeroed) and the rest looked at again. Returns the identifiability of what is
+    left and, per held entry, why."""
     held: dict[str, str] = {}
-    ident = identifiability(design, what=what)
     while True:
         basis = ident.basis[KG_INDEX]
         if basis.shape[1] == 0:
@@ -537,7 +538,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     # the entries the moves determine only weakly (WEAK_DIRECTION_U, from the information at Kg = I with the noise
     # the moves predict) are held at nominal, with a Type B u that the moves weigh by and propagate
     first = build(np.eye(3), 0.0)
-    ident, weak = _weak_entries(design, first[0].covariance(), "the moves between poses")
+    ident, weak = _weak_entries(ident, design, first[0].covariance(), "the moves between poses")
     if weak:
         held_kg.extend(KG_NAMES.index(name) for name in weak)
         kg_mask = ident.mask[KG_INDEX]
