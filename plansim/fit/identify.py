@@ -18,6 +18,7 @@ with uncertainties of 10 % and 10⁴ m/s² per (rad/s)² for a MEMS unit — mat
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,6 +30,11 @@ from plansim.model.parameters import PARAMETER_NAMES
 #: 1 %, the scale-factor error and misalignment a MEMS gyro's data sheet allows (docs/fitting.md); its effect is
 #: ≤ 0.01·7.3e-5 rad/s on a segment mean
 HELD_KG_UNCERTAINTY = 0.01
+#: standard uncertainty of a g-sensitivity entry (rad/s per m/s²) that a fit holds at 0 because the recording does not
+#: identify it but a turn still feels it (the moves between poses of a recording whose poses cannot separate it from
+#: the bias): 0.1 (°/s)/g, the linear-acceleration sensitivity a consumer MEMS gyro's data sheet states (e.g. the
+#: MPU-6050's); a full turn of T seconds about an axis across gravity feels it as an angle of up to 0.1°/s·T
+HELD_G_UNCERTAINTY = math.radians(0.1) / 9.80665
 #: singular values below this fraction of the largest (of the column-scaled design) count as zero: the
 #: design's entries are exact sums of gravity and rates, so rounding leaves ~1e-15; 1e-9 keeps every
 #: genuine direction down to a rate point of 1e-9 of the largest

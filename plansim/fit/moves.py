@@ -40,6 +40,10 @@ Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kern
   directly, are correlated through the data, and this carries the correlation);
 - the Earth rate during the move, which the linear interpolation of the bias does not follow: a rate of up
   to Ω_E about an axis not known, Type B, u = Ω_E/√3 per axis, held over the move;
+- each g-sensitivity entry the joint fit does not identify (every pose with one up axis leaves G with the bias):
+  the moves hold it at 0 instead of the joint fit's null-space value, with the Type B u
+  :data:`plansim.fit.identify.HELD_G_UNCERTAINTY`, through ∂r/∂G, and weigh by it (a whole turn about an axis
+  across gravity feels G as an angle of one sign whichever way it turns);
 - the symmetric part of each pair of Ka's cross-couplings the joint fit holds at 0 (poses placed by hand near the
   axes do not determine the triad's shear, which bends each pose's gravity direction): its Type B uncertainty
   (:data:`plansim.fit.joint.HELD_KA_UNCERTAINTY`, the joint fit's ``held_sources``) through ∂r/∂m + ∂r/∂θ·A like
@@ -73,7 +77,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
-from plansim.fit.identify import HELD_KG_UNCERTAINTY, Identifiability, identifiability
+from plansim.fit.identify import HELD_G_UNCERTAINTY, HELD_KG_UNCERTAINTY, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -85,6 +89,8 @@ KG_INDEX = np.array([PARAMETER_INDEX[name] for name in KG_NAMES])
 #: the entries of the joint estimate the moves' model reads
 _USED_FROM_JOINT = tuple(f"{p}{a}{b}" for p in ("Ka", "g") for a in "xyz" for b in "xyz") + \
     tuple(f"Ba{a}" for a in "xyz")
+#: the g-sensitivity entries, which the moves hold at 0 where the joint fit does not identify them
+G_NAMES = tuple(f"g{a}{b}" for a in "xyz" for b in "xyz")
 #: central-difference steps: a segment mean (gyro rad/s, accelerometer m/s²) and a joint parameter (SI)
 _STEP_GYRO, _STEP_ACCEL, _STEP_PARAMETER = 1e-7, 1e-6, 1e-7
 #: two moves or fewer cannot identify anything (each gives two numbers)
@@ -130,13 +136,14 @@ def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarra
     return np.linalg.solve(information, right)
 
 
-def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str
+def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str, at: str = "Kg = I"
                   ) -> tuple[Identifiability, dict]:
     """The moves' identifiability *ident* with the Kg entries they determine only weakly held at nominal.
 
-    *design* (2M, 39) is ∂r/∂θ at Kg = I (only the Kg columns non-zero; *ident* its identifiability) and *V*
-    (2M, 2M) the residuals' covariance there. With Q an orthonormal basis of what the moves determine (so that a
-    unit step of z is a unit step of Kg), the information Jzᵀ V⁺ Jz (Jz = ∂r/∂Kg · Q) has eigenvalues λ; while
+    *design* (2M, 39) is ∂r/∂θ at *at* (Kg = I, or the fitted Kg; only the Kg columns non-zero, those held
+    already zero; *ident* its identifiability) and *V* (2M, 2M) the residuals' covariance there. With Q an
+    orthonormal basis of what the moves determine (so that a unit step of z is a unit step of Kg), the information
+    Jzᵀ V⁺ Jz (Jz = ∂r/∂Kg · Q) has eigenvalues λ; while
     the smallest gives u = 1/√λ above :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that
     direction is held (its column zeroed) and the rest looked at again. Returns the identifiability of what is
     left and, per held entry, why."""
@@ -154,10 +161,11 @@ def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, wha
             return ident, held
         direction = np.abs(q @ vectors[:, 0])
         k = int(np.argmax(direction))
-        held[KG_NAMES[k]] = (f"the moves determine it only weakly (u = {u:.3g} at Kg = I along the combination it "
+        held[KG_NAMES[k]] = (f"the moves determine it only weakly (u = {u:.3g} at {at} along the combination it "
                              f"leads, above {WEAK_DIRECTION_U:g}): held at its nominal value with u = "
                              f"{HELD_KG_UNCERTAINTY:g} (a turn about an axis that is vertical, or tilted by a few "
-                             "degrees, does not show its scale factor)")
+                             "degrees, does not show its scale factor; a whole turn shows the cross-couplings of its "
+                             "axis only at second order)")
         design = design.copy()
         design[:, KG_INDEX[k]] = 0.0
         ident = identifiability(design, what=what)
@@ -392,6 +400,11 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     joint_identified = set(fit.identifiability.identified)
     symmetrise = [(i, j) for i in range(3) for j in range(i + 1, 3)
                   if not {f"Ka{'xyz'[i]}{'xyz'[j]}", f"Ka{'xyz'[j]}{'xyz'[i]}"} <= joint_identified]
+    # a g-sensitivity the joint fit does not identify is wherever its null space left it (a share of the bias, when
+    # every pose has one up axis): the moves hold it at 0 with a Type B u instead (module docstring)
+    held_g = [name for name in G_NAMES if name not in joint_identified]
+    theta = theta.copy()
+    theta[[PARAMETER_INDEX[name] for name in held_g]] = 0.0
     moves = _Moves(recording, transitions, pose_row, means, theta, symmetrise)
     n_moves = len(transitions)
     notes = []
@@ -434,6 +447,8 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         """∂r/∂θ (2M, 39) for the entries of the joint estimate the model reads (Ka, Ba, G)."""
         D = np.zeros((2 * n_moves, len(PARAMETER_NAMES)))
         for name in _USED_FROM_JOINT:
+            if name in held_g:
+                continue
             k = PARAMETER_INDEX[name]
             up, down = theta.copy(), theta.copy()
             up[k] += _STEP_PARAMETER
@@ -498,6 +513,14 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             sources.add(total @ column, u, dof, kind)
         for k in held_kg:  # the Kg entries held at nominal (_weak_entries)
             sources.add(jacobian[:, k], HELD_KG_UNCERTAINTY, math.inf, "held")
+        for name in held_g:  # the g-sensitivities held at 0: ∂r/∂g by central differences
+            k = PARAMETER_INDEX[name]
+            up, down = theta.copy(), theta.copy()
+            up[k] += _STEP_PARAMETER
+            down[k] -= _STEP_PARAMETER
+            column = (moves.residuals(Kg, up, means) - moves.residuals(Kg, down, means)) / (2 * _STEP_PARAMETER)
+            if np.any(column):
+                sources.add(column, HELD_G_UNCERTAINTY, math.inf, "held")
         return sources, jacobian, angles
 
     def solve(V, Kg_start):
@@ -536,44 +559,54 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         return kg(best.x), W
 
     # the entries the moves determine only weakly (WEAK_DIRECTION_U, from the information at Kg = I with the noise
-    # the moves predict) are held at nominal, with a Type B u that the moves weigh by and propagate
+    # the moves predict, and again at the fitted Kg with the noise between moves) are held at nominal, with a Type B
+    # u that the moves weigh by and propagate
     first = build(np.eye(3), 0.0)
     ident, weak = _weak_entries(ident, design, first[0].covariance(), "the moves between poses")
-    if weak:
-        held_kg.extend(KG_NAMES.index(name) for name in weak)
-        kg_mask = ident.mask[KG_INDEX]
-        if not kg_mask.any():
-            raise MovesNotFitted("the moves between poses were left out: " + next(iter(weak.values())))
-        basis = ident.basis[KG_INDEX]
-        first = build(np.eye(3), 0.0)
-
-    Kg = np.eye(3)
-    dark = 0.0
-    V_predicted = None
-    for iteration in range(3):
-        sources, jacobian, angles = build(Kg, dark) if iteration else first
+    while True:
+        if weak:
+            held_kg[:] = [KG_NAMES.index(name) for name in weak]
+            kg_mask = ident.mask[KG_INDEX]
+            if not kg_mask.any():
+                raise MovesNotFitted("the moves between poses were left out: " + next(iter(weak.values())))
+            basis = ident.basis[KG_INDEX]
+            first = build(np.eye(3), 0.0)
+        Kg = np.eye(3)
+        dark = 0.0
+        V_predicted = None
+        for iteration in range(3):
+            sources, jacobian, angles = build(Kg, dark) if iteration else first
+            V = sources.covariance()
+            if iteration == 0:
+                # from each sign of the three scale factors: a gyro wired with its sign flipped against the
+                # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
+                # stops in a local minimum (every move's miss of the order of its angle)
+                starts = [np.stack([unit * np.diag(signs) for signs in SIGN_STARTS], axis=2) for unit in UNIT_STARTS]
+                Kg, W = solve(V, starts)
+                continue
+            if iteration == 1:
+                V_predicted = V
+            Kg, W = solve(V, Kg)
+            r = moves.residuals(Kg, theta, means)
+            Jz = jacobian @ basis
+            Vinv = np.linalg.pinv(V)
+            hat = Jz @ _solve_information(Jz.T @ Vinv @ Jz, Jz.T @ Vinv, Kg)
+            if iteration == 1:
+                residual_predicted = r
+                dark = _dark_variance(r, V, hat, threshold)
+                if dark == 0.0:
+                    break
+        sources, jacobian, angles = build(Kg, dark)
         V = sources.covariance()
-        if iteration == 0:
-            # from each sign of the three scale factors: a gyro wired with its sign flipped against the
-            # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
-            # stops in a local minimum (every move's miss of the order of its angle)
-            starts = [np.stack([unit * np.diag(signs) for signs in SIGN_STARTS], axis=2) for unit in UNIT_STARTS]
-            Kg, W = solve(V, starts)
-            continue
-        if iteration == 1:
-            V_predicted = V
-        Kg, W = solve(V, Kg)
-        r = moves.residuals(Kg, theta, means)
-        Jz = jacobian @ basis
-        Vinv = np.linalg.pinv(V)
-        hat = Jz @ _solve_information(Jz.T @ Vinv @ Jz, Jz.T @ Vinv, Kg)
-        if iteration == 1:
-            residual_predicted = r
-            dark = _dark_variance(r, V, hat, threshold)
-            if dark == 0.0:
-                break
-    sources, jacobian, angles = build(Kg, dark)
-    V = sources.covariance()
+        # a combination the fitted moves, with their noise between moves, still determine only weakly (a cross-coupling
+        # that a whole turn shows at second order only: first order at Kg = I passed on the turns' ramps)
+        fitted = np.zeros_like(design)
+        fitted[:, KG_INDEX] = jacobian
+        fitted[:, KG_INDEX[held_kg]] = 0.0
+        ident, more = _weak_entries(ident, fitted, V, "the moves between poses", at="the fitted Kg")
+        if not more:
+            break
+        weak.update(more)
     Vinv = np.linalg.pinv(V)
     Jz = jacobian @ basis
     information = Jz.T @ Vinv @ Jz
