@@ -75,6 +75,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
+from scipy.stats import chi2 as chi2_distribution
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
 from plansim.fit.identify import HELD_G_UNCERTAINTY, HELD_KG_UNCERTAINTY, Identifiability, identifiability
@@ -104,6 +105,9 @@ UNIT_STARTS = (1.0, math.degrees(1.0))
 #: (|K| outside 0.71–1.22; the test's log in deg/s read as rad/s ended at −0.056 and +0.44 from ±1; a MEMS gyro's
 #: scale factor is within a few per cent of 1)
 FAR_OFF = 0.5
+#: … or where they end with χ² (against the noise the moves predict, before any between-move noise) beyond this
+#: upper-tail probability: gyros read in deg/s as rad/s also stop near diag(−1, −1, +1), every move missing by 25°
+POOR_FIT = 1e-3
 #: a combination of Kg entries the moves determine no better than this standard uncertainty (dimensionless) at
 #: Kg = I, with the noise they predict and no between-move noise (the smallest u they could give), is not
 #: identified: a gyro's scale factor is within a few per cent of 1 and its cross-couplings within 1 %, so such a
@@ -136,27 +140,43 @@ def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarra
     return np.linalg.solve(information, right)
 
 
-def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str, at: str = "Kg = I"
-                  ) -> tuple[Identifiability, dict]:
+def _floored_eigh(V: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The eigenvalues and eigenvectors of the residuals' covariance *V*, the eigenvalues floored at 1e-14 of the
+    largest: the moves' weights, information and gain all read V through this, so that a direction V holds no noise
+    on is determined exactly rather than left out (a recording without noise determines everything it excites)."""
+    values, vectors = np.linalg.eigh(0.5 * (V + V.T))
+    return np.maximum(values, 1e-14 * max(float(values.max()), 1e-300)), vectors
+
+
+def _floored_inverse(V: np.ndarray) -> np.ndarray:
+    """V⁻¹ through :func:`_floored_eigh`."""
+    values, vectors = _floored_eigh(V)
+    return (vectors / values) @ vectors.T
+
+
+def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str, at: str = "Kg = I",
+                  scale: float = 1.0) -> tuple[Identifiability, dict]:
     """The moves' identifiability *ident* with the Kg entries they determine only weakly held at nominal.
 
     *design* (2M, 39) is ∂r/∂θ at *at* (Kg = I, or the fitted Kg; only the Kg columns non-zero, those held
     already zero; *ident* its identifiability) and *V* (2M, 2M) the residuals' covariance there. With Q an
     orthonormal basis of what the moves determine (so that a unit step of z is a unit step of Kg), the information
-    Jzᵀ V⁺ Jz (Jz = ∂r/∂Kg · Q) has eigenvalues λ; while
+    Jzᵀ V⁻¹ Jz (Jz = ∂r/∂Kg · Q; :func:`_floored_eigh`) has eigenvalues λ; while
     the smallest gives u = 1/√λ above :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that
     direction is held (its column zeroed) and the rest looked at again. Returns the identifiability of what is
-    left and, per held entry, why."""
+    left and, per held entry, why. *scale* is the size of the gyros' scale factors there (1 at Kg = I; at the fitted
+    Kg the mean |Kg_ii|, 57.3 for gyros read in deg/s as rad/s), and u is taken relative to it."""
     held: dict[str, str] = {}
+    V_inverse = _floored_inverse(V)
     while True:
         basis = ident.basis[KG_INDEX]
         if basis.shape[1] == 0:
             return ident, held
         q, _ = np.linalg.qr(basis)
         Jz = design[:, KG_INDEX] @ q
-        information = Jz.T @ np.linalg.pinv(V) @ Jz
+        information = Jz.T @ V_inverse @ Jz
         values, vectors = np.linalg.eigh(0.5 * (information + information.T))
-        u = 1.0 / math.sqrt(max(float(values[0]), 1e-300))
+        u = 1.0 / math.sqrt(max(float(values[0]), 1e-300)) / scale
         if u <= WEAK_DIRECTION_U:
             return ident, held
         direction = np.abs(q @ vectors[:, 0])
@@ -524,8 +544,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         return sources, jacobian, angles
 
     def solve(V, Kg_start):
-        values, vectors = np.linalg.eigh(0.5 * (V + V.T))
-        values = np.maximum(values, 1e-14 * values.max())
+        values, vectors = _floored_eigh(V)
         W = (vectors / np.sqrt(values)).T
 
         def kg(z):
@@ -541,8 +560,11 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
 
         best, plain = None, None
         groups = Kg_start if isinstance(Kg_start, list) else [Kg_start]
-        for group in groups:  # a later group only where the earlier ones ended with a scale factor far from ±1
-            if best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF):
+        poor = chi2_distribution.isf(POOR_FIT, max(2 * n_moves - basis.shape[1], 1))
+        for group in groups:  # a later group only where the earlier ones ended with a scale factor far from ±1,
+            # or with misses no noise explains (2·cost = χ² against the predicted noise beyond its POOR_FIT point)
+            if best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF) and \
+                    2.0 * best.cost <= poor:
                 break
             for start in np.atleast_3d(group).transpose(2, 0, 1) if np.ndim(group) == 3 else [group]:
                 z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
@@ -589,7 +611,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             Kg, W = solve(V, Kg)
             r = moves.residuals(Kg, theta, means)
             Jz = jacobian @ basis
-            Vinv = np.linalg.pinv(V)
+            Vinv = _floored_inverse(V)
             hat = Jz @ _solve_information(Jz.T @ Vinv @ Jz, Jz.T @ Vinv, Kg)
             if iteration == 1:
                 residual_predicted = r
@@ -603,11 +625,12 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         fitted = np.zeros_like(design)
         fitted[:, KG_INDEX] = jacobian
         fitted[:, KG_INDEX[held_kg]] = 0.0
-        ident, more = _weak_entries(ident, fitted, V, "the moves between poses", at="the fitted Kg")
+        ident, more = _weak_entries(ident, fitted, V, "the moves between poses", at="the fitted Kg",
+                                    scale=float(np.mean(np.abs(np.diag(Kg)))))
         if not more:
             break
         weak.update(more)
-    Vinv = np.linalg.pinv(V)
+    Vinv = _floored_inverse(V)
     Jz = jacobian @ basis
     information = Jz.T @ Vinv @ Jz
     gain_z = _solve_information(information, Jz.T @ Vinv, Kg)  # (rank, 2M)
