@@ -86,6 +86,7 @@ import numpy as np
 from scipy.special import chdtrc
 from threadpoolctl import threadpool_limits
 
+from plansim.fit.identify import HAND_PLACEMENT
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES
 
@@ -344,18 +345,30 @@ def _chi2_sf(statistic, dof) -> np.ndarray:
 
 
 def _aliases(fit, geometry: _Geometry, column: np.ndarray) -> tuple[str, ...]:
-    """The parameters a whitened column would move, largest in units of their u first (those above 10 % of it)."""
+    """What would absorb a whitened column: each parameter's part of the column the fit takes up, ‖W·J_k·Δ_k‖ (J_k
+    its design column at the solution, Δ_k its change in the fit's own basis), and the hand placement's (every
+    nuisance tilt together) as one; the largest first, those above 10 % of the largest, at most four.
+
+    Not in units of each parameter's u: where the hand placement and parameters the recording does not identify
+    take a column up (an accelerometer's K2 on poses turned by hand about one axis: Bay, Kayy and Kazz at parts of
+    8·10⁵, 6·10⁵ and 3·10⁵), the identified parameters' share (gzz, gyy at 9 and 7) had been listed for it."""
     if geometry.X.shape[1] == 0:
         return ()
     beta = np.linalg.lstsq(geometry.X, column, rcond=None)[0]
     basis = fit.basis  # the fit's own combinations: the columns of X (not always fit.identifiability.basis)
-    change = basis[: len(PARAMETER_NAMES)] @ beta[:basis.shape[1]]
-    u = np.where(np.isfinite(fit.joint.u) & (fit.joint.u > 0), fit.joint.u, np.inf)
-    scaled = np.abs(change) / u
-    if not np.any(scaled > 0):
+    change = basis @ beta[:basis.shape[1]]  # (39 + nuisance,)
+    n = len(PARAMETER_NAMES)
+    W = geometry.W
+    parts = np.abs(change[:n]) * np.linalg.norm(W @ fit.model.parameter_jacobian(tilts=fit.nuisance), axis=0)
+    names = list(PARAMETER_NAMES)
+    if change.size > n:
+        tilt = W @ fit.model.tilt_jacobian(fit.theta, fit.nuisance) @ change[n:]
+        parts = np.append(parts, np.linalg.norm(tilt))
+        names.append(HAND_PLACEMENT)
+    if not np.any(parts > 0):
         return ()
-    order = np.argsort(-scaled)
-    return tuple(PARAMETER_NAMES[k] for k in order[:4] if scaled[k] > 0.1 * scaled[order[0]])
+    order = np.argsort(-parts)
+    return tuple(names[k] for k in order[:4] if parts[k] > 0.1 * parts[order[0]])
 
 
 def score_candidates(fit, sigs, *, alpha: float = 0.05, null_draws: int = NULL_DRAWS, seed: int = 0,

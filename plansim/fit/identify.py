@@ -35,6 +35,8 @@ HELD_KG_UNCERTAINTY = 0.01
 #: the bias): 0.1 (°/s)/g, the linear-acceleration sensitivity a consumer MEMS gyro's data sheet states (e.g. the
 #: MPU-6050's); a full turn of T seconds about an axis across gravity feels it as an angle of up to 0.1°/s·T
 HELD_G_UNCERTAINTY = math.radians(0.1) / 9.80665
+#: how a report names the nuisance parameters of poses and turns placed by hand, together
+HAND_PLACEMENT = "the hand placement (the tilts of poses placed by hand, the axes of turns by hand)"
 #: singular values below this fraction of the largest (of the column-scaled design) count as zero: the
 #: design's entries are exact sums of gravity and rates, so rounding leaves ~1e-15; 1e-9 keeps every
 #: genuine direction down to a rate point of 1e-9 of the largest
@@ -136,8 +138,8 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments", 
         partners = [p for p in partners if not p.startswith("tilt")]
         shown = ", ".join(partners[:6]) + (f" and {len(partners) - 6} more" if len(partners) > 6 else "")
         if tilts:
-            not_identified[name] = (f"{what} see it only in combination with the hand placement (the tilts of poses "
-                                    "placed by hand, the axes of turns by hand)" + (f" and {shown}" if shown else ""))
+            not_identified[name] = (f"{what} see it only in combination with {HAND_PLACEMENT}"
+                                    + (f" and {shown}" if shown else ""))
         elif partners:
             not_identified[name] = f"{what} see it only in combination with {shown}"
         else:
