@@ -189,6 +189,22 @@ def test_a_table_turn_is_not_labelled_with_the_nearest_quarter_turn():
         assert whole == pytest.approx(float(np.sum(turn[:, 2]) / FS), abs=math.radians(0.5))
 
 
+def test_a_rate_held_longer_than_all_the_rests_is_not_taken_for_the_rest():
+    """A minute at +100 °/s and a minute at −100 °/s between three 10 s rests: the turn at one rate holds more of the
+    log than the rests together, the run the most quiet samples agree with was the +100 °/s turn, and the log read as
+    one static span between two moves (every rest turning at −100 °/s). A log starts and stops at rest: its first and
+    last runs agree, and the rest is chosen among the runs that agree with them."""
+    for seed in (1, 2):
+        rng = np.random.default_rng(seed)
+        x = np.vstack([static_noise("white", 10.0, rng), _table_turn(rng, 1.0, 60.0, 100.0),
+                       static_noise("white", 10.0, rng), _table_turn(rng, 1.0, 60.0, -100.0),
+                       static_noise("white", 10.0, rng)])
+        result = segment_log(x, None, FS)
+        assert [s.kind for s in result.spans] == ["static", "move", "rotation", "move"] * 2 + ["static"]
+        assert [math.degrees(r.steady_rate) for r in result.of_kind("rotation")] == pytest.approx([100.0, -100.0],
+                                                                                                   abs=0.05)
+
+
 def test_a_turn_too_long_for_its_quarter_turn_to_be_told_is_a_move():
     """A turn of 830 deg that holds no steady rate: 10 deg + 5 % of it passes half a quarter turn, so the nearest
     whole number of quarter turns (810 deg) is no reference; it is a move, saying why (an independent simulator's

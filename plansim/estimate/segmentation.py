@@ -685,21 +685,28 @@ def _rest_by_agreement(runs: list[tuple[int, int]], medians: list, forces: list,
                        quiet: int) -> int:
     """The run taken to be at rest first (step 6): the one that the most samples of quiet runs agree with (a run
     *j* agrees with run *i* when :func:`_at_rest` finds *j* at rest with *i* as the only rest), *quiet* (the run
-    nearest the quiet stretch) where it has as many as any.
+    nearest the quiet stretch) where it has as many as any. Where the log's first and last quiet runs agree with
+    each other, only the runs that agree with them are candidates: a log starts and ends at rest.
 
     The quiet stretch alone (step 3) cannot tell a rest from a table's steady turn: a table's rate jitter is far
     below a MEMS gyro's noise, so the two are equally quiet, and a log of rests between table turns had been read
     with one turn at rest and every rest turning. The rests of a log agree with each other (one bias, up to the
     g-sensitivity between poses) and a turn agrees only with turns at its own rate, so the rests win wherever they
-    hold more of the log than the turns at any one rate. Where every run agrees with the quiet one (a log of
-    poses), this is the quiet one."""
+    hold more of the log than the turns at any one rate. Where a rate is held longer than all the rests together (a
+    minute at each of ±100 °/s between 10 s rests), the count alone takes that turn for the rest; a log is started
+    and stopped with the unit at rest, so where its two ends agree, the rest is one of the runs agreeing with them
+    (a log that starts and ends in the same steady turn would still be misread; one whose ends differ, recorded
+    into a turn, falls back to the count). Where every run agrees with the quiet one (a log of poses), this is the
+    quiet one."""
     sizes = np.array([b - a for a, b in runs])
-    support = [int(sum(sizes[j] for j in range(len(runs)) if _at_rest(j, [i], medians, forces, None, rate_threshold)))
-               for i in range(len(runs))]
-    best = max(support)
-    if support[quiet] == best:
+    agree = [[j for j in range(len(runs)) if _at_rest(j, [i], medians, forces, None, rate_threshold)]
+             for i in range(len(runs))]
+    support = [int(sum(sizes[j] for j in agree[i])) for i in range(len(runs))]
+    candidates = agree[0] if len(runs) > 1 and len(runs) - 1 in agree[0] else list(range(len(runs)))
+    best = max(support[i] for i in candidates)
+    if quiet in candidates and support[quiet] == best:
         return quiet
-    return min((i for i in range(len(runs)) if support[i] == best), key=lambda i: abs(i - quiet))
+    return min((i for i in candidates if support[i] == best), key=lambda i: abs(i - quiet))
 
 
 def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray | None,
