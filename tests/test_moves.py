@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import math
@@ -491,6 +492,13 @@ def _table_log(turns, seed: int, rest_s: float = 10.0, fs: float = 100.0):
     return np.arange(x.shape[0]) / fs, x, Kg
 
 
+def _write_log(path, t: np.ndarray, x: np.ndarray):
+    """*path* with a log of _table_log's *t*, *x* as a user's CSV (time, gyros in deg/s, accelerometers in m/s²)."""
+    np.savetxt(path, np.column_stack([t, np.degrees(x[:, :3]), x[:, 3:]]), delimiter=",",
+               header="time,gx,gy,gz,ax,ay,az", comments="", fmt="%.12g")
+    return path
+
+
 def test_a_scale_factor_the_moves_see_only_weakly_is_held_not_invented(tmp_path):
     """12 positions on a table whose y axis is turned about only while it is vertical: the moves see Kgyy only
     through the poses' fraction-of-a-degree tilts. They had given Kgyy = 5.33 ± 13.7, 7.41 ± 30.5 or 0.497 ± 0.053
@@ -506,10 +514,8 @@ def test_a_scale_factor_the_moves_see_only_weakly_is_held_not_invented(tmp_path)
     horizontal_once = [(0, 180), (1, 180)] + vertical_only[2:]
     for turns, seed, held in ((vertical_only, 5, True), (horizontal_once, 1, False)):
         t, x, Kg = _table_log(turns, seed)
-        log = tmp_path / "table.csv"
-        block = np.column_stack([t, np.degrees(x[:, :3]), x[:, 3:]])
-        np.savetxt(log, block, delimiter=",", header="time,gx,gy,gz,ax,ay,az", comments="", fmt="%.12g")
-        recording = import_log(log, time_column="time", units="deg/s,m/s^2").recording
+        recording = import_log(_write_log(tmp_path / "table.csv", t, x), time_column="time",
+                               units="deg/s,m/s^2").recording
         fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False))
         moves = fit.moves
         assert moves is not None
@@ -543,10 +549,8 @@ def test_whole_turns_about_a_horizontal_axis_give_its_scale_factor(tmp_path):
 
     for seed in (4, 5):
         t, x, Kg = _table_log([(1, 360), (1, -360), (1, 720), (1, -720), (1, 360), (1, -360)], seed=seed)
-        log = tmp_path / "whole.csv"
-        np.savetxt(log, np.column_stack([t, np.degrees(x[:, :3]), x[:, 3:]]), delimiter=",",
-                   header="time,gx,gy,gz,ax,ay,az", comments="", fmt="%.12g")
-        recording = import_log(log, time_column="time", units="deg/s,m/s^2").recording
+        recording = import_log(_write_log(tmp_path / "whole.csv", t, x), time_column="time",
+                               units="deg/s,m/s^2").recording
         fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False))
         assert not any(name.startswith("g") for name in fit.identifiability.identified)
         moves = fit.moves
@@ -573,10 +577,8 @@ def test_poses_far_from_every_axis_reach_the_other_axes_accelerometers(tmp_path)
     from plansim.io.log_import import import_log
 
     t, x, Kg = _table_log([(1, 140), (1, -140), (1, 27), (1, -27), (1, -20), (1, 20)], seed=2)
-    log = tmp_path / "far.csv"
-    np.savetxt(log, np.column_stack([t, np.degrees(x[:, :3]), x[:, 3:]]), delimiter=",",
-               header="time,gx,gy,gz,ax,ay,az", comments="", fmt="%.12g")
-    recording = import_log(log, time_column="time", units="deg/s,m/s^2").recording
+    recording = import_log(_write_log(tmp_path / "far.csv", t, x), time_column="time",
+                           units="deg/s,m/s^2").recording
     assert sum(s.orientation == "unknown" and s.test == "static" for s in recording.schedule.segments) == 3
     fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False))
     assert chi2_distribution.sf(fit.chi2, fit.chi2_dof) >= 1e-3, (fit.chi2, fit.chi2_dof)
@@ -610,13 +612,50 @@ def test_an_accelerometer_effect_is_not_said_to_alias_with_gyro_parameters(tmp_p
     from plansim.io.log_import import import_log
 
     t, x, _ = _table_log([(1, 140), (1, -140), (1, 27), (1, -27), (1, -20), (1, 20)], seed=2)
-    log = tmp_path / "far.csv"
-    np.savetxt(log, np.column_stack([t, np.degrees(x[:, :3]), x[:, 3:]]), delimiter=",",
-               header="time,gx,gy,gz,ax,ay,az", comments="", fmt="%.12g")
-    recording = import_log(log, time_column="time", units="deg/s,m/s^2").recording
+    recording = import_log(_write_log(tmp_path / "far.csv", t, x), time_column="time",
+                           units="deg/s,m/s^2").recording
     result = diagnose(recording, Site(math.radians(40.0), 50.0, earth_rate=False), null_draws=200)
     quadratic = next(c for c in result.candidates if c.effect == "accel_quadratic")
     assert quadratic.aliased_with, quadratic
     assert all(name.startswith(("Ka", "Ba", "one segment (")) or name == HAND_PLACEMENT
                for name in quadratic.aliased_with), \
         quadratic.aliased_with
+
+
+def test_a_scenario_states_the_priors_of_what_the_fit_holds(tmp_path):
+    """Whole turns about a horizontal axis one way only (+360°, +720° at one peak rate, their durations nearly in
+    proportion to their angles) cannot tell the held g-sensitivity from the scale factor: Kgyy's u is the held G's,
+    about 3.3e-3 with the data sheet's 0.1 (°/s)/g. A lab that knows its gyros' g-sensitivity to 0.01 (°/s)/g says
+    so in its scenario (``[reduction] held_g_sensitivity``); the fit then carries that u, ten times smaller (the
+    moves' own noise adds 4e-5 in quadrature: the ratio is asserted within 8-12), the estimate still within 3.3 u of
+    the truth (0.1 % two-sided). A bad value is refused naming the field."""
+    from plansim.config import parse_scenario
+    from plansim.fit import scenario_fit_options
+    from plansim.fit.identify import HeldPriors
+    from plansim.io.log_import import import_log
+    from plansim.io.scenario_file import load_scenario
+
+    document = copy.deepcopy(load_scenario("jjf2003").document)
+    document.setdefault("reduction", {})["held_g_sensitivity"] = "0.01 deg/s/g"
+    options = scenario_fit_options(parse_scenario(document, name="lab"))
+    held = options["held"]
+    assert held.g_sensitivity == pytest.approx(math.radians(0.01) / 9.80665)
+    assert (held.gyro, held.accel_cross) == (HeldPriors().gyro, HeldPriors().accel_cross) and "lab" in held.source
+    for bad, error in (("-0.1 deg/s/g", ValueError), ("0.1 deg/s", ValueError), (True, TypeError)):
+        document["reduction"]["held_g_sensitivity"] = bad
+        with pytest.raises(error, match="reduction.held_g_sensitivity"):
+            parse_scenario(document)
+
+    t, x, Kg = _table_log([(1, 360), (1, 360), (1, 720), (1, 720), (1, 360), (1, 720)], seed=4)
+    recording = import_log(_write_log(tmp_path / "one_way.csv", t, x), time_column="time",
+                           units="deg/s,m/s^2").recording
+    site = Site(math.radians(40.0), 50.0, earth_rate=False)
+    k = KG_INDEX[KG_NAMES.index("Kgyy")]
+    u = {}
+    for name, priors in (("sheet", None), ("lab", held)):
+        fit = fit_recording(recording, site, held=priors)
+        assert fit.moves is not None and "Kgyy" in fit.moves.identified
+        estimate, u[name] = fit.moves.method.estimate[k], fit.moves.method.u[k]
+        assert abs(estimate - Kg[1, 1]) < 3.3 * u[name], (name, estimate, Kg[1, 1], u[name])
+    assert 8.0 < u["sheet"] / u["lab"] < 12.0, u
+    assert any("scenario 'lab'" in note for note in fit.notes)

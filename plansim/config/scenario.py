@@ -165,6 +165,12 @@ class Reduction:
     reference_gravity: float  # m/s²: the value of "1 g" in the matrix A of eq. (6)-(11)
     reference_gravity_label: str  # "local", "standard" or the stated value
     omega_squared_sign: str  # "model": p = (U8 − U7)/ω², consistent with eq. (2); "as_printed": eq. (12)
+    #: the Type B standard uncertainties a fit of measured data gives what it holds at nominal (plansim fit
+    #: --scenario): a gyro scale factor or cross-coupling, the accelerometers' shear (dimensionless), a g-sensitivity
+    #: (rad/s per m/s²); None where the scenario does not say (the fit's data-sheet default)
+    held_gyro: float | None = None
+    held_accel_cross: float | None = None
+    held_g_sensitivity: float | None = None
 
 
 @dataclass(frozen=True)
@@ -566,8 +572,14 @@ def parse_scenario(document: dict, name: str | None = None, source: str = "") ->
         g_label = str(raw_g)
         if not g_ref > 0:
             raise ValueError(f"reduction.reference_gravity = {raw_g!r}: must be > 0")
+    held = {}
+    for key, kind in (("held_gyro", "dimensionless"), ("held_accel_cross", "dimensionless"),
+                      ("held_g_sensitivity", "rate_per_acceleration")):
+        if r.get(key) is not None:
+            held[key] = _nonneg(r.quantity(key, kind, None), r.where(key))
     reduction = Reduction(reference_gravity=g_ref, reference_gravity_label=g_label,
-                          omega_squared_sign=r.string("omega_squared_sign", "model", allowed=("model", "as_printed")))
+                          omega_squared_sign=r.string("omega_squared_sign", "model", allowed=("model", "as_printed")),
+                          **held)
     r.check_unknown()
 
     description = document.get("description", "")

@@ -320,13 +320,13 @@ def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed: int = 0,
              null_draws: int = NULL_DRAWS, lever_arm=None, reference_gravity=None, omega_squared_sign: str = "model",
-             turntable_source: str = "", stated_white=None, stated_step=None) -> Diagnosis:
+             turntable_source: str = "", stated_white=None, stated_step=None, held=None) -> Diagnosis:
     """Diagnose a recording (module docstring).
 
     Parameters
     ----------
     recording : plansim.io.recording.Recording
-    site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source, stated_white, stated_step
+    site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source, stated_white, stated_step, held
         As :func:`plansim.fit.fit_recording`.
     alpha : float
         False-alarm rate of the whole diagnosis (0 < alpha < 1): on a recording the base model describes, the
@@ -356,7 +356,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         raise ValueError(f"null_draws = {null_draws!r}: must be a whole number >= 19 (p resolves to 1/(B + 1))")
     options = dict(site=site, turntable=turntable, turntable_source=turntable_source,
                    reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm,
-                   stated_white=stated_white, stated_step=stated_step,
+                   stated_white=stated_white, stated_step=stated_step, held=held,
                    moves=False)  # the diagnosis tests the segment means' model; the moves' gyro fit is fit's
     # the samples' noise depends on the samples alone: estimated once, shared by every refit below
     # (every static segment at the model's noise: one that scatters more is the within tests' finding, and its mean

@@ -30,6 +30,12 @@ from plansim.model.parameters import PARAMETER_NAMES
 #: 1 %, the scale-factor error and misalignment a MEMS gyro's data sheet allows (docs/fitting.md); its effect is
 #: ≤ 0.01·7.3e-5 rad/s on a segment mean
 HELD_KG_UNCERTAINTY = 0.01
+#: standard uncertainty of the symmetric part of a pair of Ka's cross-couplings (Ka_ij = Ka_ji: a shear of the
+#: triad) that poses placed by hand do not determine (at first order a tilt of an axis-aligned pose is a
+#: cross-coupling) but that still moves what the fit uses (a pose a few degrees off its axis; the moves' gravity
+#: directions): held at 0 with this Type B uncertainty, 1 %, the cross-axis sensitivity a MEMS accelerometer's data
+#: sheet allows (docs/fitting.md)
+HELD_KA_UNCERTAINTY = 0.01
 #: standard uncertainty of a g-sensitivity entry (rad/s per m/s²) that a fit holds at 0 because the recording does not
 #: identify it but a turn still feels it (the moves between poses of a recording whose poses cannot separate it from
 #: the bias): 0.1 (°/s)/g, the linear-acceleration sensitivity a consumer MEMS gyro's data sheet states (e.g. the
@@ -43,6 +49,30 @@ HAND_PLACEMENT = "the hand placement (the tilts of poses placed by hand, the axe
 RANK_TOLERANCE = 1e-9
 #: a parameter is identified when the norm of its unit vector's projection onto the null space is below this
 NULL_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class HeldPriors:
+    """The Type B standard uncertainties of what a fit holds at its nominal value because the recording does not
+    determine it, while it still moves what the fit uses (docs/fitting.md): a gyro's scale factor or cross-coupling
+    (``gyro``, dimensionless), the symmetric part of a pair of the accelerometers' cross-couplings
+    (``accel_cross``, dimensionless), a gyro's g-sensitivity (``g_sensitivity``, rad/s per m/s²). The defaults are
+    a consumer MEMS data sheet's (:data:`HELD_KG_UNCERTAINTY`, :data:`HELD_KA_UNCERTAINTY`,
+    :data:`HELD_G_UNCERTAINTY`); a lab's scenario may state its own (``[reduction]`` ``held_gyro``,
+    ``held_accel_cross``, ``held_g_sensitivity``). ``source`` says where they came from, for the report."""
+
+    gyro: float = HELD_KG_UNCERTAINTY
+    accel_cross: float = HELD_KA_UNCERTAINTY
+    g_sensitivity: float = HELD_G_UNCERTAINTY
+    source: str = "data-sheet defaults"
+
+    def __post_init__(self):
+        for name in ("gyro", "accel_cross", "g_sensitivity"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise TypeError(f"HeldPriors.{name} = {value!r}: expected a number")
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"HeldPriors.{name} = {value!r}: a standard uncertainty must be finite and >= 0")
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,7 @@ from threadpoolctl import threadpool_limits
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.estimate.segmentation import APPROXIMATE_TILT, MAD_TO_SIGMA
-from plansim.fit.identify import HELD_KG_UNCERTAINTY, NULL_TOLERANCE, RANK_TOLERANCE, Identifiability, identifiability
+from plansim.fit.identify import NULL_TOLERANCE, RANK_TOLERANCE, HeldPriors, Identifiability, identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
 from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
@@ -47,13 +47,8 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.schedule.segments import Schedule
 from plansim.uncertainty.metrology.propagation import combine
+from plansim.units import to_unit
 
-#: standard uncertainty of the symmetric part of a pair of Ka's cross-couplings (Ka_ij = Ka_ji: a shear of the
-#: triad) that poses placed by hand do not determine (at first order a tilt of an axis-aligned pose is a
-#: cross-coupling) but that still moves what the fit uses (a pose a few degrees off its axis; the moves' gravity
-#: directions): held at 0 with this Type B uncertainty, 1 %, the cross-axis sensitivity a MEMS accelerometer's data
-#: sheet allows (docs/fitting.md)
-HELD_KA_UNCERTAINTY = 0.01
 #: two-sided probability outside which a χ² (fit, or between-segment comparison) is flagged
 CHI2_FLAG_PROBABILITY = 0.01
 
@@ -316,10 +311,12 @@ class FitResult:
     gain: np.ndarray | None = field(default=None, repr=False)
     sources: object = field(default=None, repr=False)
     #: inputs propagated through the gain but not weighed by (the triad's shear held at 0 where poses placed by hand
-    #: leave it with their tilts: HELD_KA_UNCERTAINTY); the moves map them as they map ``sources``, and weigh by them
+    #: leave it with their tilts: ``held.accel_cross``); the moves map them as they map ``sources``, and weigh by them
     held_sources: object = field(default=None, repr=False)
     #: the gyros from the moves between poses (:func:`plansim.fit.moves.fit_moves`); None without two usable moves
     moves: object = None
+    #: the Type B standard uncertainties of what the fit (and the moves) hold at nominal
+    held: HeldPriors = field(default_factory=HeldPriors)
 
     @property
     def residuals(self) -> np.ndarray:
@@ -576,7 +573,7 @@ def _prior_covariance(V: np.ndarray, sources: _Sources, noise: NoiseEstimate, fi
 
 
 def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, turntable, site_inputs,
-                   held: list[int], jacobian: np.ndarray, levels, tilts) -> _Sources:
+                   held: list[int], jacobian: np.ndarray, levels, tilts, priors: HeldPriors) -> _Sources:
     S = model.n_segments
     sources = _Sources(6 * S)
     quantisation = noise.quantisation_variance
@@ -636,7 +633,7 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
                 column[s, c] = 1.0
                 sources.add(column.ravel(), math.sqrt(covariance[s, c, c]), math.inf, "angle")
     for k in held:
-        sources.add(jacobian[:, k], HELD_KG_UNCERTAINTY, math.inf, "held")
+        sources.add(jacobian[:, k], priors.gyro, math.inf, "held")
     return sources
 
 
@@ -664,9 +661,9 @@ def _held_cross_couplings(ident: Identifiability, J: np.ndarray) -> list[tuple[i
 
 
 def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank: int,
-                pairs: list[tuple[int, int]]) -> list[float]:
-    """The standard uncertainty of each held pair's symmetric part (:func:`_held_cross_couplings`):
-    :data:`HELD_KA_UNCERTAINTY`, or less where the poses' tilts give the data a hold on it.
+                pairs: list[tuple[int, int]], prior: float) -> list[float]:
+    """The standard uncertainty of each held pair's symmetric part (:func:`_held_cross_couplings`): *prior*
+    (:attr:`HeldPriors.accel_cross`), or less where the poses' tilts give the data a hold on it.
 
     At the fitted tilts, second-order terms can determine what the nominal point could not, and the fit frees
     those combinations when χ² drops by more than its 99 % quantile. Where it did not, a pair's symmetric part
@@ -676,7 +673,7 @@ def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank
     that u."""
     local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
                             nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
-    out = [HELD_KA_UNCERTAINTY] * len(pairs)
+    out = [prior] * len(pairs)
     if local.rank <= nominal_rank:
         return out
     design = np.hstack([model.parameter_jacobian(earth_rate=True, tilts=tilts),
@@ -689,7 +686,7 @@ def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank
         v = np.zeros(covariance.shape[0])
         v[[a, b]] = 0.5  # the symmetric part (Ka_ij + Ka_ji)/2
         freed = math.sqrt(max(float(v @ covariance @ v), 0.0))
-        out[k] = min(HELD_KA_UNCERTAINTY, factor * freed)
+        out[k] = min(prior, factor * freed)
     return out
 
 
@@ -702,7 +699,7 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
     The fit's answer, and its gain on the means, would depend on that start (a cross-coupling of 0.005 moved Ba by
     twice what the gain said). Held at its nominal value (0) instead, the parameter is what the fit says it is,
     the tilts carry the combination, and the gain is the fit's derivative; the parameter's own Type B uncertainty
-    (HELD_KA_UNCERTAINTY) goes through that gain. Returns *basis* unchanged where the zeroed one loses rank on
+    (``HeldPriors.accel_cross``) goes through that gain. Returns *basis* unchanged where the zeroed one loses rank on
     *design* (the design at the nominal point, with the tilts' columns)."""
     if not held:
         return basis
@@ -885,7 +882,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                   reference_gravity: float | None = None, omega_squared_sign: str = "model",
                   lever_arm=None, extra: dict | None = None,
                   between_noise: BetweenSegmentNoise | None = None, stated_white=None,
-                  noise: NoiseEstimate | None = None, stated_step=None, moves: bool = True) -> FitResult:
+                  noise: NoiseEstimate | None = None, stated_step=None, moves: bool = True,
+                  held: HeldPriors | None = None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -929,18 +927,28 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     moves : bool
         Also fit the gyros from the moves between static poses (:mod:`plansim.fit.moves`; default True). The
         joint fit and its result do not depend on it.
+    held : HeldPriors, optional
+        The Type B standard uncertainties of what the fit holds at nominal (a gyro's scale factor or
+        cross-coupling, the accelerometers' shear, a g-sensitivity the moves need); default the data sheet's
+        (:class:`~plansim.fit.identify.HeldPriors`), or a scenario's ``[reduction]`` (``scenario_fit_options``).
 
     Returns
     -------
     FitResult
     """
     site = Site() if site is None else site
+    priors = HeldPriors() if held is None else held
+    if not isinstance(priors, HeldPriors):
+        raise TypeError(f"held = {held!r}: expected a plansim.fit.identify.HeldPriors or None")
+    notes = [] if held is None else [
+        f"what the fit holds at nominal carries the Type B u of {priors.source}: a gyro scale factor or "
+        f"cross-coupling {priors.gyro:g}, the accelerometers' shear {priors.accel_cross:g}, a g-sensitivity "
+        f"{float(to_unit(priors.g_sensitivity, 'rate_per_acceleration', 'deg/s/g')):g} (deg/s)/g"]
     if turntable is None:
         turntable, turntable_source = TABLE_1_TURNTABLE, turntable_source or "JJF 2003 Table 1"
     schedule = recording.schedule
     use = _segment_use(schedule, recording)
     used, unused = use.used, use.unused
-    notes = []
     if not used:
         raise ValueError("recording: no segment can be fitted; "
                          f"{len(unused)} segment(s) not used: " + "; ".join(f"{k}: {r}" for k, r in unused.items()))
@@ -1024,7 +1032,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
     # noise the residuals show beyond the prediction (slow noise the segments are too short to show)
     for iteration in range(3):
-        sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts)
+        sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts, priors)
         if iteration == 1:
             V_predicted = sources.covariance()
         if slow is not None:
@@ -1036,7 +1044,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         # that hold only as exactly as the levels, the dither and the offset model do (docs/fitting.md)
         working = V
         if levels is not None and np.any(noise.quantisation_variance > 0):
-            work = _build_sources(model, theta, noise, turntable, site_inputs, held, J, None, tilts)
+            work = _build_sources(model, theta, noise, turntable, site_inputs, held, J, None, tilts, priors)
             if slow is not None:
                 _add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
             working = work.covariance()
@@ -1070,7 +1078,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             if not np.any(slow.variance > 0):
                 break
     held_sources = _Sources(len(m))
-    bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross) if held_cross else []
+    bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
+        if held_cross else []
     for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
         held_sources.add(J[:, a] + J[:, b], u, math.inf, "held")
     joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask)
@@ -1136,7 +1145,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      covariance=V, whitening=W, design=design, rows=rows,
                      segment_times=times, basis=step_basis, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
-                     gain=gain, sources=sources, held_sources=held_sources)
+                     gain=gain, sources=sources, held_sources=held_sources, held=priors)
     if moves:
         transitions, unused_moves = find_transitions(recording)
         try:

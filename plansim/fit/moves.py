@@ -42,11 +42,11 @@ Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kern
   to Ω_E about an axis not known, Type B, u = Ω_E/√3 per axis, held over the move;
 - each g-sensitivity entry the joint fit does not identify (every pose with one up axis leaves G with the bias):
   the moves hold it at 0 instead of the joint fit's null-space value, with the Type B u
-  :data:`plansim.fit.identify.HELD_G_UNCERTAINTY`, through ∂r/∂G, and weigh by it (a whole turn about an axis
-  across gravity feels G as an angle of one sign whichever way it turns);
+  ``fit.held.g_sensitivity`` (:class:`plansim.fit.identify.HeldPriors`), through ∂r/∂G, and weigh by it (a
+  whole turn about an axis across gravity feels G as an angle of one sign whichever way it turns);
 - the symmetric part of each pair of Ka's cross-couplings the joint fit holds at 0 (poses placed by hand near the
   axes do not determine the triad's shear, which bends each pose's gravity direction): its Type B uncertainty
-  (:data:`plansim.fit.joint.HELD_KA_UNCERTAINTY`, the joint fit's ``held_sources``) through ∂r/∂m + ∂r/∂θ·A like
+  (``fit.held.accel_cross``, the joint fit's ``held_sources``) through ∂r/∂m + ∂r/∂θ·A like
   the joint fit's inputs, and into the moves' weights (it makes their misses correlated: left out, the χ² of a
   start with two gyro axes flipped came out below the true one's, :data:`SIGN_EVIDENCE`);
 - noise between moves beyond all of that (a hand that shakes at the ends of a pose, timing, effects beyond
@@ -78,7 +78,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_distribution
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
-from plansim.fit.identify import HELD_G_UNCERTAINTY, HELD_KG_UNCERTAINTY, Identifiability, identifiability
+from plansim.fit.identify import Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -154,8 +154,8 @@ def _floored_inverse(V: np.ndarray) -> np.ndarray:
     return (vectors / values) @ vectors.T
 
 
-def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str, at: str = "Kg = I",
-                  scale: float = 1.0) -> tuple[Identifiability, dict]:
+def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str, prior: float,
+                  at: str = "Kg = I", scale: float = 1.0) -> tuple[Identifiability, dict]:
     """The moves' identifiability *ident* with the Kg entries they determine only weakly held at nominal.
 
     *design* (2M, 39) is ∂r/∂θ at *at* (Kg = I, or the fitted Kg; only the Kg columns non-zero, those held
@@ -164,7 +164,8 @@ def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, wha
     Jzᵀ V⁻¹ Jz (Jz = ∂r/∂Kg · Q; :func:`_floored_eigh`) has eigenvalues λ; while
     the smallest gives u = 1/√λ above :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that
     direction is held (its column zeroed) and the rest looked at again. Returns the identifiability of what is
-    left and, per held entry, why. *scale* is the size of the gyros' scale factors there (1 at Kg = I; at the fitted
+    left and, per held entry, why (held with the Type B u *prior*, :attr:`HeldPriors.gyro`). *scale* is the size
+    of the gyros' scale factors there (1 at Kg = I; at the fitted
     Kg the mean |Kg_ii|, 57.3 for gyros read in deg/s as rad/s), and u is taken relative to it."""
     held: dict[str, str] = {}
     V_inverse = _floored_inverse(V)
@@ -183,7 +184,7 @@ def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, wha
         k = int(np.argmax(direction))
         held[KG_NAMES[k]] = (f"the moves determine it only weakly (u = {u:.3g} at {at} along the combination it "
                              f"leads, above {WEAK_DIRECTION_U:g}): held at its nominal value with u = "
-                             f"{HELD_KG_UNCERTAINTY:g} (a turn about an axis that is vertical, or tilted by a few "
+                             f"{prior:g} (a turn about an axis that is vertical, or tilted by a few "
                              "degrees, does not show its scale factor; a whole turn shows the cross-couplings of its "
                              "axis only at second order)")
         design = design.copy()
@@ -532,7 +533,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
             sources.add(total @ column, u, dof, kind)
         for k in held_kg:  # the Kg entries held at nominal (_weak_entries)
-            sources.add(jacobian[:, k], HELD_KG_UNCERTAINTY, math.inf, "held")
+            sources.add(jacobian[:, k], fit.held.gyro, math.inf, "held")
         for name in held_g:  # the g-sensitivities held at 0: ∂r/∂g by central differences
             k = PARAMETER_INDEX[name]
             up, down = theta.copy(), theta.copy()
@@ -540,7 +541,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             down[k] -= _STEP_PARAMETER
             column = (moves.residuals(Kg, up, means) - moves.residuals(Kg, down, means)) / (2 * _STEP_PARAMETER)
             if np.any(column):
-                sources.add(column, HELD_G_UNCERTAINTY, math.inf, "held")
+                sources.add(column, fit.held.g_sensitivity, math.inf, "held")
         return sources, jacobian, angles
 
     def solve(V, Kg_start):
@@ -584,7 +585,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     # the moves predict, and again at the fitted Kg with the noise between moves) are held at nominal, with a Type B
     # u that the moves weigh by and propagate
     first = build(np.eye(3), 0.0)
-    ident, weak = _weak_entries(ident, design, first[0].covariance(), "the moves between poses")
+    ident, weak = _weak_entries(ident, design, first[0].covariance(), "the moves between poses", fit.held.gyro)
     while True:
         if weak:
             held_kg[:] = [KG_NAMES.index(name) for name in weak]
@@ -625,7 +626,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         fitted = np.zeros_like(design)
         fitted[:, KG_INDEX] = jacobian
         fitted[:, KG_INDEX[held_kg]] = 0.0
-        ident, more = _weak_entries(ident, fitted, V, "the moves between poses", at="the fitted Kg",
+        ident, more = _weak_entries(ident, fitted, V, "the moves between poses", fit.held.gyro, at="the fitted Kg",
                                     scale=float(np.mean(np.abs(np.diag(Kg)))))
         if not more:
             break

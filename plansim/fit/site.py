@@ -184,12 +184,15 @@ def scenario_fit_options(scenario) -> dict:
     - ``stated_white``: the sensor's stated white noise (``[mimu.noise]``,
       :func:`plansim.fit.noise.stated_white_noise`), where any is stated — the prior of the noise an undithered
       quantiser hides;
+    - ``held``: the Type B standard uncertainties of what the fit holds at nominal (``[reduction]`` ``held_gyro``,
+      ``held_accel_cross``, ``held_g_sensitivity``; :class:`plansim.fit.identify.HeldPriors`), where any is stated;
     - ``stated_step``: the acquisition's quantisation steps (``[acquisition]``, :func:`plansim.fit.noise.stated_steps`)
       where it quantises — for a channel that reads one code in every pose, whose step the data cannot show.
 
     *scenario* None gives no options (JJF 2003 Table 1 and the recording's attributes).
     """
     from plansim.config import Scenario
+    from plansim.fit.identify import HeldPriors
     from plansim.fit.noise import stated_steps, stated_white_noise
 
     if scenario is None:
@@ -199,6 +202,11 @@ def scenario_fit_options(scenario) -> dict:
     options = dict(turntable=scenario.turntable, turntable_source=f"scenario {scenario.name!r}, [turntable]",
                    reference_gravity=scenario.reduction.reference_gravity,
                    omega_squared_sign=scenario.reduction.omega_squared_sign)
+    stated_priors = {name: getattr(scenario.reduction, f"held_{name}") for name in ("gyro", "accel_cross",
+                                                                                      "g_sensitivity")}
+    if any(value is not None for value in stated_priors.values()):
+        options["held"] = HeldPriors(**{k: v for k, v in stated_priors.items() if v is not None},
+                                     source=f"scenario {scenario.name!r}, [reduction]")
     if scenario.effects.accel_lever_arm.any():
         options["lever_arm"] = scenario.effects.accel_lever_arm
     stated = stated_white_noise(scenario)
