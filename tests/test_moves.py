@@ -458,7 +458,8 @@ def test_a_turn_about_the_vertical_tells_the_moves_nothing():
 
 def _table_log(turns, seed: int, rest_s: float = 10.0, fs: float = 100.0):
     """A 12-position log on a table, written without plansim's simulator: the unit starts +x up and the table turns
-    it about one body axis at a time (*turns*: (axis, degrees); a trapezoid of 1 s ramps at 30 deg/s), resting
+    it about one body axis at a time (*turns*: (axis, degrees[, peak deg/s]); a trapezoid of 1 s ramps to the peak,
+    30 deg/s unless given), resting
     *rest_s* between turns; the rates are scaled so that their samples sum to the angle, and a turn under 30° never
     reaches its peak. R(t) = R_start·Rot(axis, angle(t)) exactly, angle the rates' running sum, so the gyros read
     rate(t) along the axis and integrate, held over each sample interval, to the attitude;
@@ -470,8 +471,9 @@ def _table_log(turns, seed: int, rest_s: float = 10.0, fs: float = 100.0):
     R = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])  # body x up
     rests = int(rest_s * fs)
     rates, attitudes = [np.zeros((rests, 3))], [np.repeat(R[None], rests, axis=0)]
-    for axis, degrees in turns:
-        peak = math.radians(30.0) * np.sign(degrees)
+    for turn in turns:
+        axis, degrees = turn[:2]
+        peak = math.radians(turn[2] if len(turn) > 2 else 30.0) * np.sign(degrees)
         steady = abs(math.radians(degrees) / peak) - 1.0
         t = np.arange(int(round((2.0 + steady) * fs))) / fs
         T = 2.0 + steady

@@ -108,6 +108,10 @@ FAR_OFF = 0.5
 #: … or where they end with χ² (against the noise the moves predict, before any between-move noise) beyond this
 #: upper-tail probability: gyros read in deg/s as rad/s also stop near diag(−1, −1, +1), every move missing by 25°
 POOR_FIT = 1e-3
+#: a start that ends with a gyro scale factor beyond this (twice the largest start) ran away, and is not taken: where
+#: every move is a whole turn about one axis, no turn at all (Kg_ii → ∞) fits as well as the truth, and on a
+#: table's ±360° turns a start at 180/π ran to 2·10⁶ with a χ² below an unconverged start at 1
+RUNAWAY = 2.0 * max(UNIT_STARTS)
 #: a combination of Kg entries the moves determine no better than this standard uncertainty (dimensionless) at
 #: Kg = I, with the noise they predict and no between-move noise (the smallest u they could give), is not
 #: identified: a gyro's scale factor is within a few per cent of 1 and its cross-couplings within 1 %, so such a
@@ -572,6 +576,8 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                 result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                                        max_nfev=200)
                 plain = result if plain is None else plain  # the first start: every gyro as wired, K near +1
+                if result is not plain and np.any(np.abs(np.diag(kg(result.x))) > RUNAWAY):
+                    continue
                 if best is None or result.cost < best.cost:
                     best = result
         # a flipped pair of axes (a half turn of the gyro triad) that fits no better than the gyros as wired is not
