@@ -993,7 +993,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     tilts0 = model.initial_tilts(observed[:, 3:])
     # at the nominal point: the nominal parameters and every pose as named (a hand-placed pose untilted), so that
     # what a tilt stands in for at first order (an accelerometer's cross-coupling) counts as not identified; a pose
-    # farther than APPROXIMATE_TILT from every axis is named by no axis, and its nominal is where the data put it
+    # tilted beyond APPROXIMATE_TILT about East or North is taken where the data put it in that component
     nominal_tilts = _far_tilts(tilts0, int(model.placed.sum()))
     ident = identifiability(model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts)[rows],
                             nuisance=model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)[rows])
@@ -1006,7 +1006,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         notes.append("turns on a pose placed by hand about " + ", ".join("xyz"[a] for a in use.hand_axes) + ": the "
                      "mean rate is the table's rate or the reference angle over the duration, only the gyros are "
                      "fitted, and each turned axis's misalignment is fitted (two nuisance parameters)")
-    held = [PARAMETER_INDEX[p.name] for p in PARAMETERS
+    held_kg = [PARAMETER_INDEX[p.name] for p in PARAMETERS
             if p.group == "Kg" and not mask[PARAMETER_INDEX[p.name]] and np.any(J[:, PARAMETER_INDEX[p.name]])]
     held_cross = _held_cross_couplings(ident, J) if model.n_tilts else []
 
@@ -1032,7 +1032,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
     # noise the residuals show beyond the prediction (slow noise the segments are too short to show)
     for iteration in range(3):
-        sources = _build_sources(model, theta, noise, turntable, site_inputs, held, J, levels, tilts, priors)
+        sources = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, levels, tilts, priors)
         if iteration == 1:
             V_predicted = sources.covariance()
         if slow is not None:
@@ -1044,7 +1044,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         # that hold only as exactly as the levels, the dither and the offset model do (docs/fitting.md)
         working = V
         if levels is not None and np.any(noise.quantisation_variance > 0):
-            work = _build_sources(model, theta, noise, turntable, site_inputs, held, J, None, tilts, priors)
+            work = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, None, tilts, priors)
             if slow is not None:
                 _add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
             working = work.covariance()
