@@ -738,6 +738,12 @@ def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray,
 
 #: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
 MAX_EVALUATIONS = 400
+#: a non-linear fit that has used its MAX_EVALUATIONS is taken where it stopped when one more Gauss–Newton step would
+#: lower χ² by less than this: less than one degree of freedom's expected share, so no test or u reads it. It stops
+#: short only in a direction the data barely determine (a curved valley, walked in ever smaller steps: poses placed
+#: by hand whose gravity directions all lie in one cap leave the accelerometers' ellipsoid so), where the estimate's
+#: u says as much (docs/fitting.md)
+STALLED_CHI2 = 1.0
 #: eigenvalues of the means' covariance V below this fraction of its largest are raised to it before V is
 #: inverted: a channel that shows no noise at all (noise-free data) must not make V singular to rounding
 EIGENVALUE_FLOOR = 1e-14
@@ -769,7 +775,8 @@ def _far_tilts(tilts: np.ndarray, n_placed: int) -> np.ndarray:
 
 
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
-           W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None):
+           W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None,
+           stalled: list | None = None):
     """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
 
     The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
@@ -782,6 +789,10 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
 
     ``extra`` (6S, m): further unknowns c that add ``extra·c`` to the means (an effect beyond eq. (1)/(2),
     linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
+
+    A non-linear fit that uses up :data:`MAX_EVALUATIONS` is taken where it stopped if one more Gauss–Newton
+    step would lower χ² by at most :data:`STALLED_CHI2`, and ``(evaluations, that decrease)`` is appended to
+    *stalled*; otherwise a ``ValueError``.
     """
     n = len(theta0)
     extra = np.zeros((len(observed), 0)) if extra is None else np.asarray(extra, dtype=float)
@@ -819,15 +830,33 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
             theta, tilts = unpack(z)
             return W @ (model.means(theta, tilts).ravel() + shift(z) - observed)
 
-        # start from the linear solution with the tilts held at their first guess, then free them together
+        def run(z0):
+            result = least_squares(residual, z0, jac=lambda z: W @ design_at(z), method="lm", x_scale="jac",
+                                   xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
+            X = W @ design_at(result.x)
+            # where it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's
+            # part in the design's column space)
+            decrease = 0.0 if result.success else \
+                float(np.sum((X @ np.linalg.lstsq(X, -result.fun, rcond=None)[0]) ** 2))
+            return result, decrease
+
+        # start from the linear solution with the tilts held at their first guess, then free them together; where
+        # that start leads the search astray (a near-null direction the linear step takes at full length: hand
+        # poses whose gravity directions lie in one cap), from the first guess itself
         z0 = np.zeros(basis.shape[1])
         if linear_start:
-            z0 = np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0]
-        result = least_squares(residual, z0, jac=lambda z: W @ design_at(z), method="lm",
-                               x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
-        if not result.success:
+            result, decrease = run(np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0])
+            if decrease > STALLED_CHI2:
+                retry = run(z0)
+                result, decrease = min((result, decrease), retry, key=lambda r: r[0].cost)
+        else:
+            result, decrease = run(z0)
+        if decrease > STALLED_CHI2:
             raise ValueError(f"the fit of the hand-placed poses did not converge in {MAX_EVALUATIONS} evaluations "
-                             f"({result.message}); check the segment table's poses (docs/fitting.md)")
+                             f"({result.message}; one more step would lower chi2 by {decrease:.3g}); check the "
+                             "segment table's poses (docs/fitting.md)")
+        if not result.success and stalled is not None:
+            stalled.append((int(result.nfev), decrease))
         design = design_at(result.x)
         X = W @ design
     gain_z = np.linalg.lstsq(X, W, rcond=None)[0]
@@ -1049,7 +1078,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                 _add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
             working = work.covariance()
         W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
-        theta, tilts, gain, design, gain_z, chi2, c = _solve(model, basis, theta0, tilts0, m, W, J, extra=E)
+        stall: list = []
+        theta, tilts, gain, design, gain_z, chi2, c = _solve(model, basis, theta0, tilts0, m, W, J, extra=E,
+                                                             stalled=stall)
         rank, step_basis = ident.rank, basis
         if model.n_tilts:
             # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
@@ -1058,13 +1089,15 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
                                     nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
             if local.rank > rank:
+                second_stall: list = []
                 try:
-                    second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E)
+                    second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E,
+                                    stalled=second_stall)
                 except ValueError:
                     second = None
                 if second is not None and chi2 - second[5] > _chi2_quantile(local.rank - rank, 0.99):
                     theta, tilts, gain, design, gain_z, chi2, c = second
-                    rank, step_basis = local.rank, local.basis
+                    rank, step_basis, stall = local.rank, local.basis, second_stall
         J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
         fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
@@ -1077,6 +1110,12 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                       coupled=model.n_tilts > 0)
             if not np.any(slow.variance > 0):
                 break
+    if stall:
+        evaluations, decrease = stall[-1]
+        notes.append(f"the joint fit stopped after {evaluations} evaluations, where one more Gauss–Newton step "
+                     f"would lower chi2 by {decrease:.2g}: it was walking a direction the data barely determine "
+                     "(poses placed by hand whose gravity directions leave part of the model nearly free); the "
+                     "estimates' u along it are correspondingly large")
     held_sources = _Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
         if held_cross else []
