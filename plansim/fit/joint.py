@@ -756,6 +756,12 @@ def whitening(V: np.ndarray) -> np.ndarray:
     return (vectors / np.sqrt(values)).T
 
 
+#: a hand-placed pose's fitted tilt component (its biases taken out) beyond this many times the Type B u of the
+#: accelerometers' shear the fit holds (HeldPriors.accel_cross; 5 × 0.01 rad = 2.9° by default) is a tilt: no
+#: cross-coupling the prior allows could stand in for it
+TILT_BEYOND_SHEAR = 5.0
+
+
 def _far_tilts(tilts: np.ndarray, n_placed: int) -> np.ndarray:
     """*tilts* (the nuisance parameters: two per hand-placed pose, about East and North, then two per hand-turned
     axis) with each pose's components of at most :data:`plansim.estimate.segmentation.APPROXIMATE_TILT` zeroed, and
@@ -912,7 +918,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                   lever_arm=None, extra: dict | None = None,
                   between_noise: BetweenSegmentNoise | None = None, stated_white=None,
                   noise: NoiseEstimate | None = None, stated_step=None, moves: bool = True,
-                  held: HeldPriors | None = None) -> FitResult:
+                  held: HeldPriors | None = None, _judged: np.ndarray | None = None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -965,6 +971,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     -------
     FitResult
     """
+    given = dict(site=site, turntable=turntable, turntable_source=turntable_source,
+                 reference_gravity=reference_gravity, omega_squared_sign=omega_squared_sign, lever_arm=lever_arm,
+                 extra=extra, between_noise=between_noise, stated_white=stated_white, stated_step=stated_step,
+                 held=held)
     site = Site() if site is None else site
     priors = HeldPriors() if held is None else held
     if not isinstance(priors, HeldPriors):
@@ -1024,6 +1034,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     # what a tilt stands in for at first order (an accelerometer's cross-coupling) counts as not identified; a pose
     # tilted beyond APPROXIMATE_TILT about East or North is taken where the data put it in that component
     nominal_tilts = _far_tilts(tilts0, int(model.placed.sum()))
+    if _judged is not None:  # the tilts a first fit found, its biases taken out (below)
+        nominal_tilts = np.where(_judged != 0.0, _judged, nominal_tilts)
     ident = identifiability(model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts)[rows],
                             nuisance=model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)[rows])
     J = model.parameter_jacobian(earth_rate=True, tilts=tilts0)
@@ -1185,6 +1197,27 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      segment_times=times, basis=step_basis, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
                      gain=gain, sources=sources, held_sources=held_sources, held=priors)
+    if _judged is None and model.placed.any():
+        # a pose's tilt as the import read it carries the accelerometers' biases (0.5 m/s² tilts the raw specific
+        # force by 3°): judged again from this fit's tilts, a component no cross-coupling the shear's prior allows
+        # could stand in for counts, and where that lets the poses determine more, the recording is fitted again
+        # with what they identify decided there
+        n_placed = int(model.placed.sum())
+        judged = np.zeros_like(tilts)
+        fitted = np.asarray(tilts, dtype=float)[:2 * n_placed]
+        judged[:2 * n_placed] = np.where(np.abs(fitted) > TILT_BEYOND_SHEAR * priors.accel_cross, fitted, 0.0)
+        point = np.where(judged != 0.0, judged, nominal_tilts)
+        if identifiability(model.parameter_jacobian(earth_rate=False, tilts=point)[rows],
+                           nuisance=model.tilt_jacobian(theta0, point, earth_rate=False)[rows]).rank > ident.rank:
+            try:
+                again = fit_recording(recording, noise=all_noise, moves=False, _judged=judged, **given)
+            except ValueError:  # the first fit stands
+                again = None
+            if again is not None:
+                result = dataclasses.replace(again, notes=again.notes + (
+                    "what the recording identifies was decided with the poses where this fit found them (their "
+                    f"tilt components beyond {math.degrees(TILT_BEYOND_SHEAR * priors.accel_cross):.2g}°, more "
+                    "than an accelerometer cross-coupling within five times its prior could stand in for)",))
     if moves:
         transitions, unused_moves = find_transitions(recording)
         try:
