@@ -610,17 +610,26 @@ def _table_log_truth(seed: int) -> dict:
     return {f"Bg{a}": bg[i] for i, a in enumerate("xyz")} | {f"g{a}{b}": 0.0 for a in "xyz" for b in "xyz"}
 
 
-def _assert_fits_its_truth(fit, seed: int):
-    """χ² consistent with the noise (P ≥ 0.001: a false failure one time in a thousand) and every identified gyro
-    bias and g-sensitivity within 3.3 u of the truth (0.1 % two-sided each)."""
+def _assert_fits_its_truth(tmp_path, turns, seed: int, noted: str):
+    """_table_log(*turns*, *seed*) imported and fitted (no moves): χ² consistent with the noise (P ≥ 0.001: a false
+    failure one time in a thousand), the gyro biases identified, every identified gyro bias and g-sensitivity within
+    3.3 u of the truth (0.1 % two-sided each), and a note that holds *noted*."""
     from scipy.stats import chi2 as chi2_distribution
 
+    from plansim.io.log_import import import_log
+
+    t, x, _ = _table_log(turns, seed=seed)
+    recording = import_log(_write_log(tmp_path / "tilted.csv", t, x), time_column="time",
+                           units="deg/s,m/s^2").recording
+    fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False), moves=False)
     assert chi2_distribution.sf(fit.chi2, fit.chi2_dof) >= 1e-3, (fit.chi2, fit.chi2_dof)
+    assert {"Bgx", "Bgy", "Bgz"} <= set(fit.identifiability.identified), fit.identifiability.identified
     truth = _table_log_truth(seed)
     for name in fit.identifiability.identified:
         if name in truth:
             k = PARAMETER_INDEX[name]
             assert abs(fit.joint.estimate[k] - truth[name]) < 3.3 * fit.joint.u[k], (name, fit.joint.estimate[k])
+    assert any(noted in note for note in fit.notes), fit.notes
 
 
 def test_poses_tilted_by_hand_a_few_degrees_are_fitted_where_they_are(tmp_path):
@@ -636,15 +645,8 @@ def test_poses_tilted_by_hand_a_few_degrees_are_fitted_where_they_are(tmp_path):
     component beyond five times the u of the accelerometers' shear (2.9°, TILT_BEYOND_SHEAR) counts, and the
     recording is fitted again with what it identifies decided there. The residuals are consistent with the noise,
     the biases and g-sensitivities identified and within 3.3 u of the truth (``_assert_fits_its_truth``)."""
-    from plansim.io.log_import import import_log
-
-    t, x, _ = _table_log([(1, 140), (1, -140), (1, 10), (1, -10), (1, -10), (1, 10), (2, 10), (2, -10)], seed=2)
-    recording = import_log(_write_log(tmp_path / "tilt10.csv", t, x), time_column="time",
-                           units="deg/s,m/s^2").recording
-    fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False), moves=False)
-    _assert_fits_its_truth(fit, seed=2)
-    assert {"Bgx", "Bgy", "Bgz"} <= set(fit.identifiability.identified), fit.identifiability.identified
-    assert any("where this fit found them" in note for note in fit.notes), fit.notes
+    turns = [(1, 140), (1, -140), (1, 10), (1, -10), (1, -10), (1, 10), (2, 10), (2, -10)]
+    _assert_fits_its_truth(tmp_path, turns, seed=2, noted="where this fit found them")
 
 
 def test_poses_tilted_about_two_axes_are_fitted_not_refused(tmp_path):
@@ -654,17 +656,9 @@ def test_poses_tilted_about_two_axes_are_fitted_not_refused(tmp_path):
     400 evaluations and refused the recording ("did not converge"). It is now taken where it stopped (one more
     Gauss–Newton step would take less than 1 off χ²), with a note, and the biases and g-sensitivities the poses
     identify fit their truth."""
-    from plansim.io.log_import import import_log
-
     a = 20
     turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
-    t, x, _ = _table_log(turns, seed=2)
-    recording = import_log(_write_log(tmp_path / "tilt2.csv", t, x), time_column="time",
-                           units="deg/s,m/s^2").recording
-    fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False), moves=False)
-    _assert_fits_its_truth(fit, seed=2)
-    assert {"Bgx", "Bgy", "Bgz"} <= set(fit.identifiability.identified), fit.identifiability.identified
-    assert any("stopped after" in note for note in fit.notes), fit.notes
+    _assert_fits_its_truth(tmp_path, turns, seed=2, noted="stopped after")
 
 
 def test_an_accelerometer_effect_is_not_said_to_alias_with_gyro_parameters(tmp_path):
