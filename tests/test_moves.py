@@ -661,6 +661,26 @@ def test_poses_tilted_about_two_axes_are_fitted_not_refused(tmp_path):
     _assert_fits_its_truth(tmp_path, turns, seed=2, noted="stopped after")
 
 
+def test_a_linear_start_that_falls_into_a_false_minimum_is_not_taken(tmp_path, monkeypatch):
+    """The same two-axis schedule on seed 4, with 2000 evaluations allowed: the search from the linear first step
+    converges — to χ² = 3.4·10⁶, a minimum that step fell into, far above the first guess's own χ². It had been
+    taken as the fit. A search that ends above its first guess is now started again from the first guess; on this
+    log that one stops with 2.6 of χ² still in reach (the valley of the test above), so the recording is refused
+    with the reason, not fitted at χ² = 3.4·10⁶. (At the default 400 evaluations the linear start stops short and
+    is retried anyway.)"""
+    from plansim.fit import joint
+    from plansim.io.log_import import import_log
+
+    monkeypatch.setattr(joint, "MAX_EVALUATIONS", 2000)
+    a = 20
+    turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
+    t, x, _ = _table_log(turns, seed=4)
+    recording = import_log(_write_log(tmp_path / "tilted.csv", t, x), time_column="time",
+                           units="deg/s,m/s^2").recording
+    with pytest.raises(ValueError, match="one more step would lower chi2"):
+        fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False), moves=False)
+
+
 def test_an_accelerometer_effect_is_not_said_to_alias_with_gyro_parameters(tmp_path):
     """On the log of poses turned by hand about one horizontal axis (above), an accelerometer's K2 is taken up by
     accelerometer parameters and the poses' tilts, none of which the recording identifies; `diagnose` had listed it

@@ -848,11 +848,12 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
 
         # start from the linear solution with the tilts held at their first guess, then free them together; where
         # that start leads the search astray (a near-null direction the linear step takes at full length: hand
-        # poses whose gravity directions lie in one cap), from the first guess itself
+        # poses whose gravity directions lie in one cap), from the first guess itself: where it stops short, or
+        # ends above the first guess's own χ² (a minimum the linear step fell into)
         z0 = np.zeros(basis.shape[1])
         if linear_start:
             result, decrease = run(np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0])
-            if decrease > STALLED_CHI2:
+            if decrease > STALLED_CHI2 or result.cost > 0.5 * float(np.sum(residual(z0) ** 2)):
                 retry = run(z0)
                 result, decrease = min((result, decrease), retry, key=lambda r: r[0].cost)
         else:
