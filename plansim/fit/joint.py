@@ -671,8 +671,7 @@ def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank
     fit's weights): uniform within that bound, its standard uncertainty is the bound/√3, if that is below the
     data sheet's. Where the fit freed them (*rank* above *nominal_rank*), the gain carries them and the bound is
     that u."""
-    local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
-                            nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
+    local = _identifiability_at(model, theta, tilts, rows)
     out = [prior] * len(pairs)
     if local.rank <= nominal_rank:
         return out
@@ -762,10 +761,18 @@ def whitening(V: np.ndarray) -> np.ndarray:
 TILT_BEYOND_SHEAR = 5.0
 
 
-def _far_tilts(tilts: np.ndarray, n_placed: int) -> np.ndarray:
+def _identifiability_at(model: MeanModel, theta: np.ndarray, tilts: np.ndarray, rows: np.ndarray) -> Identifiability:
+    """What the fitted *rows* of the segment means identify with the hand-placed poses at *tilts* (the design at
+    *θ*, the Earth rate left out; the tilts as nuisance parameters)."""
+    return identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
+                           nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
+
+
+def _far_tilts(tilts: np.ndarray, n_placed: int, beyond: float = APPROXIMATE_TILT) -> np.ndarray:
     """*tilts* (the nuisance parameters: two per hand-placed pose, about East and North, then two per hand-turned
-    axis) with each pose's components of at most :data:`plansim.estimate.segmentation.APPROXIMATE_TILT` zeroed, and
-    the hand-turned axes' zeroed: the point where the fit decides what a recording identifies.
+    axis) with each pose's components of at most *beyond* (default
+    :data:`plansim.estimate.segmentation.APPROXIMATE_TILT`) zeroed, and the hand-turned axes' zeroed: the point where
+    the fit decides what a recording identifies.
 
     At a pose near an axis, a tilt and an accelerometer's cross-coupling move the means alike to first order, and
     the pose is taken as named, so that a fraction of a degree does not count as determining the cross-coupling
@@ -776,7 +783,7 @@ def _far_tilts(tilts: np.ndarray, n_placed: int) -> np.ndarray:
     fit stuck at χ²/dof = 134 with 1.8·10³ µg on az)."""
     out = np.zeros_like(tilts)
     placed = np.asarray(tilts[:2 * n_placed], dtype=float)
-    out[:2 * n_placed] = np.where(np.abs(placed) > APPROXIMATE_TILT, placed, 0.0)
+    out[:2 * n_placed] = np.where(np.abs(placed) > beyond, placed, 0.0)
     return out
 
 
@@ -839,12 +846,12 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         def run(z0):
             result = least_squares(residual, z0, jac=lambda z: W @ design_at(z), method="lm", x_scale="jac",
                                    xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
+            if result.success:
+                return result, 0.0
+            # it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's part in
+            # the design's column space)
             X = W @ design_at(result.x)
-            # where it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's
-            # part in the design's column space)
-            decrease = 0.0 if result.success else \
-                float(np.sum((X @ np.linalg.lstsq(X, -result.fun, rcond=None)[0]) ** 2))
-            return result, decrease
+            return result, float(np.sum((X @ np.linalg.lstsq(X, -result.fun, rcond=None)[0]) ** 2))
 
         # start from the linear solution with the tilts held at their first guess, then free them together; where
         # that start leads the search astray (a near-null direction the linear step takes at full length: hand
@@ -1037,8 +1044,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     nominal_tilts = _far_tilts(tilts0, int(model.placed.sum()))
     if _judged is not None:  # the tilts a first fit found, its biases taken out (below)
         nominal_tilts = np.where(_judged != 0.0, _judged, nominal_tilts)
-    ident = identifiability(model.parameter_jacobian(earth_rate=False, tilts=nominal_tilts)[rows],
-                            nuisance=model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)[rows])
+    ident = _identifiability_at(model, theta0, nominal_tilts, rows)
     J = model.parameter_jacobian(earth_rate=True, tilts=tilts0)
     mask = ident.mask
     if model.placed.any():
@@ -1099,8 +1105,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
             # accelerometer's cross-coupling): those combinations are freed when the data ask for them (χ² drops
             # by more than its 99 % quantile for as many degrees of freedom), from the first solution
-            local = identifiability(model.parameter_jacobian(earth_rate=False, tilts=tilts)[rows],
-                                    nuisance=model.tilt_jacobian(theta, tilts, earth_rate=False)[rows])
+            local = _identifiability_at(model, theta, tilts, rows)
             if local.rank > rank:
                 second_stall: list = []
                 try:
@@ -1203,13 +1208,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         # force by 3°): judged again from this fit's tilts, a component no cross-coupling the shear's prior allows
         # could stand in for counts, and where that lets the poses determine more, the recording is fitted again
         # with what they identify decided there
-        n_placed = int(model.placed.sum())
-        judged = np.zeros_like(tilts)
-        fitted = np.asarray(tilts, dtype=float)[:2 * n_placed]
-        judged[:2 * n_placed] = np.where(np.abs(fitted) > TILT_BEYOND_SHEAR * priors.accel_cross, fitted, 0.0)
+        judged = _far_tilts(tilts, int(model.placed.sum()), TILT_BEYOND_SHEAR * priors.accel_cross)
         point = np.where(judged != 0.0, judged, nominal_tilts)
-        if identifiability(model.parameter_jacobian(earth_rate=False, tilts=point)[rows],
-                           nuisance=model.tilt_jacobian(theta0, point, earth_rate=False)[rows]).rank > ident.rank:
+        if _identifiability_at(model, theta0, point, rows).rank > ident.rank:
             try:
                 again = fit_recording(recording, noise=all_noise, moves=False, _judged=judged, **given)
             except ValueError:  # the first fit stands
