@@ -126,6 +126,29 @@ def test_the_full_procedure_identifies_all_39():
     assert result.identified == PARAMETER_NAMES and result.rank == 39 and not result.not_identified
 
 
+def test_an_identified_parameter_is_weakly_determined_only_beyond_its_groups_limit():
+    """weakly_determined flags an identified parameter exactly when its u exceeds UNINFORMATIVE_U of its group
+    (the limit itself passes), names the u and the limit in display units, and ignores what is not identified or
+    has no u; a u of the wrong length is refused, naming the field."""
+    from plansim.fit.identify import UNINFORMATIVE_U, weakly_determined
+    from plansim.model.parameters import PARAMETERS
+
+    limits = np.array([UNINFORMATIVE_U[p.group] for p in PARAMETERS])
+    assert weakly_determined(PARAMETER_NAMES, limits) == {}
+    u = limits.copy()
+    u[PARAMETER_NAMES.index("Baz")] *= 21.0
+    u[PARAMETER_NAMES.index("Kaxx")] *= 1.5
+    u[PARAMETER_NAMES.index("Bgx")] *= 5.0  # not identified below: not flagged
+    u[PARAMETER_NAMES.index("gxx")] = math.nan
+    names = [n for n in PARAMETER_NAMES if n != "Bgx"]
+    weak = weakly_determined(names, u)
+    assert set(weak) == {"Baz", "Kaxx"}
+    assert "u = 2.14e+06 ug, above 1.02e+05 ug" in weak["Baz"], weak["Baz"]
+    assert "u = 0.15, above 0.1," in weak["Kaxx"], weak["Kaxx"]
+    with pytest.raises(ValueError, match=r"u has shape \(38,\)"):
+        weakly_determined(names, u[:-1])
+
+
 def test_six_positions_identify_ka_ba_bg_g_and_nothing_of_kg_or_p():
     result = _identified(multi_position(6))
     assert set(result.identified) == set(GROUP["Ka"] + GROUP["Ba"] + GROUP["Bg"] + GROUP["G"])
@@ -261,6 +284,7 @@ def test_a_six_position_log_fits_what_it_identifies_and_says_what_not():
     assert np.all(np.isnan(result.joint.estimate[~mask])) and np.all(np.isnan(result.joint.u[~mask]))
     z = (result.joint.estimate[mask] - truth[mask]) / result.joint.u[mask]
     assert np.all(np.abs(z) < 5)
+    assert result.weakly_determined == {}  # what 6 table positions identify, they determine well
     document = fit_json(result)
     assert {d["name"] for d in document["not_identified"]} == set(np.array(PARAMETER_NAMES)[~mask])
     assert all(d["estimate"] is None for d in document["parameters"] if d["name"] not in result.identified)
@@ -806,6 +830,7 @@ def test_plansim_fit_json_and_out(tmp_path, capsys):
     document = json.loads(capsys.readouterr().out)
     assert tuple(document) == JSON_KEYS
     assert len(document["identified"]) == 39 and document["not_identified"] == []
+    assert document["weakly_determined"] == []  # a full JJF 2003 run determines every parameter well
     assert {p["method"] for p in document["parameters"]} == {"jjf2003", "joint_wls"}
     assert set(document["parameters"][0]) == {"name", "unit", "estimate", "u", "method"}
     assert [n["channel"] for n in document["noise"]] == ["gx", "gy", "gz", "ax", "ay", "az"]
@@ -814,6 +839,7 @@ def test_plansim_fit_json_and_out(tmp_path, capsys):
     assert 0.5 < document["chi2_dof"]["ratio"] < 1.5
     with xr.open_dataset(out) as ds:
         assert ds["estimate_joint_wls"].sizes["parameter"] == 39
+        assert int(ds["weakly_determined"].sum()) == 0
     assert main(["fit", str(path), "--latitude", "39.9", "--height", "50", "--no-residuals"]) == 0
     text = capsys.readouterr().out
     assert "Identified by the segments: 39 of 39" in text and "deg/h" in text and "chi2/dof" in text

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from plansim.model.parameters import PARAMETER_NAMES
+from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
 #: standard uncertainty of a Kg entry that a fit holds at its nominal value (1 or 0) while it still matters: one the
 #: recording does not identify but the Earth rate reaches, or one the moves between poses determine only weakly:
@@ -41,6 +41,17 @@ HELD_KA_UNCERTAINTY = 0.01
 #: the bias): 0.1 (°/s)/g, the linear-acceleration sensitivity a consumer MEMS gyro's data sheet states (e.g. the
 #: MPU-6050's); a full turn of T seconds about an axis across gravity feels it as an angle of up to 0.1°/s·T
 HELD_G_UNCERTAINTY = math.radians(0.1) / 9.80665
+#: per parameter group, the standard uncertainty (SI) beyond which an estimate says no more of a MEMS unit than a
+#: consumer data sheet does before any calibration (the MPU-6050's: scale factors within ±3 %, cross-axis
+#: sensitivity ±2 %, a gyro's zero-rate offset ±20 °/s, an accelerometer's zero-g offset ±50–80 mg, a gyro's
+#: linear-acceleration sensitivity 0.1 (°/s)/g typical): scale factors and cross-couplings 0.1; gyro bias 20 °/s;
+#: g-sensitivity 1 (°/s)/g, ten times the typical value; accelerometer bias 1 m/s² (0.1 g); accelerometer
+#: sensitivity to squared rate 1 m (a lever arm no fixture has). A parameter the segments identify (the design's
+#: rank) but leave with a larger u is reported as *determined only weakly* (:func:`weakly_determined`): the rank
+#: counts every direction noise-free data would settle, and poses placed by hand whose gravity directions lie in
+#: one cap leave an accelerometer's scale factor at 0.9 ± 0.5 and its bias at 6 ± 21 m/s², "identified"
+UNINFORMATIVE_U = {"Kg": 0.1, "Bg": math.radians(20.0), "G": math.radians(1.0) / 9.80665, "Ka": 0.1, "Ba": 1.0,
+                   "P": 1.0}
 #: how a report names the nuisance parameters of poses and turns placed by hand, together
 HAND_PLACEMENT = "the hand placement (the tilts of poses placed by hand, the axes of turns by hand)"
 #: singular values below this fraction of the largest (of the column-scaled design) count as zero: the
@@ -175,3 +186,25 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments", 
         else:
             not_identified[name] = f"{what} see it only in combination with other parameters"
     return Identifiability(tuple(identified), not_identified, rank, row_space, scale)
+
+
+def weakly_determined(identified, u: np.ndarray) -> dict:
+    """name -> why, for each parameter in *identified* whose standard uncertainty *u* ((39,) SI, in the order of
+    :data:`~plansim.model.parameters.PARAMETER_NAMES`; NaN where not estimated) exceeds its group's
+    :data:`UNINFORMATIVE_U`: identified by the design's rank, but left by the data where its estimate says no more
+    of the unit than a data sheet. The estimate and its u stay in the report; this says how to read them."""
+    out = {}
+    u = np.asarray(u, dtype=float)
+    if u.shape != (len(PARAMETERS),):
+        raise ValueError(f"u has shape {u.shape}: expected ({len(PARAMETERS)},), one per parameter")
+    for k, spec in enumerate(PARAMETERS):
+        limit = UNINFORMATIVE_U[spec.group]
+        if spec.name in identified and math.isfinite(u[k]) and u[k] > limit:
+            factor = spec.display_factor
+            unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"
+            out[spec.name] = (f"identified by the segments' geometry, but with u = {u[k] / factor:.3g}{unit}, "
+                              f"above {limit / factor:.3g}{unit}, "
+                              "beyond which an estimate says no more of a MEMS unit than its data sheet does: read "
+                              "it as not determined (more gravity directions or rates in the schedule would determine "
+                              "it)")
+    return out

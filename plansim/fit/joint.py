@@ -38,7 +38,14 @@ from threadpoolctl import threadpool_limits
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.estimate.segmentation import APPROXIMATE_TILT, MAD_TO_SIGMA
-from plansim.fit.identify import NULL_TOLERANCE, RANK_TOLERANCE, HeldPriors, Identifiability, identifiability
+from plansim.fit.identify import (
+    NULL_TOLERANCE,
+    RANK_TOLERANCE,
+    HeldPriors,
+    Identifiability,
+    identifiability,
+    weakly_determined,
+)
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
 from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
@@ -344,6 +351,19 @@ class FitResult:
             else:
                 out[name] = reason
         return out
+
+    @property
+    def weakly_determined(self) -> dict:
+        """name -> why, for every identified parameter whose smallest u (the joint fit's, or the moves' where they
+        identify it) is beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U`
+        (:func:`plansim.fit.identify.weakly_determined`)."""
+        joint = set(self.identifiability.identified)
+        u = np.array([self.joint.u[k] if name in joint else math.inf for k, name in enumerate(PARAMETER_NAMES)])
+        if self.moves is not None:
+            moved = set(self.moves.identified)
+            u = np.fmin(u, [self.moves.method.u[k] if name in moved else math.inf
+                            for k, name in enumerate(PARAMETER_NAMES)])
+        return weakly_determined(self.identified, np.where(np.isfinite(u), u, math.nan))
 
     @property
     def methods(self) -> tuple[Method, ...]:

@@ -78,7 +78,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_distribution
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
-from plansim.fit.identify import Identifiability, identifiability
+from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -118,7 +118,7 @@ RUNAWAY = 2.0 * max(UNIT_STARTS)
 #: direction says nothing of the unit, and the fit wandered along it (an independent simulator's 12-position log,
 #: whose y axis was turned about only while vertical: Kgyy 5.33 ± 13.7, 0.497 ± 0.053, or the moves dropped with
 #: advice to check the gyros' units). The identified directions' u is 1e-5 to 1e-2 on the logs we have
-WEAK_DIRECTION_U = 0.1
+WEAK_DIRECTION_U = UNINFORMATIVE_U["Kg"]
 #: a start with some gyro axes flipped is taken over the gyros as wired only where its χ² is lower by more than
 #: this (the 99 % point of χ² with 1 degree of freedom): with poses near the six axes a half turn of the gyro
 #: triad about one axis maps every pose's gravity onto itself, and the moves cannot tell it from none

@@ -1,7 +1,7 @@
 """A fit's result as data: the ``--json`` object of ``plansim fit`` and the ``--out`` NetCDF Dataset.
 
-Everything in SI, each number with its unit. The JSON object has exactly the keys ``identified``,
-``not_identified``, ``parameters``, ``noise``, ``residuals`` and ``chi2_dof`` (docs/fitting.md).
+Everything in SI, each number with its unit. The JSON object has exactly the keys of :data:`JSON_KEYS`
+(docs/fitting.md).
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
-JSON_KEYS = ("identified", "not_identified", "site", "turntable", "parameters", "noise", "residuals", "chi2_dof",
-             "moves")
+JSON_KEYS = ("identified", "not_identified", "weakly_determined", "site", "turntable", "parameters", "noise",
+             "residuals", "chi2_dof", "moves")
 
 
 def _number(value: float):
@@ -63,6 +63,7 @@ def fit_json(result: FitResult) -> dict:
     return {
         "identified": list(result.identified),
         "not_identified": [{"name": name, "reason": reason} for name, reason in result.not_identified.items()],
+        "weakly_determined": [{"name": name, "reason": reason} for name, reason in result.weakly_determined.items()],
         "site": result.site.describe(),
         "turntable": result.turntable_source,
         "parameters": parameters,
@@ -109,6 +110,10 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
                                                {"long_name": f"part of u_{method.name} from the {kind} inputs"})
     data["identified"] = ("parameter", np.array([n in result.identified for n in PARAMETER_NAMES], dtype=np.int8),
                           {"long_name": "1 when the recording's segments identify the parameter"})
+    weak = result.weakly_determined
+    data["weakly_determined"] = ("parameter", np.array([n in weak for n in PARAMETER_NAMES], dtype=np.int8),
+                                 {"long_name": "1 when identified but with u beyond what a data sheet already says "
+                                               "(plansim.fit.identify.UNINFORMATIVE_U)"})
     data["spec_bias"] = ("parameter", result.spec_bias,
                          {"long_name": "expected error of the specification's estimators at the joint estimate "
                                        "(the site's Earth rate and gravity; NaN when not computed)"})
@@ -172,6 +177,7 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
         "chi2": result.chi2, "chi2_dof": result.chi2_dof, "chi2_verdict": result.chi2_verdict,
         "spec_note": result.spec_note,
         "not_identified": "; ".join(f"{k}: {v}" for k, v in result.not_identified.items()),
+        "weakly_determined": "; ".join(f"{k}: {v}" for k, v in weak.items()),
         "moves": "none" if moves is None else (f"{len(moves.transitions)} used; chi2 {moves.chi2:.6g} on "
                                                f"{moves.chi2_dof} dof: {moves.chi2_verdict}"),
         "unused_segments": "; ".join(f"{k}: {v}" for k, v in result.unused.items()),

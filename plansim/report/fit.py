@@ -59,6 +59,12 @@ def fit_report(result, residuals: bool = True) -> str:
         for reason, names in by_reason.items():
             lines.append(f"  {' '.join(names)}: {reason}")
 
+    weak = result.weakly_determined
+    if weak:
+        lines.append("Determined only weakly (estimate and u below, but read them as not determined):")
+        for name, reason in weak.items():
+            lines.append(f"  {name}: {reason}")
+
     lines += ["", "Parameters (display units; u = standard uncertainty, nu = effective degrees of freedom)"]
     head = f"{'name':6s} {'unit':>13s} {'joint WLS':>14s} {'u':>10s} {'nu':>7s}"
     if result.spec is not None:
