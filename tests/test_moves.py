@@ -681,21 +681,47 @@ def test_poses_tilted_about_two_axes_are_fitted_not_refused(tmp_path):
 def test_a_linear_start_that_falls_into_a_false_minimum_is_not_taken(tmp_path, monkeypatch):
     """The same two-axis schedule on seed 4, with 2000 evaluations allowed: the search from the linear first step
     converges — to χ² = 3.4·10⁶, a minimum that step fell into, far above the first guess's own χ². It had been
-    taken as the fit. A search that ends above its first guess is now started again from the first guess; on this
-    log that one stops with 2.6 of χ² still in reach (the valley of the test above), so the recording is refused
-    with the reason, not fitted at χ² = 3.4·10⁶. (At the default 400 evaluations the linear start stops short and
-    is retried anyway.)"""
+    taken as the solution. A search that ends above its first guess is now started again from the first guess, so
+    no solve hands on that minimum (every solve's χ² is below 10³; with the restart removed the first is 3.4·10⁶:
+    verified. The second solve, at the fitted tilts, now climbs out of it either way, so the final χ² alone would
+    not show it), and the fit is consistent with the noise. (At the default 400 evaluations the linear start
+    stops short and is retried anyway.)"""
+    from scipy.stats import chi2 as chi2_distribution
+
     from plansim.fit import joint
     from plansim.io.log_import import import_log
 
     monkeypatch.setattr(joint, "MAX_EVALUATIONS", 2000)
+    solved = []
+
+    def recorded(*args, solve=joint._solve, **kwargs):
+        out = solve(*args, **kwargs)
+        solved.append(out[5])  # its χ²
+        return out
+
+    monkeypatch.setattr(joint, "_solve", recorded)
     a = 20
     turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
     t, x, _ = _table_log(turns, seed=4)
     recording = import_log(_write_log(tmp_path / "tilted.csv", t, x), time_column="time",
                            units="deg/s,m/s^2").recording
-    with pytest.raises(ValueError, match="one more step would lower chi2"):
-        fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False), moves=False)
+    fit = fit_recording(recording, Site(math.radians(40.0), 50.0, earth_rate=False), moves=False)
+    assert solved and max(solved) < 1e3, solved
+    assert chi2_distribution.sf(fit.chi2, fit.chi2_dof) >= 1e-3, (fit.chi2, fit.chi2_dof)
+
+
+def test_a_search_stopped_in_a_weakly_determined_valley_is_taken(tmp_path):
+    """Seed 4 of the 20° two-axis schedule at the default 400 evaluations had been refused: the search stopped with
+    2.3 of χ² within one more Gauss–Newton step, above STALLED_CHI2. Split by the design's singular directions,
+    all of it lies along directions where a step of one u moves a parameter beyond UNINFORMATIVE_U (what a data
+    sheet already says): directions the data determine only weakly, along which the fit could only wander. Such a
+    remainder below the 99 % point of χ² for as many degrees of freedom no longer refuses the fit; the note gives
+    both parts. The fit is consistent with the noise, its gyro biases and g-sensitivities within 3.3 u of the
+    truth (``_assert_fits_its_truth``), and the accelerometer parameters along the valley flagged."""
+    a = 20
+    turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
+    fit = _assert_fits_its_truth(tmp_path, turns, seed=4, noted="along what the data determine and by")
+    assert fit.weakly_determined and all(name.startswith(("Ka", "Ba")) for name in fit.weakly_determined)
 
 
 def test_an_accelerometer_effect_is_not_said_to_alias_with_gyro_parameters(tmp_path):

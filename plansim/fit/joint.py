@@ -41,6 +41,7 @@ from plansim.estimate.segmentation import APPROXIMATE_TILT, MAD_TO_SIGMA
 from plansim.fit.identify import (
     NULL_TOLERANCE,
     RANK_TOLERANCE,
+    UNINFORMATIVE_U,
     HeldPriors,
     Identifiability,
     identifiability,
@@ -758,7 +759,8 @@ def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray,
 #: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
 MAX_EVALUATIONS = 400
 #: a non-linear fit that has used its MAX_EVALUATIONS is taken where it stopped when one more Gauss–Newton step would
-#: lower χ² by less than this: less than one degree of freedom's expected share, so no test or u reads it. It stops
+#: lower χ² along what the data determine by less than this (and along what they determine only weakly by less than
+#: its 99 % point: :func:`_short`): less than one degree of freedom's expected share, so no test or u reads it. It stops
 #: short only in a direction the data barely determine (a curved valley, walked in ever smaller steps: poses placed
 #: by hand whose gravity directions all lie in one cap leave the accelerometers' ellipsoid so), where the estimate's
 #: u says as much (docs/fitting.md)
@@ -807,6 +809,30 @@ def _far_tilts(tilts: np.ndarray, n_placed: int, beyond: float = APPROXIMATE_TIL
     return out
 
 
+def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.ndarray) -> tuple[float, float, int]:
+    """What one more Gauss–Newton step would take off χ² where a search stopped: the whitened *residual*'s part in
+    the column space of the whitened design *X* (its columns the fit's unknowns z, θ = θ0 + *theta_basis*·z),
+    split by the design's singular directions into the part along directions the data determine and the part
+    along directions they determine only weakly — where a step of one standard uncertainty moves some parameter
+    beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U` (the parameters :attr:`FitResult.
+    weakly_determined` flags). Returns (determined part, weak part, number of weak directions)."""
+    left, singular, right = np.linalg.svd(X, full_matrices=False)
+    kept = singular > np.finfo(float).eps * max(X.shape) * max(singular.max(initial=0.0), 1e-300)  # lstsq's cut
+    parts = (left[:, kept].T @ residual) ** 2
+    limits = np.array([UNINFORMATIVE_U[p.group] for p in PARAMETERS])
+    one_sigma = (theta_basis @ right[kept].T) / singular[kept]  # (39, k): θ's step of 1 u along each direction
+    weak = np.max(np.abs(one_sigma) / limits[:, None], axis=0, initial=0.0) > 1.0
+    return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
+
+
+def _short(decrease: float, weak: float, n_weak: int) -> bool:
+    """Whether a search that used up its evaluations stopped short of the minimum (:func:`_gauss_newton_decrease`):
+    more than :data:`STALLED_CHI2` left along what the data determine, or, along the directions they determine
+    only weakly, more than the 99 % point of χ² for as many degrees of freedom (what freeing them would have to
+    take off to count, as for the combinations :func:`fit_recording` frees at the fitted tilts)."""
+    return decrease > STALLED_CHI2 or (n_weak > 0 and weak > _chi2_quantile(n_weak, 0.99))
+
+
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
            W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None,
            stalled: list | None = None):
@@ -824,8 +850,10 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
 
     A non-linear fit that uses up :data:`MAX_EVALUATIONS` is taken where it stopped if one more Gauss–Newton
-    step would lower χ² by at most :data:`STALLED_CHI2`, and ``(evaluations, that decrease)`` is appended to
-    *stalled*; otherwise a ``ValueError``.
+    step would lower χ² by at most :data:`STALLED_CHI2` along what the data determine, and by less than its
+    99 % point along what they determine only weakly (:func:`_gauss_newton_decrease`, :func:`_short`), and
+    ``(evaluations, the two decreases, the number of weak directions)`` is appended to *stalled*; otherwise a
+    ``ValueError``.
     """
     n = len(theta0)
     extra = np.zeros((len(observed), 0)) if extra is None else np.asarray(extra, dtype=float)
@@ -867,11 +895,10 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
             result = least_squares(residual, z0, jac=lambda z: W @ design_at(z), method="lm", x_scale="jac",
                                    xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
             if result.success:
-                return result, 0.0
+                return result, 0.0, 0.0, 0
             # it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's part in
             # the design's column space)
-            X = W @ design_at(result.x)
-            return result, float(np.sum((X @ np.linalg.lstsq(X, -result.fun, rcond=None)[0]) ** 2))
+            return (result, *_gauss_newton_decrease(W @ design_at(result.x), result.fun, basis[:n]))
 
         # start from the linear solution with the tilts held at their first guess, then free them together; where
         # that start leads the search astray (a near-null direction the linear step takes at full length: hand
@@ -879,18 +906,19 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         # ends above the first guess's own χ² (a minimum the linear step fell into)
         z0 = np.zeros(basis.shape[1])
         if linear_start:
-            result, decrease = run(np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0])
-            if decrease > STALLED_CHI2 or result.cost > 0.5 * float(np.sum(residual(z0) ** 2)):
-                retry = run(z0)
-                result, decrease = min((result, decrease), retry, key=lambda r: r[0].cost)
+            outcome = run(np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0])
+            if _short(*outcome[1:]) or outcome[0].cost > 0.5 * float(np.sum(residual(z0) ** 2)):
+                outcome = min(outcome, run(z0), key=lambda r: r[0].cost)
         else:
-            result, decrease = run(z0)
-        if decrease > STALLED_CHI2:
+            outcome = run(z0)
+        result, decrease, weak, n_weak = outcome
+        if _short(decrease, weak, n_weak):
             raise ValueError(f"the fit of the hand-placed poses did not converge in {MAX_EVALUATIONS} evaluations "
-                             f"({result.message}; one more step would lower chi2 by {decrease:.3g}); check the "
-                             "segment table's poses (docs/fitting.md)")
+                             f"({result.message}; one more step would lower chi2 by {decrease + weak:.3g}, "
+                             f"{decrease:.3g} of it along what the data determine); check the segment table's poses "
+                             "(docs/fitting.md)")
         if not result.success and stalled is not None:
-            stalled.append((int(result.nfev), decrease))
+            stalled.append((int(result.nfev), decrease, weak, n_weak))
         design = design_at(result.x)
         X = W @ design
     gain_z = np.linalg.lstsq(X, W, rcond=None)[0]
@@ -1149,10 +1177,14 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             if not np.any(slow.variance > 0):
                 break
     if stall:
-        evaluations, decrease = stall[-1]
+        evaluations, decrease, weak, n_weak = stall[-1]
         notes.append(f"the joint fit stopped after {evaluations} evaluations, where one more Gauss–Newton step "
-                     f"would lower chi2 by {decrease:.2g}: it was walking a direction the data barely determine "
-                     "(poses placed by hand whose gravity directions leave part of the model nearly free); the "
+                     f"would lower chi2 by {decrease:.2g}" + (
+                         f" along what the data determine and by {weak:.2g} along {n_weak} direction(s) they "
+                         "determine only weakly (below the 99 % point for as many degrees of freedom; the "
+                         "parameters along them are listed as determined only weakly where their u shows it)"
+                         if n_weak else "") + ": it was walking a direction the data barely determine (poses "
+                     "placed by hand whose gravity directions leave part of the model nearly free); the "
                      "estimates' u along it are correspondingly large")
     held_sources = _Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
