@@ -535,7 +535,8 @@ def test_json_keys_and_the_command(tmp_path, capsys):
     assert {"effect", "identifiable", "aliased_with", "statistic", "p_value", "adjusted_p_value", "selected",
             "size", "unit"} <= set(out["candidates"][0])
     assert {"residual_rms", "chi2_dof", "holdout_rms"} <= set(out["before"])
-    assert {"name", "unit", "before", "after", "u_after"} <= set(out["parameters"][0])
+    assert {"name", "unit", "before", "after", "u_after", "weakly_determined"} <= set(out["parameters"][0])
+    assert not any(p["weakly_determined"] for p in out["parameters"])  # a full JJF 2003 run determines them all
     assert {"alpha", "draws", "segments_tested", "smallest_adjusted_p_value", "flagged"} <= set(out["within_segment"])
     assert "within_segments" in out["unexplained"] and out["unexplained"]["excess_scatter"] == []
     assert out["selected"] == ["gyro_scale_asymmetry"] and out["undithered_channels"] == []

@@ -578,9 +578,11 @@ def diagnosis_json(d: Diagnosis) -> dict:
                            "noise_equivalent_size": {c: _number(v) for c, v in
                                                      zip(s.components, s.noise_equivalent_size)},
                            "unit": s.unit})
+    weak = d.after.weakly_determined
     parameters = [{"name": p.name, "unit": p.si_unit, "before": _number(d.before.joint.estimate[k]),
                    "u_before": _number(d.before.joint.u[k]), "after": _number(d.after.joint.estimate[k]),
-                   "u_after": _number(d.after.joint.u[k])} for k, p in enumerate(PARAMETERS)]
+                   "u_after": _number(d.after.joint.u[k]), "weakly_determined": p.name in weak}
+                  for k, p in enumerate(PARAMETERS)]
     return {"identified": list(d.before.identified), "lack_of_fit": lof(d.lack_of_fit),
             "lack_of_fit_after": lof(d.lack_of_fit_after), "candidates": candidates, "selected": list(d.selected),
             "unexplained": d.unexplained, "before": side(d.before, d.holdout["before"]),

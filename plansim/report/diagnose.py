@@ -195,4 +195,8 @@ def diagnose_report(d) -> str:
             f = p.display_factor
             lines.append(f"{p.name:8s} {p.display_unit:>14s} {_g(d.before.joint.estimate[k] / f, 8):>14s} "
                          f"{_g(d.after.joint.estimate[k] / f, 8):>14s} {_g(d.after.joint.u[k] / f, 3):>10s}")
+    weak = d.after.weakly_determined
+    if weak:
+        lines += ["", "Determined only weakly (identified, but u beyond what a data sheet already says; read them as "
+                  "not determined): " + ", ".join(weak)]
     return "\n".join(lines)
