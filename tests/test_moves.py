@@ -610,6 +610,11 @@ def _table_log_truth(seed: int) -> dict:
     return {f"Bg{a}": bg[i] for i, a in enumerate("xyz")} | {f"g{a}{b}": 0.0 for a in "xyz" for b in "xyz"}
 
 
+def _about_both_axes(a: float) -> list:
+    """_table_log's turns: x up and x down (40° off), then poses tilted by hand *a*° about y and z together."""
+    return [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
+
+
 def _assert_fits_its_truth(tmp_path, turns, seed: int, noted: str):
     """_table_log(*turns*, *seed*) imported and fitted (no moves): χ² consistent with the noise (P ≥ 0.001: a false
     failure one time in a thousand), the gyro biases identified, every identified gyro bias and g-sensitivity within
@@ -667,8 +672,7 @@ def test_poses_tilted_about_two_axes_are_fitted_not_refused(tmp_path):
     from plansim.model.parameters import PARAMETERS
     from plansim.report.fit import fit_report
 
-    a = 20
-    turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
+    turns = _about_both_axes(20)
     fit = _assert_fits_its_truth(tmp_path, turns, seed=2, noted="stopped after")
     accelerometers = {p.name for p in PARAMETERS if p.group in ("Ka", "Ba")} & set(fit.identified)
     assert accelerometers and set(fit.weakly_determined) == accelerometers, (accelerometers, fit.weakly_determined)
@@ -700,8 +704,7 @@ def test_a_linear_start_that_falls_into_a_false_minimum_is_not_taken(tmp_path, m
         return out
 
     monkeypatch.setattr(joint, "_solve", recorded)
-    a = 20
-    turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
+    turns = _about_both_axes(20)
     t, x, _ = _table_log(turns, seed=4)
     recording = import_log(_write_log(tmp_path / "tilted.csv", t, x), time_column="time",
                            units="deg/s,m/s^2").recording
@@ -718,8 +721,7 @@ def test_a_search_stopped_in_a_weakly_determined_valley_is_taken(tmp_path):
     remainder below the 99 % point of χ² for as many degrees of freedom no longer refuses the fit; the note gives
     both parts. The fit is consistent with the noise, its gyro biases and g-sensitivities within 3.3 u of the
     truth (``_assert_fits_its_truth``), and the accelerometer parameters along the valley flagged."""
-    a = 20
-    turns = [(1, 140), (1, -140), (1, a), (2, a), (2, -a), (1, -a), (1, -a), (2, -a), (2, a), (1, a), (2, a), (2, -a)]
+    turns = _about_both_axes(20)
     fit = _assert_fits_its_truth(tmp_path, turns, seed=4, noted="along what the data determine and by")
     assert fit.weakly_determined and all(name.startswith(("Ka", "Ba")) for name in fit.weakly_determined)
 

@@ -52,6 +52,8 @@ HELD_G_UNCERTAINTY = math.radians(0.1) / 9.80665
 #: one cap leave an accelerometer's scale factor at 0.9 ± 0.5 and its bias at 6 ± 21 m/s², "identified"
 UNINFORMATIVE_U = {"Kg": 0.1, "Bg": math.radians(20.0), "G": math.radians(1.0) / 9.80665, "Ka": 0.1, "Ba": 1.0,
                    "P": 1.0}
+#: :data:`UNINFORMATIVE_U` per parameter, in the order of :data:`~plansim.model.parameters.PARAMETER_NAMES` (SI)
+UNINFORMATIVE_LIMITS = np.array([UNINFORMATIVE_U[p.group] for p in PARAMETERS])
 #: how a report names the nuisance parameters of poses and turns placed by hand, together
 HAND_PLACEMENT = "the hand placement (the tilts of poses placed by hand, the axes of turns by hand)"
 #: singular values below this fraction of the largest (of the column-scaled design) count as zero: the
@@ -198,7 +200,7 @@ def weakly_determined(identified, u: np.ndarray) -> dict:
     if u.shape != (len(PARAMETERS),):
         raise ValueError(f"u has shape {u.shape}: expected ({len(PARAMETERS)},), one per parameter")
     for k, spec in enumerate(PARAMETERS):
-        limit = UNINFORMATIVE_U[spec.group]
+        limit = UNINFORMATIVE_LIMITS[k]
         if spec.name in identified and math.isfinite(u[k]) and u[k] > limit:
             factor = spec.display_factor
             unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"

@@ -41,7 +41,7 @@ from plansim.estimate.segmentation import APPROXIMATE_TILT, MAD_TO_SIGMA
 from plansim.fit.identify import (
     NULL_TOLERANCE,
     RANK_TOLERANCE,
-    UNINFORMATIVE_U,
+    UNINFORMATIVE_LIMITS,
     HeldPriors,
     Identifiability,
     identifiability,
@@ -759,8 +759,9 @@ def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray,
 #: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
 MAX_EVALUATIONS = 400
 #: a non-linear fit that has used its MAX_EVALUATIONS is taken where it stopped when one more Gauss–Newton step would
-#: lower χ² along what the data determine by less than this (and along what they determine only weakly by less than
-#: its 99 % point: :func:`_short`): less than one degree of freedom's expected share, so no test or u reads it. It stops
+#: lower χ² along what the data determine by less than this — less than one degree of freedom's expected share, so no
+#: test or u reads it — and along what they determine only weakly by less than the 99 % point of χ² for as many
+#: degrees of freedom (:func:`_short`). It stops
 #: short only in a direction the data barely determine (a curved valley, walked in ever smaller steps: poses placed
 #: by hand whose gravity directions all lie in one cap leave the accelerometers' ellipsoid so), where the estimate's
 #: u says as much (docs/fitting.md)
@@ -819,9 +820,8 @@ def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.
     left, singular, right = np.linalg.svd(X, full_matrices=False)
     kept = singular > np.finfo(float).eps * max(X.shape) * max(singular.max(initial=0.0), 1e-300)  # lstsq's cut
     parts = (left[:, kept].T @ residual) ** 2
-    limits = np.array([UNINFORMATIVE_U[p.group] for p in PARAMETERS])
     one_sigma = (theta_basis @ right[kept].T) / singular[kept]  # (39, k): θ's step of 1 u along each direction
-    weak = np.max(np.abs(one_sigma) / limits[:, None], axis=0, initial=0.0) > 1.0
+    weak = np.max(np.abs(one_sigma) / UNINFORMATIVE_LIMITS[:, None], axis=0, initial=0.0) > 1.0
     return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
 
 
