@@ -128,8 +128,9 @@ def test_the_full_procedure_identifies_all_39():
 
 def test_an_identified_parameter_is_weakly_determined_only_beyond_its_groups_limit():
     """weakly_determined flags an identified parameter exactly when its u exceeds UNINFORMATIVE_U of its group
-    (the limit itself passes), names the u and the limit in display units, and ignores what is not identified or
-    has no u; a u of the wrong length is refused, naming the field."""
+    (the limit itself passes), or, where the fit carried the data sheet as a prior, when the prior's part of u holds
+    more than half its variance; it names the u and the limit in display units, and ignores what is not identified
+    or has no u; a u or prior part of the wrong length is refused, naming the field."""
     from plansim.fit.identify import UNINFORMATIVE_U, weakly_determined
     from plansim.model.parameters import PARAMETERS
 
@@ -147,6 +148,16 @@ def test_an_identified_parameter_is_weakly_determined_only_beyond_its_groups_lim
     assert "u = 0.15, above 0.1," in weak["Kaxx"], weak["Kaxx"]
     with pytest.raises(ValueError, match=r"u has shape \(38,\)"):
         weakly_determined(names, u[:-1])
+    # with the data sheet as the fit's prior: flagged when the prior's part holds more than half the variance
+    u = 0.5 * limits
+    prior = np.zeros_like(u)
+    prior[PARAMETER_NAMES.index("Kazz")] = 0.8 * u[PARAMETER_NAMES.index("Kazz")]  # 64 % of the variance
+    prior[PARAMETER_NAMES.index("Bax")] = 0.7 * u[PARAMETER_NAMES.index("Bax")]  # 49 %: not flagged
+    prior[PARAMETER_NAMES.index("Bgx")] = u[PARAMETER_NAMES.index("Bgx")]  # not identified: not flagged
+    weak = weakly_determined(names, u, prior)
+    assert set(weak) == {"Kazz"} and "from the data sheet's prior" in weak["Kazz"], weak
+    with pytest.raises(ValueError, match=r"data_sheet has shape \(3,\)"):
+        weakly_determined(names, u, prior[:3])
 
 
 def test_six_positions_identify_ka_ba_bg_g_and_nothing_of_kg_or_p():

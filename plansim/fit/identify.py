@@ -190,23 +190,35 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments", 
     return Identifiability(tuple(identified), not_identified, rank, row_space, scale)
 
 
-def weakly_determined(identified, u: np.ndarray) -> dict:
+def weakly_determined(identified, u: np.ndarray, data_sheet: np.ndarray | None = None) -> dict:
     """name -> why, for each parameter in *identified* whose standard uncertainty *u* ((39,) SI, in the order of
     :data:`~plansim.model.parameters.PARAMETER_NAMES`; NaN where not estimated) exceeds its group's
-    :data:`UNINFORMATIVE_U`: identified by the design's rank, but left by the data where its estimate says no more
-    of the unit than a data sheet. The estimate and its u stay in the report; this says how to read them."""
+    :data:`UNINFORMATIVE_U`, or, where the fit carried the data sheet as a prior, whose u owes more than half its
+    variance to that prior (*data_sheet*: (39,) the prior's part of u): identified by the design's rank, but left
+    by the data where its estimate says no more of the unit than a data sheet. The estimate and its u stay in the
+    report; this says how to read them."""
     out = {}
     u = np.asarray(u, dtype=float)
     if u.shape != (len(PARAMETERS),):
         raise ValueError(f"u has shape {u.shape}: expected ({len(PARAMETERS)},), one per parameter")
+    prior = np.zeros(len(PARAMETERS)) if data_sheet is None else np.nan_to_num(np.asarray(data_sheet, dtype=float))
+    if prior.shape != (len(PARAMETERS),):
+        raise ValueError(f"data_sheet has shape {prior.shape}: expected ({len(PARAMETERS)},), one per parameter")
     for k, spec in enumerate(PARAMETERS):
         limit = UNINFORMATIVE_LIMITS[k]
-        if spec.name in identified and math.isfinite(u[k]) and u[k] > limit:
-            factor = spec.display_factor
-            unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"
-            out[spec.name] = (f"identified by the segments' geometry, but with u = {u[k] / factor:.3g}{unit}, "
-                              f"above {limit / factor:.3g}{unit}, "
-                              "beyond which an estimate says no more of a MEMS unit than its data sheet does: read "
-                              "it as not determined (more gravity directions or rates in the schedule would determine "
-                              "it)")
+        if spec.name not in identified or not math.isfinite(u[k]):
+            continue
+        factor = spec.display_factor
+        unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"
+        if u[k] > limit:
+            why = (f"u = {u[k] / factor:.3g}{unit}, above {limit / factor:.3g}{unit}, beyond which an estimate says "
+                   "no more of a MEMS unit than its data sheet")
+        elif prior[k] ** 2 > 0.5 * u[k] ** 2:
+            why = (f"u = {u[k] / factor:.3g}{unit}, of it {prior[k] / factor:.3g}{unit} from the data sheet's prior "
+                   f"(u {limit / factor:.3g}{unit}), which holds what the data leave open: the estimate says little "
+                   "more of the unit than its data sheet")
+        else:
+            continue
+        out[spec.name] = (f"identified by the segments' geometry, but with {why}: read it as not determined (more "
+                          "gravity directions or rates in the schedule would determine it)")
     return out

@@ -68,8 +68,8 @@ METHOD_JOINT = "joint_wls"
 class Method:
     """The estimates of one method (39 each, SI; NaN where not identified).
 
-    ``contributions`` maps a kind of input (``noise``, ``table``, ``angle``, ``site``, ``held``) to the
-    (39,) root-sum-square of its contributions: the budget in short.
+    ``contributions`` maps a kind of input (``noise``, ``table``, ``angle``, ``site``, ``held``, ``data_sheet``) to
+    the (39,) root-sum-square of its contributions: the budget in short.
     """
 
     name: str
@@ -325,6 +325,9 @@ class FitResult:
     moves: object = None
     #: the Type B standard uncertainties of what the fit (and the moves) hold at nominal
     held: HeldPriors = field(default_factory=HeldPriors)
+    #: with the data sheet as a prior (where the data leave a direction to it, :func:`_solve`): the joint
+    #: estimate's gain on the prior's mean, ∂θ̂/∂nominal (39, 39), each input with u = UNINFORMATIVE_U; else None
+    prior_gain: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def residuals(self) -> np.ndarray:
@@ -356,15 +359,20 @@ class FitResult:
     @property
     def weakly_determined(self) -> dict:
         """name -> why, for every identified parameter whose smallest u (the joint fit's, or the moves' where they
-        identify it) is beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U`
-        (:func:`plansim.fit.identify.weakly_determined`)."""
+        identify it) is beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U` or owes more than half its
+        variance to the data sheet's prior (:func:`plansim.fit.identify.weakly_determined`)."""
         joint = set(self.identifiability.identified)
         u = np.array([self.joint.u[k] if name in joint else math.inf for k, name in enumerate(PARAMETER_NAMES)])
+        # the data sheet's part of that u, where the joint fit carried it as a prior (_solve)
+        zero = np.zeros(len(PARAMETER_NAMES))
+        data_sheet = np.nan_to_num(self.joint.contributions.get("data_sheet", zero))
         if self.moves is not None:
-            moved = set(self.moves.identified)
-            u = np.fmin(u, [self.moves.method.u[k] if name in moved else math.inf
-                            for k, name in enumerate(PARAMETER_NAMES)])
-        return weakly_determined(self.identified, np.where(np.isfinite(u), u, math.nan))
+            moved = np.array([name in set(self.moves.identified) for name in PARAMETER_NAMES])
+            smaller = moved & (self.moves.method.u < u)
+            u = np.where(smaller, self.moves.method.u, u)
+            data_sheet = np.where(smaller, np.nan_to_num(self.moves.method.contributions.get("data_sheet", zero)),
+                                  data_sheet)
+        return weakly_determined(self.identified, np.where(np.isfinite(u), u, math.nan), data_sheet)
 
     @property
     def methods(self) -> tuple[Method, ...]:
@@ -740,17 +748,24 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
     return candidate
 
 
-def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "") -> Method:
-    """θ̂ = gain · m: u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent sources."""
+def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "",
+               prior_gain: np.ndarray | None = None) -> Method:
+    """θ̂ = gain · m (+ prior_gain · nominal): u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent
+    sources, and, with *prior_gain* (39, 39), the data sheet's prior of the joint fit (:func:`_solve`), one Type B
+    input per parameter with u = :data:`plansim.fit.identify.UNINFORMATIVE_U` (kind ``data_sheet``)."""
     contributions = gain @ sources.matrix()  # (39, n)
     dofs = np.asarray(sources.dof)
+    kinds = np.asarray(sources.kind, dtype=object)
+    if prior_gain is not None:
+        contributions = np.hstack([contributions, prior_gain * UNINFORMATIVE_LIMITS[None, :]])
+        dofs = np.concatenate([dofs, np.full(len(UNINFORMATIVE_LIMITS), math.inf)])
+        kinds = np.concatenate([kinds, np.full(len(UNINFORMATIVE_LIMITS), "data_sheet", dtype=object)])
     u = np.full(gain.shape[0], math.nan)
     nu = np.full(gain.shape[0], math.nan)
     for k in np.flatnonzero(mask):
         u[k], nu[k] = combine(contributions[k], dofs)
     by_kind = {}
-    kinds = np.asarray(sources.kind)
-    for kind in dict.fromkeys(sources.kind):
+    for kind in dict.fromkeys(kinds.tolist()):
         part = np.sqrt(np.sum(contributions[:, kinds == kind] ** 2, axis=1))
         by_kind[kind] = np.where(mask, part, math.nan)
     return Method(name, np.full(gain.shape[0], math.nan), u, nu, by_kind, note)
@@ -817,12 +832,22 @@ def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.
     along directions they determine only weakly — where a step of one standard uncertainty moves some parameter
     beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U` (the parameters :attr:`FitResult.
     weakly_determined` flags). Returns (determined part, weak part, number of weak directions)."""
+    left, weak = _weak_directions(X, theta_basis)
+    parts = (left.T @ residual) ** 2
+    return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
+
+
+def _weak_directions(X: np.ndarray, theta_basis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The whitened design *X*'s left singular vectors (those above lstsq's cut), and for each whether the data
+    determine it only weakly: a step of one standard uncertainty along it (θ = θ0 + *theta_basis*·z) moves some
+    parameter beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U`."""
+    if X.shape[1] == 0:
+        return np.zeros((X.shape[0], 0)), np.zeros(0, dtype=bool)
     left, singular, right = np.linalg.svd(X, full_matrices=False)
     kept = singular > np.finfo(float).eps * max(X.shape) * max(singular.max(initial=0.0), 1e-300)  # lstsq's cut
-    parts = (left[:, kept].T @ residual) ** 2
     one_sigma = (theta_basis @ right[kept].T) / singular[kept]  # (39, k): θ's step of 1 u along each direction
     weak = np.max(np.abs(one_sigma) / UNINFORMATIVE_LIMITS[:, None], axis=0, initial=0.0) > 1.0
-    return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
+    return left[:, kept], weak
 
 
 def _short(decrease: float, weak: float, n_weak: int) -> bool:
@@ -835,7 +860,7 @@ def _short(decrease: float, weak: float, n_weak: int) -> bool:
 
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
            W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None,
-           stalled: list | None = None):
+           stalled: list | None = None, prior: bool = False):
     """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
 
     The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
@@ -844,7 +869,15 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
 
     Returns θ̂ (39,), the tilts (n_placed, 2), the gain A (39, 6S) of θ̂ on the means, the design of the
     identified combinations D (6S, rank) at the solution and the gain G (rank, 6S) of z (the fit's hat matrix
-    is D·G), and χ² = ‖W·(m − model)‖².
+    is D·G), χ² = ‖W·(m − model)‖², the sizes of the extra unknowns, and the data sheet's part (below).
+
+    ``prior``: the data sheet as a prior of every parameter, θ_k ~ N(nominal_k, :data:`plansim.fit.identify.
+    UNINFORMATIVE_U`_k²), as further whitened residuals (θ_k − nominal_k)/U_k (a ridge regression towards the
+    nominal point; the tilts get none). Where the data determine a combination far better than a data sheet its
+    pull is (u/U)² of the estimate's distance from nominal — 10⁻⁶ of it for a scale factor known to 10⁻⁴; along a
+    direction they determine only weakly it holds the estimate and its u where the data sheet does. The last
+    element is then (∂θ̂/∂nominal (39, 39), ∂(D·z)/∂nominal (6S, 39), ∂z/∂nominal), the gains of the prior's
+    mean, whose Type B u is U; otherwise None. χ² stays the data's.
 
     ``extra`` (6S, m): further unknowns c that add ``extra·c`` to the means (an effect beyond eq. (1)/(2),
     linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
@@ -856,6 +889,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     ``ValueError``.
     """
     n = len(theta0)
+    n_rows = W.shape[0]
     extra = np.zeros((len(observed), 0)) if extra is None else np.asarray(extra, dtype=float)
     if extra.shape[1]:
         basis = np.block([[basis, np.zeros((basis.shape[0], extra.shape[1]))],
@@ -864,7 +898,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         empty = np.zeros((len(observed), 0))
         chi2 = float(np.sum((W @ (observed - J_linear @ theta0)) ** 2)) if model.n_tilts == 0 else \
             float(np.sum((W @ (observed - model.means(theta0, tilts0).ravel())) ** 2))
-        return theta0.copy(), tilts0.copy(), np.zeros((n, len(observed))), empty, empty.T, chi2, np.zeros(0)
+        return theta0.copy(), tilts0.copy(), np.zeros((n, len(observed))), empty, empty.T, chi2, np.zeros(0), None
 
     m = extra.shape[1]
     nt = basis.shape[0] - m  # θ and the nuisance parameters
@@ -876,10 +910,15 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     def shift(z):
         return extra @ z[basis.shape[1] - m:] if m else 0.0
 
+    # the data sheet's prior: whitened rows P·(θ − nominal), P = diag(1/U); none (zero rows) without it
+    P = np.diag(1.0 / UNINFORMATIVE_LIMITS) if prior else np.zeros((0, n))
+    nominal = nominal_parameters()
+    X_prior = P @ basis[:n]
+
     if model.n_tilts == 0:
         design = np.hstack([J_linear, extra]) @ basis
-        X = W @ design
-        y = W @ (observed - J_linear @ theta0)
+        X = np.vstack([W @ design, X_prior])
+        y = np.concatenate([W @ (observed - J_linear @ theta0), P @ (nominal - theta0)])
         result = least_squares(lambda z: X @ z - y, np.zeros(basis.shape[1]), jac=lambda z: X, method="lm",
                                x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15)
     else:
@@ -889,16 +928,20 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
 
         def residual(z):
             theta, tilts = unpack(z)
-            return W @ (model.means(theta, tilts).ravel() + shift(z) - observed)
+            return np.concatenate([W @ (model.means(theta, tilts).ravel() + shift(z) - observed),
+                                   P @ (theta - nominal)])
+
+        def jacobian(z):
+            return np.vstack([W @ design_at(z), X_prior])
 
         def run(z0):
-            result = least_squares(residual, z0, jac=lambda z: W @ design_at(z), method="lm", x_scale="jac",
+            result = least_squares(residual, z0, jac=jacobian, method="lm", x_scale="jac",
                                    xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
             if result.success:
                 return result, 0.0, 0.0, 0
             # it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's part in
             # the design's column space)
-            return (result, *_gauss_newton_decrease(W @ design_at(result.x), result.fun, basis[:n]))
+            return (result, *_gauss_newton_decrease(jacobian(result.x), result.fun, basis[:n]))
 
         # start from the linear solution with the tilts held at their first guess, then free them together; where
         # that start leads the search astray (a near-null direction the linear step takes at full length: hand
@@ -906,7 +949,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         # ends above the first guess's own χ² (a minimum the linear step fell into)
         z0 = np.zeros(basis.shape[1])
         if linear_start:
-            outcome = run(np.linalg.lstsq(W @ design_at(z0), -residual(z0), rcond=None)[0])
+            outcome = run(np.linalg.lstsq(jacobian(z0), -residual(z0), rcond=None)[0])
             if _short(*outcome[1:]) or outcome[0].cost > 0.5 * float(np.sum(residual(z0) ** 2)):
                 outcome = min(outcome, run(z0), key=lambda r: r[0].cost)
         else:
@@ -920,10 +963,18 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         if not result.success and stalled is not None:
             stalled.append((int(result.nfev), decrease, weak, n_weak))
         design = design_at(result.x)
-        X = W @ design
-    gain_z = np.linalg.lstsq(X, W, rcond=None)[0]
+        X = jacobian(result.x)
+    # the gain of z on (the means, the prior's mean): X's rows are W·(means) and P·(θ − nominal)
+    inputs = np.zeros((X.shape[0], W.shape[1] + P.shape[0]))
+    inputs[:n_rows, :W.shape[1]] = W
+    if prior:
+        inputs[n_rows:, W.shape[1]:] = P
+    gain_all = np.linalg.lstsq(X, inputs, rcond=None)[0]
+    gain_z, gain_prior = gain_all[:, :W.shape[1]], gain_all[:, W.shape[1]:]
     theta, tilts = unpack(result.x)
-    return theta, tilts, basis[:n] @ gain_z, design, gain_z, 2.0 * float(result.cost), result.x[len(result.x) - m:]
+    chi2 = float(np.sum(result.fun[:n_rows] ** 2))
+    prior_gains = (basis[:n] @ gain_prior, design @ gain_prior, gain_prior) if prior else None
+    return theta, tilts, basis[:n] @ gain_z, design, gain_z, chi2, result.x[len(result.x) - m:], prior_gains
 
 
 def _noise_segments(schedule) -> list[int]:
@@ -1125,6 +1176,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                             model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)])[rows])
     theta, tilts, levels = theta0, tilts0, None
     slow = None
+    # the data sheet as a prior (_solve), once the data leave some direction to it: then in every later solve
+    use_prior = False
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
     # noise the residuals show beyond the prediction (slow noise the segments are too short to show)
     for iteration in range(3):
@@ -1146,8 +1199,15 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             working = work.covariance()
         W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
         stall: list = []
-        theta, tilts, gain, design, gain_z, chi2, c = _solve(model, basis, theta0, tilts0, m, W, J, extra=E,
-                                                             stalled=stall)
+        try:
+            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=use_prior)
+        except ValueError:
+            if use_prior:
+                raise
+            # a search that stops short may be walking a valley only the data sheet bounds: with it
+            stall, use_prior = [], True
+            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True)
+        theta, tilts, gain, design, gain_z, chi2, c, prior_gains = solution
         rank, step_basis = ident.rank, basis
         if model.n_tilts:
             # at the fitted tilts, second-order terms separate what a tilt stood in for at the nominal point (an
@@ -1158,17 +1218,33 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                 second_stall: list = []
                 try:
                     second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E,
-                                    stalled=second_stall)
+                                    stalled=second_stall, prior=use_prior)
                 except ValueError:
                     second = None
                 if second is not None and chi2 - second[5] > _chi2_quantile(local.rank - rank, 0.99):
-                    theta, tilts, gain, design, gain_z, chi2, c = second
+                    theta, tilts, gain, design, gain_z, chi2, c, prior_gains = second
                     rank, step_basis, stall = local.rank, local.basis, second_stall
+        if not use_prior and _weak_directions(
+                W @ design, np.hstack([step_basis[:len(theta0)], np.zeros((len(theta0), n_extra))]))[1].any():
+            # the data leave a direction to what a data sheet already says: the data sheet holds it (estimate and
+            # u alike), from here on
+            use_prior, stall = True, []
+            try:  # from where the data alone left it, or, where the prior's pull along a curved valley takes
+                # longer than the search may walk, from the start
+                solution = _solve(model, step_basis, theta, tilts, m, W, J, linear_start=False, extra=E,
+                                  stalled=stall, prior=True)
+            except ValueError:
+                stall = []
+                solution = _solve(model, step_basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True)
+            theta, tilts, gain, design, gain_z, chi2, c, prior_gains = solution
         J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
         fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
+        # what the data sheet's prior puts into the fitted means (its mean's Type B u through their gain on it)
+        held_by_prior = 0.0 if prior_gains is None else \
+            (prior_gains[1] * UNINFORMATIVE_LIMITS[None, :]) @ (prior_gains[1] * UNINFORMATIVE_LIMITS[None, :]).T
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
-        levels = (fitted, hat @ _prior_covariance(V, sources, noise, fitted, J) @ hat.T)
+        levels = (fitted, hat @ _prior_covariance(V, sources, noise, fitted, J) @ hat.T + held_by_prior)
         if iteration == 1:
             residual_predicted = m - fitted.ravel()  # the fit with the predicted noise alone, for its χ²
             slow = between_noise if between_noise is not None else \
@@ -1186,25 +1262,37 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                          if n_weak else "") + ": it was walking a direction the data barely determine (poses "
                      "placed by hand whose gravity directions leave part of the model nearly free); the "
                      "estimates' u along it are correspondingly large")
+    if prior_gains is not None:
+        notes.append("the data leave some direction of the fitted parameters no better determined than a MEMS data "
+                     "sheet says (a step of one u along it moves a parameter beyond plansim.fit.identify."
+                     "UNINFORMATIVE_U): the fit carries the data sheet as a prior of every parameter (nominal ± "
+                     "UNINFORMATIVE_U, the 'data_sheet' part of u), which holds the estimate and its u along those "
+                     "directions and pulls a well-determined one by (u/U)² of its distance from nominal; a parameter "
+                     "that owes more than half its variance to it is listed as determined only weakly")
     held_sources = _Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
         if held_cross else []
     for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
         held_sources.add(J[:, a] + J[:, b], u, math.inf, "held")
-    joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask)
+    joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask,
+                       prior_gain=None if prior_gains is None else prior_gains[0])
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
-    residual_cov = project @ V @ project.T
+    residual_cov = project @ V @ project.T + held_by_prior
     residual_sd = np.where(rows, np.sqrt(np.maximum(np.diag(residual_cov), 0.0)), math.nan).reshape(observed.shape)
     # χ² of the fit with the predicted noise (the within-segment model, quantisation, table, site) against it,
     # not against the between-segment part estimated from these same residuals
     chi2 = float(np.sum((whitening(V_predicted[np.ix_(rows, rows)]) @ select @ residual_predicted) ** 2))
-    chi2_dof = int(rows.sum()) - rank - n_extra
+    # with the data sheet's prior, the effective number of fitted combinations: the trace of the hat matrix
+    # (each direction the data determine counts 1, one the prior holds less)
+    chi2_dof = int(rows.sum()) - (rank + n_extra if prior_gains is None else int(round(float(np.trace(hat)))))
     extra_method = None
     if n_extra:
         every = np.ones(n_extra, dtype=bool)
-        extra_method = _propagate("joint_wls_extra", gain_z[gain_z.shape[0] - n_extra:], sources, every)
+        extra_method = _propagate("joint_wls_extra", gain_z[gain_z.shape[0] - n_extra:], sources, every,
+                                  prior_gain=None if prior_gains is None else
+                                  prior_gains[2][gain_z.shape[0] - n_extra:])
         extra_method = Method("joint_wls_extra", np.asarray(c, dtype=float), extra_method.u, extra_method.dof,
                               extra_method.contributions)
 
@@ -1254,7 +1342,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      covariance=V, whitening=W, design=design, rows=rows,
                      segment_times=times, basis=step_basis, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
-                     gain=gain, sources=sources, held_sources=held_sources, held=priors)
+                     gain=gain, sources=sources, held_sources=held_sources, held=priors,
+                     prior_gain=None if prior_gains is None else prior_gains[0])
     if _judged is None and model.placed.any():
         # a pose's tilt as the import read it carries the accelerometers' biases (0.5 m/s² tilts the raw specific
         # force by 3°): judged again from this fit's tilts, a component no cross-coupling the shear's prior allows

@@ -78,7 +78,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_distribution
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
-from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability
+from plansim.fit.identify import UNINFORMATIVE_LIMITS, UNINFORMATIVE_U, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -533,6 +533,10 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                 column = np.zeros(2 * n_moves)
                 column[i] = 1.0
                 sources.add(column, math.sqrt(dark), max(2 * n_moves - basis.shape[1], 1), "between")
+        if fit.prior_gain is not None:  # the joint fit's data-sheet prior (its estimate's gain on the nominal)
+            for k, column in enumerate((joint_sensitivity(Kg) @ fit.prior_gain).T):
+                if np.any(column):
+                    sources.add(column, UNINFORMATIVE_LIMITS[k], math.inf, "data_sheet")
         # the joint fit's held_sources (its gain, not its weights, took them): here weighed by and propagated
         for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
             sources.add(total @ column, u, dof, kind)

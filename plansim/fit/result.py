@@ -113,7 +113,8 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
     weak = result.weakly_determined
     data["weakly_determined"] = ("parameter", np.array([n in weak for n in PARAMETER_NAMES], dtype=np.int8),
                                  {"long_name": "1 when identified but with u beyond what a data sheet already says "
-                                               "(plansim.fit.identify.UNINFORMATIVE_U)"})
+                                               "(plansim.fit.identify.UNINFORMATIVE_U) or mostly the data sheet "
+                                               "prior's"})
     data["spec_bias"] = ("parameter", result.spec_bias,
                          {"long_name": "expected error of the specification's estimators at the joint estimate "
                                        "(the site's Earth rate and gravity; NaN when not computed)"})
