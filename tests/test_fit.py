@@ -301,6 +301,53 @@ def test_a_six_position_log_fits_what_it_identifies_and_says_what_not():
     assert all(d["estimate"] is None for d in document["parameters"] if d["name"] not in result.identified)
 
 
+def test_a_lab_states_its_units_data_sheet_and_the_data_can_contradict_it():
+    """A scenario's ``[reduction] data_sheet_<group>`` replaces the consumer MEMS data sheet (UNINFORMATIVE_U) for
+    its unit; a bad value is refused naming the field. Stated at 1 µg for the accelerometer biases, below the
+    2.6 µg the 6 positions determine them to, it leaves the biases' directions to the data sheet: the fit carries it
+    as a prior (a note says so), holds Bax, Bay, Baz to u ≤ 1 µg and flags them as determined only weakly; what the
+    positions determine independently of the biases — every gyro bias and g-sensitivity — moves by less than 0.01 of
+    its u. Such a data sheet is wrong for this unit (the simulated biases are ~10³ µg), and χ² says so: P < 10⁻⁶,
+    against the data-sheet fit's consistent χ²."""
+    import copy
+
+    from scipy.stats import chi2 as chi2_distribution
+
+    from plansim.config import parse_scenario
+    from plansim.fit import scenario_fit_options
+    from plansim.fit.identify import HeldPriors
+
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=2, trial=0)
+    six = [k for k, s in enumerate(recording.schedule.segments) if s.test == "multi_position" and s.heading == 0.0]
+    log = _subset(recording, six)
+    document = copy.deepcopy(scenario.document)
+    document.setdefault("reduction", {})["data_sheet_ba"] = "1 ug"
+    lab = parse_scenario(document, name="lab")
+    held = scenario_fit_options(lab)["held"]
+    assert held.data_sheet["Ba"] == pytest.approx(1e-6 * 9.80665)
+    assert held.data_sheet["Kg"] == HeldPriors().data_sheet["Kg"]
+    for bad, error in (("-1 ug", ValueError), ("1 deg/s", ValueError)):
+        document["reduction"]["data_sheet_ba"] = bad
+        with pytest.raises(error, match="reduction.data_sheet_ba"):
+            parse_scenario(document)
+
+    site = resolve_site(scenario=scenario)
+    sheet = fit_recording(log, site, scenario.turntable)
+    fit = fit_recording(log, site, scenario.turntable, held=held)
+    assert sheet.prior_gain is None and fit.prior_gain is not None
+    assert any("carries the data sheet as a prior" in note for note in fit.notes), fit.notes
+    biases = [PARAMETER_NAMES.index(n) for n in ("Bax", "Bay", "Baz")]
+    assert np.all(sheet.joint.u[biases] > 2 * held.data_sheet["Ba"])
+    assert np.all(fit.joint.u[biases] <= held.data_sheet["Ba"] * (1 + 1e-9))
+    assert set(fit.weakly_determined) == {"Bax", "Bay", "Baz"}, fit.weakly_determined
+    gyros = [PARAMETER_NAMES.index(n) for n in fit.identified if n.startswith(("Bg", "g"))]
+    assert len(gyros) == 12
+    assert np.all(np.abs(fit.joint.estimate[gyros] - sheet.joint.estimate[gyros]) < 0.01 * sheet.joint.u[gyros])
+    assert chi2_distribution.sf(sheet.chi2, sheet.chi2_dof) > 1e-3
+    assert chi2_distribution.sf(fit.chi2, fit.chi2_dof) < 1e-6
+
+
 def test_segments_it_cannot_fit_yet_are_listed_with_the_reason():
     scenario = load_scenario("linear_gaussian")
     recording = simulate_and_record(scenario, seed=2, trial=0)

@@ -158,6 +158,12 @@ class Turntable:
                           self.position_repeatability.standard_uncertainty)
 
 
+#: the parameter groups a scenario's ``[reduction]`` may give its data sheet's u for (``data_sheet_<group>``), and
+#: the kind of quantity of each
+DATA_SHEET_KEYS = {"Kg": "dimensionless", "Bg": "angular_rate", "G": "rate_per_acceleration", "Ka": "dimensionless",
+                   "Ba": "acceleration", "P": "acceleration_per_rate_squared"}
+
+
 @dataclass(frozen=True)
 class Reduction:
     """Choices a lab makes when it reduces the data with the specification's formulas."""
@@ -171,6 +177,10 @@ class Reduction:
     held_gyro: float | None = None
     held_accel_cross: float | None = None
     held_g_sensitivity: float | None = None
+    #: (group, u) pairs, SI: the unit's data sheet, beyond which a fitted parameter's u says no more than it does and
+    #: which the fit carries as a prior where the data leave a direction to it (``data_sheet_kg`` … ``data_sheet_p``;
+    #: plansim.fit.identify.HeldPriors.data_sheet); empty where the scenario does not say (a consumer MEMS unit's)
+    data_sheet: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -577,9 +587,17 @@ def parse_scenario(document: dict, name: str | None = None, source: str = "") ->
                       ("held_g_sensitivity", "rate_per_acceleration")):
         if r.get(key) is not None:
             held[key] = _nonneg(r.quantity(key, kind, None), r.where(key))
+    data_sheet = []
+    for group, kind in DATA_SHEET_KEYS.items():
+        key = f"data_sheet_{group.lower()}"
+        if r.get(key) is not None:
+            value = r.quantity(key, kind, None)
+            if not value > 0:
+                raise ValueError(f"{r.where(key)} = {r.get(key)!r}: a data sheet's standard uncertainty must be > 0")
+            data_sheet.append((group, value))
     reduction = Reduction(reference_gravity=g_ref, reference_gravity_label=g_label,
                           omega_squared_sign=r.string("omega_squared_sign", "model", allowed=("model", "as_printed")),
-                          **held)
+                          data_sheet=tuple(data_sheet), **held)
     r.check_unknown()
 
     description = document.get("description", "")

@@ -72,12 +72,19 @@ class HeldPriors:
     (``accel_cross``, dimensionless), a gyro's g-sensitivity (``g_sensitivity``, rad/s per m/s²). The defaults are
     a consumer MEMS data sheet's (:data:`HELD_KG_UNCERTAINTY`, :data:`HELD_KA_UNCERTAINTY`,
     :data:`HELD_G_UNCERTAINTY`); a lab's scenario may state its own (``[reduction]`` ``held_gyro``,
-    ``held_accel_cross``, ``held_g_sensitivity``). ``source`` says where they came from, for the report."""
+    ``held_accel_cross``, ``held_g_sensitivity``). ``source`` says where they came from, for the report.
+
+    ``data_sheet``: per parameter group (Kg, Bg, G, Ka, Ba, P), the standard uncertainty (SI) beyond which an
+    estimate says no more of the unit than its data sheet — the limits of *determined only weakly* and the data
+    sheet's prior of the joint fit (docs/fitting.md, Identifiability); default :data:`UNINFORMATIVE_U`, a consumer
+    MEMS data sheet's; a lab's scenario may state its unit's (``[reduction]`` ``data_sheet_kg`` … ``data_sheet_p``).
+    """
 
     gyro: float = HELD_KG_UNCERTAINTY
     accel_cross: float = HELD_KA_UNCERTAINTY
     g_sensitivity: float = HELD_G_UNCERTAINTY
     source: str = "data-sheet defaults"
+    data_sheet: dict = field(default_factory=lambda: dict(UNINFORMATIVE_U))
 
     def __post_init__(self):
         for name in ("gyro", "accel_cross", "g_sensitivity"):
@@ -86,6 +93,34 @@ class HeldPriors:
                 raise TypeError(f"HeldPriors.{name} = {value!r}: expected a number")
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"HeldPriors.{name} = {value!r}: a standard uncertainty must be finite and >= 0")
+        if not isinstance(self.data_sheet, dict):
+            raise TypeError(f"HeldPriors.data_sheet = {self.data_sheet!r}: expected a dict of group -> u")
+        unknown = set(self.data_sheet) - set(UNINFORMATIVE_U)
+        if unknown:
+            raise ValueError(f"HeldPriors.data_sheet has group(s) {sorted(unknown)}: allowed "
+                             f"{list(UNINFORMATIVE_U)}")
+        for group, value in self.data_sheet.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise TypeError(f"HeldPriors.data_sheet[{group!r}] = {value!r}: expected a number")
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"HeldPriors.data_sheet[{group!r}] = {value!r}: a standard uncertainty must be "
+                                 "finite and > 0")
+        object.__setattr__(self, "data_sheet", dict(UNINFORMATIVE_U) | dict(self.data_sheet))
+
+    def describe_data_sheet(self) -> str:
+        """The data sheet's u per group in display units, for a report: 'Kg 0.1, Bg 7.2e+04 deg/h, …'."""
+        parts = []
+        for group, value in self.data_sheet.items():
+            spec = next(p for p in PARAMETERS if p.group == group)
+            unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"
+            parts.append(f"{group} {value / spec.display_factor:.3g}{unit}")
+        return ", ".join(parts)
+
+    @property
+    def limits(self) -> np.ndarray:
+        """:attr:`data_sheet` per parameter, in the order of :data:`~plansim.model.parameters.PARAMETER_NAMES`
+        (SI)."""
+        return np.array([self.data_sheet[p.group] for p in PARAMETERS])
 
 
 @dataclass(frozen=True)
@@ -190,11 +225,13 @@ def identifiability(design: np.ndarray, what: str = "the recording's segments", 
     return Identifiability(tuple(identified), not_identified, rank, row_space, scale)
 
 
-def weakly_determined(identified, u: np.ndarray, data_sheet: np.ndarray | None = None) -> dict:
+def weakly_determined(identified, u: np.ndarray, data_sheet: np.ndarray | None = None,
+                      limits: np.ndarray | None = None) -> dict:
     """name -> why, for each parameter in *identified* whose standard uncertainty *u* ((39,) SI, in the order of
     :data:`~plansim.model.parameters.PARAMETER_NAMES`; NaN where not estimated) exceeds its group's
     :data:`UNINFORMATIVE_U`, or, where the fit carried the data sheet as a prior, whose u owes more than half its
-    variance to that prior (*data_sheet*: (39,) the prior's part of u): identified by the design's rank, but left
+    variance to that prior (*data_sheet*: (39,) the prior's part of u; *limits* (39,) the groups' u, default
+    :data:`UNINFORMATIVE_LIMITS`, or a lab's :attr:`HeldPriors.limits`): identified by the design's rank, but left
     by the data where its estimate says no more of the unit than a data sheet. The estimate and its u stay in the
     report; this says how to read them."""
     out = {}
@@ -204,8 +241,9 @@ def weakly_determined(identified, u: np.ndarray, data_sheet: np.ndarray | None =
     prior = np.zeros(len(PARAMETERS)) if data_sheet is None else np.nan_to_num(np.asarray(data_sheet, dtype=float))
     if prior.shape != (len(PARAMETERS),):
         raise ValueError(f"data_sheet has shape {prior.shape}: expected ({len(PARAMETERS)},), one per parameter")
+    limits = UNINFORMATIVE_LIMITS if limits is None else np.asarray(limits, dtype=float)
     for k, spec in enumerate(PARAMETERS):
-        limit = UNINFORMATIVE_LIMITS[k]
+        limit = limits[k]
         if spec.name not in identified or not math.isfinite(u[k]):
             continue
         factor = spec.display_factor

@@ -372,7 +372,8 @@ class FitResult:
             u = np.where(smaller, self.moves.method.u, u)
             data_sheet = np.where(smaller, np.nan_to_num(self.moves.method.contributions.get("data_sheet", zero)),
                                   data_sheet)
-        return weakly_determined(self.identified, np.where(np.isfinite(u), u, math.nan), data_sheet)
+        return weakly_determined(self.identified, np.where(np.isfinite(u), u, math.nan), data_sheet,
+                                 self.held.limits)
 
     @property
     def methods(self) -> tuple[Method, ...]:
@@ -749,17 +750,18 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
 
 
 def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "",
-               prior_gain: np.ndarray | None = None) -> Method:
+               prior_gain: np.ndarray | None = None, prior_u: np.ndarray = UNINFORMATIVE_LIMITS) -> Method:
     """θ̂ = gain · m (+ prior_gain · nominal): u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent
-    sources, and, with *prior_gain* (39, 39), the data sheet's prior of the joint fit (:func:`_solve`), one Type B
-    input per parameter with u = :data:`plansim.fit.identify.UNINFORMATIVE_U` (kind ``data_sheet``)."""
+    sources, and, with *prior_gain* (·, 39), the data sheet's prior of the joint fit (:func:`_solve`), one Type B
+    input per parameter with u = *prior_u* (39,) (default :data:`plansim.fit.identify.UNINFORMATIVE_U`; kind
+    ``data_sheet``)."""
     contributions = gain @ sources.matrix()  # (39, n)
     dofs = np.asarray(sources.dof)
     kinds = np.asarray(sources.kind, dtype=object)
     if prior_gain is not None:
-        contributions = np.hstack([contributions, prior_gain * UNINFORMATIVE_LIMITS[None, :]])
-        dofs = np.concatenate([dofs, np.full(len(UNINFORMATIVE_LIMITS), math.inf)])
-        kinds = np.concatenate([kinds, np.full(len(UNINFORMATIVE_LIMITS), "data_sheet", dtype=object)])
+        contributions = np.hstack([contributions, prior_gain * np.asarray(prior_u)[None, :]])
+        dofs = np.concatenate([dofs, np.full(len(prior_u), math.inf)])
+        kinds = np.concatenate([kinds, np.full(len(prior_u), "data_sheet", dtype=object)])
     u = np.full(gain.shape[0], math.nan)
     nu = np.full(gain.shape[0], math.nan)
     for k in np.flatnonzero(mask):
@@ -825,28 +827,30 @@ def _far_tilts(tilts: np.ndarray, n_placed: int, beyond: float = APPROXIMATE_TIL
     return out
 
 
-def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.ndarray) -> tuple[float, float, int]:
+def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.ndarray,
+                           limits: np.ndarray = UNINFORMATIVE_LIMITS) -> tuple[float, float, int]:
     """What one more Gauss–Newton step would take off χ² where a search stopped: the whitened *residual*'s part in
     the column space of the whitened design *X* (its columns the fit's unknowns z, θ = θ0 + *theta_basis*·z),
     split by the design's singular directions into the part along directions the data determine and the part
     along directions they determine only weakly — where a step of one standard uncertainty moves some parameter
     beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U` (the parameters :attr:`FitResult.
     weakly_determined` flags). Returns (determined part, weak part, number of weak directions)."""
-    left, weak = _weak_directions(X, theta_basis)
+    left, weak = _weak_directions(X, theta_basis, limits)
     parts = (left.T @ residual) ** 2
     return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
 
 
-def _weak_directions(X: np.ndarray, theta_basis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _weak_directions(X: np.ndarray, theta_basis: np.ndarray,
+                     limits: np.ndarray = UNINFORMATIVE_LIMITS) -> tuple[np.ndarray, np.ndarray]:
     """The whitened design *X*'s left singular vectors (those above lstsq's cut), and for each whether the data
     determine it only weakly: a step of one standard uncertainty along it (θ = θ0 + *theta_basis*·z) moves some
-    parameter beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U`."""
+    parameter beyond its group's *limits* ((39,), default :data:`plansim.fit.identify.UNINFORMATIVE_U`)."""
     if X.shape[1] == 0:
         return np.zeros((X.shape[0], 0)), np.zeros(0, dtype=bool)
     left, singular, right = np.linalg.svd(X, full_matrices=False)
     kept = singular > np.finfo(float).eps * max(X.shape) * max(singular.max(initial=0.0), 1e-300)  # lstsq's cut
     one_sigma = (theta_basis @ right[kept].T) / singular[kept]  # (39, k): θ's step of 1 u along each direction
-    weak = np.max(np.abs(one_sigma) / UNINFORMATIVE_LIMITS[:, None], axis=0, initial=0.0) > 1.0
+    weak = np.max(np.abs(one_sigma) / np.asarray(limits)[:, None], axis=0, initial=0.0) > 1.0
     return left[:, kept], weak
 
 
@@ -860,7 +864,7 @@ def _short(decrease: float, weak: float, n_weak: int) -> bool:
 
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
            W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None,
-           stalled: list | None = None, prior: bool = False):
+           stalled: list | None = None, prior: bool = False, limits: np.ndarray = UNINFORMATIVE_LIMITS):
     """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
 
     The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
@@ -871,13 +875,13 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     identified combinations D (6S, rank) at the solution and the gain G (rank, 6S) of z (the fit's hat matrix
     is D·G), χ² = ‖W·(m − model)‖², the sizes of the extra unknowns, and the data sheet's part (below).
 
-    ``prior``: the data sheet as a prior of every parameter, θ_k ~ N(nominal_k, :data:`plansim.fit.identify.
-    UNINFORMATIVE_U`_k²), as further whitened residuals (θ_k − nominal_k)/U_k (a ridge regression towards the
-    nominal point; the tilts get none). Where the data determine a combination far better than a data sheet its
-    pull is (u/U)² of the estimate's distance from nominal — 10⁻⁶ of it for a scale factor known to 10⁻⁴; along a
-    direction they determine only weakly it holds the estimate and its u where the data sheet does. The last
-    element is then (∂θ̂/∂nominal (39, 39), ∂(D·z)/∂nominal (6S, 39), ∂z/∂nominal), the gains of the prior's
-    mean, whose Type B u is U; otherwise None. χ² stays the data's.
+    ``prior``: the data sheet as a prior of every parameter, θ_k ~ N(nominal_k, U_k²) with U the data sheet's
+    *limits* (default :data:`plansim.fit.identify.UNINFORMATIVE_U`, per parameter), as further whitened residuals
+    (θ_k − nominal_k)/U_k (a ridge regression towards the nominal point; the tilts get none). Where the data
+    determine a combination far better than a data sheet its pull is (u/U)² of the estimate's distance from nominal
+    — 10⁻⁶ of it for a scale factor known to 10⁻⁴; along a direction they determine only weakly it holds the
+    estimate and its u where the data sheet does. The last element is then (∂θ̂/∂nominal (39, 39), ∂(D·z)/∂nominal
+    (6S, 39), ∂z/∂nominal), the gains of the prior's mean, whose Type B u is U; otherwise None. χ² stays the data's.
 
     ``extra`` (6S, m): further unknowns c that add ``extra·c`` to the means (an effect beyond eq. (1)/(2),
     linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
@@ -911,7 +915,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         return extra @ z[basis.shape[1] - m:] if m else 0.0
 
     # the data sheet's prior: whitened rows P·(θ − nominal), P = diag(1/U); none (zero rows) without it
-    P = np.diag(1.0 / UNINFORMATIVE_LIMITS) if prior else np.zeros((0, n))
+    P = np.diag(1.0 / np.asarray(limits, dtype=float)) if prior else np.zeros((0, n))
     nominal = nominal_parameters()
     X_prior = P @ basis[:n]
 
@@ -941,7 +945,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
                 return result, 0.0, 0.0, 0
             # it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's part in
             # the design's column space)
-            return (result, *_gauss_newton_decrease(jacobian(result.x), result.fun, basis[:n]))
+            return (result, *_gauss_newton_decrease(jacobian(result.x), result.fun, basis[:n], limits))
 
         # start from the linear solution with the tilts held at their first guess, then free them together; where
         # that start leads the search astray (a near-null direction the linear step takes at full length: hand
@@ -1089,7 +1093,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     notes = [] if held is None else [
         f"what the fit holds at nominal carries the Type B u of {priors.source}: a gyro scale factor or "
         f"cross-coupling {priors.gyro:g}, the accelerometers' shear {priors.accel_cross:g}, a g-sensitivity "
-        f"{float(to_unit(priors.g_sensitivity, 'rate_per_acceleration', 'deg/s/g')):g} (deg/s)/g"]
+        f"{float(to_unit(priors.g_sensitivity, 'rate_per_acceleration', 'deg/s/g')):g} (deg/s)/g; the unit's data "
+        f"sheet: {priors.describe_data_sheet()}"]
     if turntable is None:
         turntable, turntable_source = TABLE_1_TURNTABLE, turntable_source or "JJF 2003 Table 1"
     schedule = recording.schedule
@@ -1178,6 +1183,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     slow = None
     # the data sheet as a prior (_solve), once the data leave some direction to it: then in every later solve
     use_prior = False
+    limits = priors.limits
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
     # noise the residuals show beyond the prediction (slow noise the segments are too short to show)
     for iteration in range(3):
@@ -1200,13 +1206,14 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
         stall: list = []
         try:
-            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=use_prior)
+            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=use_prior,
+                              limits=limits)
         except ValueError:
             if use_prior:
                 raise
             # a search that stops short may be walking a valley only the data sheet bounds: with it
             stall, use_prior = [], True
-            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True)
+            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True, limits=limits)
         theta, tilts, gain, design, gain_z, chi2, c, prior_gains = solution
         rank, step_basis = ident.rank, basis
         if model.n_tilts:
@@ -1218,31 +1225,32 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                 second_stall: list = []
                 try:
                     second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E,
-                                    stalled=second_stall, prior=use_prior)
+                                    stalled=second_stall, prior=use_prior, limits=limits)
                 except ValueError:
                     second = None
                 if second is not None and chi2 - second[5] > _chi2_quantile(local.rank - rank, 0.99):
                     theta, tilts, gain, design, gain_z, chi2, c, prior_gains = second
                     rank, step_basis, stall = local.rank, local.basis, second_stall
         if not use_prior and _weak_directions(
-                W @ design, np.hstack([step_basis[:len(theta0)], np.zeros((len(theta0), n_extra))]))[1].any():
+                W @ design, np.hstack([step_basis[:len(theta0)], np.zeros((len(theta0), n_extra))]), limits)[1].any():
             # the data leave a direction to what a data sheet already says: the data sheet holds it (estimate and
             # u alike), from here on
             use_prior, stall = True, []
             try:  # from where the data alone left it, or, where the prior's pull along a curved valley takes
                 # longer than the search may walk, from the start
                 solution = _solve(model, step_basis, theta, tilts, m, W, J, linear_start=False, extra=E,
-                                  stalled=stall, prior=True)
+                                  stalled=stall, prior=True, limits=limits)
             except ValueError:
                 stall = []
-                solution = _solve(model, step_basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True)
+                solution = _solve(model, step_basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True,
+                                  limits=limits)
             theta, tilts, gain, design, gain_z, chi2, c, prior_gains = solution
         J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
         fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
         # what the data sheet's prior puts into the fitted means (its mean's Type B u through their gain on it)
         held_by_prior = 0.0 if prior_gains is None else \
-            (prior_gains[1] * UNINFORMATIVE_LIMITS[None, :]) @ (prior_gains[1] * UNINFORMATIVE_LIMITS[None, :]).T
+            (prior_gains[1] * limits[None, :]) @ (prior_gains[1] * limits[None, :]).T
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
         levels = (fitted, hat @ _prior_covariance(V, sources, noise, fitted, J) @ hat.T + held_by_prior)
         if iteration == 1:
@@ -1263,19 +1271,20 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      "placed by hand whose gravity directions leave part of the model nearly free); the "
                      "estimates' u along it are correspondingly large")
     if prior_gains is not None:
-        notes.append("the data leave some direction of the fitted parameters no better determined than a MEMS data "
-                     "sheet says (a step of one u along it moves a parameter beyond plansim.fit.identify."
-                     "UNINFORMATIVE_U): the fit carries the data sheet as a prior of every parameter (nominal ± "
-                     "UNINFORMATIVE_U, the 'data_sheet' part of u), which holds the estimate and its u along those "
-                     "directions and pulls a well-determined one by (u/U)² of its distance from nominal; a parameter "
-                     "that owes more than half its variance to it is listed as determined only weakly")
+        notes.append("the data leave some direction of the fitted parameters no better determined than the unit's "
+                     "data sheet says (a step of one u along it moves a parameter beyond its group's limit, "
+                     f"{priors.source}: {priors.describe_data_sheet()}): the fit carries the data sheet as a prior "
+                     "of every parameter (nominal ± those limits, the 'data_sheet' part of u), which holds the "
+                     "estimate and its u along those directions and pulls a well-determined one by (u/U)² of its "
+                     "distance from nominal; a parameter that owes more than half its variance to it is listed as "
+                     "determined only weakly")
     held_sources = _Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
         if held_cross else []
     for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
         held_sources.add(J[:, a] + J[:, b], u, math.inf, "held")
     joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask,
-                       prior_gain=None if prior_gains is None else prior_gains[0])
+                       prior_gain=None if prior_gains is None else prior_gains[0], prior_u=limits)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
@@ -1292,7 +1301,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         every = np.ones(n_extra, dtype=bool)
         extra_method = _propagate("joint_wls_extra", gain_z[gain_z.shape[0] - n_extra:], sources, every,
                                   prior_gain=None if prior_gains is None else
-                                  prior_gains[2][gain_z.shape[0] - n_extra:])
+                                  prior_gains[2][gain_z.shape[0] - n_extra:], prior_u=limits)
         extra_method = Method("joint_wls_extra", np.asarray(c, dtype=float), extra_method.u, extra_method.dof,
                               extra_method.contributions)
 

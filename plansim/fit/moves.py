@@ -78,7 +78,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_distribution
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
-from plansim.fit.identify import UNINFORMATIVE_LIMITS, UNINFORMATIVE_U, Identifiability, identifiability
+from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -117,7 +117,8 @@ RUNAWAY = 2.0 * max(UNIT_STARTS)
 #: identified: a gyro's scale factor is within a few per cent of 1 and its cross-couplings within 1 %, so such a
 #: direction says nothing of the unit, and the fit wandered along it (an independent simulator's 12-position log,
 #: whose y axis was turned about only while vertical: Kgyy 5.33 ± 13.7, 0.497 ± 0.053, or the moves dropped with
-#: advice to check the gyros' units). The identified directions' u is 1e-5 to 1e-2 on the logs we have
+#: advice to check the gyros' units). The identified directions' u is 1e-5 to 1e-2 on the logs we have. The default:
+#: a lab's own data sheet for Kg (a scenario's ``[reduction] data_sheet_kg``, HeldPriors.data_sheet) replaces it
 WEAK_DIRECTION_U = UNINFORMATIVE_U["Kg"]
 #: a start with some gyro axes flipped is taken over the gyros as wired only where its χ² is lower by more than
 #: this (the 99 % point of χ² with 1 degree of freedom): with poses near the six axes a half turn of the gyro
@@ -159,14 +160,16 @@ def _floored_inverse(V: np.ndarray) -> np.ndarray:
 
 
 def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, what: str, prior: float,
-                  at: str = "Kg = I", scale: float = 1.0) -> tuple[Identifiability, dict]:
+                  at: str = "Kg = I", scale: float = 1.0,
+                  limit: float = WEAK_DIRECTION_U) -> tuple[Identifiability, dict]:
     """The moves' identifiability *ident* with the Kg entries they determine only weakly held at nominal.
 
     *design* (2M, 39) is ∂r/∂θ at *at* (Kg = I, or the fitted Kg; only the Kg columns non-zero, those held
     already zero; *ident* its identifiability) and *V* (2M, 2M) the residuals' covariance there. With Q an
     orthonormal basis of what the moves determine (so that a unit step of z is a unit step of Kg), the information
     Jzᵀ V⁻¹ Jz (Jz = ∂r/∂Kg · Q; :func:`_floored_eigh`) has eigenvalues λ; while
-    the smallest gives u = 1/√λ above :data:`WEAK_DIRECTION_U`, the Kg entry with the largest share of that
+    the smallest gives u = 1/√λ above *limit* (the unit's data sheet for Kg, :attr:`HeldPriors.data_sheet`;
+    default :data:`WEAK_DIRECTION_U`, a consumer MEMS unit's), the Kg entry with the largest share of that
     direction is held (its column zeroed) and the rest looked at again. Returns the identifiability of what is
     left and, per held entry, why (held with the Type B u *prior*, :attr:`HeldPriors.gyro`). *scale* is the size
     of the gyros' scale factors there (1 at Kg = I; at the fitted
@@ -182,12 +185,12 @@ def _weak_entries(ident: Identifiability, design: np.ndarray, V: np.ndarray, wha
         information = Jz.T @ V_inverse @ Jz
         values, vectors = np.linalg.eigh(0.5 * (information + information.T))
         u = 1.0 / math.sqrt(max(float(values[0]), 1e-300)) / scale
-        if u <= WEAK_DIRECTION_U:
+        if u <= limit:
             return ident, held
         direction = np.abs(q @ vectors[:, 0])
         k = int(np.argmax(direction))
         held[KG_NAMES[k]] = (f"the moves determine it only weakly (u = {u:.3g} at {at} along the combination it "
-                             f"leads, above {WEAK_DIRECTION_U:g}): held at its nominal value with u = "
+                             f"leads, above {limit:g}): held at its nominal value with u = "
                              f"{prior:g} (a turn about an axis that is vertical, or tilted by a few "
                              "degrees, does not show its scale factor; a whole turn shows the cross-couplings of its "
                              "axis only at second order)")
@@ -536,7 +539,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         if fit.prior_gain is not None:  # the joint fit's data-sheet prior (its estimate's gain on the nominal)
             for k, column in enumerate((joint_sensitivity(Kg) @ fit.prior_gain).T):
                 if np.any(column):
-                    sources.add(column, UNINFORMATIVE_LIMITS[k], math.inf, "data_sheet")
+                    sources.add(column, fit.held.limits[k], math.inf, "data_sheet")
         # the joint fit's held_sources (its gain, not its weights, took them): here weighed by and propagated
         for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
             sources.add(total @ column, u, dof, kind)
@@ -595,7 +598,8 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     # the moves predict, and again at the fitted Kg with the noise between moves) are held at nominal, with a Type B
     # u that the moves weigh by and propagate
     first = build(np.eye(3), 0.0)
-    ident, weak = _weak_entries(ident, design, first[0].covariance(), "the moves between poses", fit.held.gyro)
+    ident, weak = _weak_entries(ident, design, first[0].covariance(), "the moves between poses", fit.held.gyro,
+                                limit=fit.held.data_sheet["Kg"])
     while True:
         if weak:
             held_kg[:] = [KG_NAMES.index(name) for name in weak]
@@ -637,7 +641,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
         fitted[:, KG_INDEX] = jacobian
         fitted[:, KG_INDEX[held_kg]] = 0.0
         ident, more = _weak_entries(ident, fitted, V, "the moves between poses", fit.held.gyro, at="the fitted Kg",
-                                    scale=float(np.mean(np.abs(np.diag(Kg)))))
+                                    scale=float(np.mean(np.abs(np.diag(Kg)))), limit=fit.held.data_sheet["Kg"])
         if not more:
             break
         weak.update(more)

@@ -185,7 +185,8 @@ def scenario_fit_options(scenario) -> dict:
       :func:`plansim.fit.noise.stated_white_noise`), where any is stated — the prior of the noise an undithered
       quantiser hides;
     - ``held``: the Type B standard uncertainties of what the fit holds at nominal (``[reduction]`` ``held_gyro``,
-      ``held_accel_cross``, ``held_g_sensitivity``; :class:`plansim.fit.identify.HeldPriors`), where any is stated;
+      ``held_accel_cross``, ``held_g_sensitivity``) and the unit's data sheet (``data_sheet_kg`` …
+      ``data_sheet_p``; :class:`plansim.fit.identify.HeldPriors`), where any is stated;
     - ``stated_step``: the acquisition's quantisation steps (``[acquisition]``, :func:`plansim.fit.noise.stated_steps`)
       where it quantises — for a channel that reads one code in every pose, whose step the data cannot show.
 
@@ -204,9 +205,10 @@ def scenario_fit_options(scenario) -> dict:
                    omega_squared_sign=scenario.reduction.omega_squared_sign)
     stated_priors = {name: getattr(scenario.reduction, f"held_{name}") for name in ("gyro", "accel_cross",
                                                                                       "g_sensitivity")}
-    if any(value is not None for value in stated_priors.values()):
+    if any(value is not None for value in stated_priors.values()) or scenario.reduction.data_sheet:
         options["held"] = HeldPriors(**{k: v for k, v in stated_priors.items() if v is not None},
-                                     source=f"scenario {scenario.name!r}, [reduction]")
+                                     source=f"scenario {scenario.name!r}, [reduction]",
+                                     data_sheet=dict(scenario.reduction.data_sheet))
     if scenario.effects.accel_lever_arm.any():
         options["lever_arm"] = scenario.effects.accel_lever_arm
     stated = stated_white_noise(scenario)
