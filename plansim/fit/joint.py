@@ -326,7 +326,7 @@ class FitResult:
     #: the Type B standard uncertainties of what the fit (and the moves) hold at nominal
     held: HeldPriors = field(default_factory=HeldPriors)
     #: with the data sheet as a prior (where the data leave a direction to it, :func:`_solve`): the joint
-    #: estimate's gain on the prior's mean, ∂θ̂/∂nominal (39, 39), each input with u = UNINFORMATIVE_U; else None
+    #: estimate's gain on the prior's mean, ∂θ̂/∂nominal (39, 39), each input with u = held.limits; else None
     prior_gain: np.ndarray | None = field(default=None, repr=False)
 
     @property
