@@ -159,9 +159,8 @@ class Turntable:
 
 
 #: the parameter groups a scenario's ``[reduction]`` may give its data sheet's u for (``data_sheet_<group>``), and
-#: the kind of quantity of each
-DATA_SHEET_KEYS = {"Kg": "dimensionless", "Bg": "angular_rate", "G": "rate_per_acceleration", "Ka": "dimensionless",
-                   "Ba": "acceleration", "P": "acceleration_per_rate_squared"}
+#: the kind of quantity of each (its parameters')
+DATA_SHEET_KEYS = {p.group: p.kind for p in PARAMETERS}
 
 
 @dataclass(frozen=True)

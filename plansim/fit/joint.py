@@ -750,10 +750,10 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
 
 
 def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "",
-               prior_gain: np.ndarray | None = None, prior_u: np.ndarray = UNINFORMATIVE_LIMITS) -> Method:
+               prior_gain: np.ndarray | None = None, prior_u: np.ndarray | None = None) -> Method:
     """θ̂ = gain · m (+ prior_gain · nominal): u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent
     sources, and, with *prior_gain* (·, 39), the data sheet's prior of the joint fit (:func:`_solve`), one Type B
-    input per parameter with u = *prior_u* (39,) (default :data:`plansim.fit.identify.UNINFORMATIVE_U`; kind
+    input per parameter with u = *prior_u* (39,) (the fit's :attr:`~plansim.fit.identify.HeldPriors.limits`; kind
     ``data_sheet``)."""
     contributions = gain @ sources.matrix()  # (39, n)
     dofs = np.asarray(sources.dof)
@@ -828,23 +828,23 @@ def _far_tilts(tilts: np.ndarray, n_placed: int, beyond: float = APPROXIMATE_TIL
 
 
 def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.ndarray,
-                           limits: np.ndarray = UNINFORMATIVE_LIMITS) -> tuple[float, float, int]:
+                           limits: np.ndarray) -> tuple[float, float, int]:
     """What one more Gauss–Newton step would take off χ² where a search stopped: the whitened *residual*'s part in
     the column space of the whitened design *X* (its columns the fit's unknowns z, θ = θ0 + *theta_basis*·z),
     split by the design's singular directions into the part along directions the data determine and the part
     along directions they determine only weakly — where a step of one standard uncertainty moves some parameter
-    beyond its group's :data:`plansim.fit.identify.UNINFORMATIVE_U` (the parameters :attr:`FitResult.
-    weakly_determined` flags). Returns (determined part, weak part, number of weak directions)."""
+    beyond its group's *limits* ((39,), the fit's data sheet; the parameters :attr:`FitResult.weakly_determined`
+    flags). Returns (determined part, weak part, number of weak directions)."""
     left, weak = _weak_directions(X, theta_basis, limits)
     parts = (left.T @ residual) ** 2
     return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
 
 
-def _weak_directions(X: np.ndarray, theta_basis: np.ndarray,
-                     limits: np.ndarray = UNINFORMATIVE_LIMITS) -> tuple[np.ndarray, np.ndarray]:
+def _weak_directions(X: np.ndarray, theta_basis: np.ndarray, limits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The whitened design *X*'s left singular vectors (those above lstsq's cut), and for each whether the data
     determine it only weakly: a step of one standard uncertainty along it (θ = θ0 + *theta_basis*·z) moves some
-    parameter beyond its group's *limits* ((39,), default :data:`plansim.fit.identify.UNINFORMATIVE_U`)."""
+    parameter beyond its group's *limits* ((39,), the fit's data sheet: :attr:`plansim.fit.identify.HeldPriors.
+    limits`)."""
     if X.shape[1] == 0:
         return np.zeros((X.shape[0], 0)), np.zeros(0, dtype=bool)
     left, singular, right = np.linalg.svd(X, full_matrices=False)
@@ -864,7 +864,7 @@ def _short(decrease: float, weak: float, n_weak: int) -> bool:
 
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
            W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None,
-           stalled: list | None = None, prior: bool = False, limits: np.ndarray = UNINFORMATIVE_LIMITS):
+           stalled: list | None = None, prior: bool = False, limits: np.ndarray | None = None):
     """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
 
     The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
@@ -876,12 +876,14 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     is D·G), χ² = ‖W·(m − model)‖², the sizes of the extra unknowns, and the data sheet's part (below).
 
     ``prior``: the data sheet as a prior of every parameter, θ_k ~ N(nominal_k, U_k²) with U the data sheet's
-    *limits* (default :data:`plansim.fit.identify.UNINFORMATIVE_U`, per parameter), as further whitened residuals
-    (θ_k − nominal_k)/U_k (a ridge regression towards the nominal point; the tilts get none). Where the data
-    determine a combination far better than a data sheet its pull is (u/U)² of the estimate's distance from nominal
-    — 10⁻⁶ of it for a scale factor known to 10⁻⁴; along a direction they determine only weakly it holds the
-    estimate and its u where the data sheet does. The last element is then (∂θ̂/∂nominal (39, 39), ∂(D·z)/∂nominal
-    (6S, 39), ∂z/∂nominal), the gains of the prior's mean, whose Type B u is U; otherwise None. χ² stays the data's.
+    *limits* ((39,), :attr:`plansim.fit.identify.HeldPriors.limits`; default the consumer MEMS data sheet's,
+    :data:`plansim.fit.identify.UNINFORMATIVE_LIMITS`), also what judges a stopped search (:func:`_short`); as
+    further whitened residuals (θ_k − nominal_k)/U_k (a ridge regression towards the nominal point; the tilts get
+    none). Where the data determine a combination far better than a data sheet its pull is (u/U)² of the estimate's
+    distance from nominal — 10⁻⁶ of it for a scale factor known to 10⁻⁴; along a direction they determine only
+    weakly it holds the estimate and its u where the data sheet does. The last element is then (∂θ̂/∂nominal (39,
+    39), ∂(D·z)/∂nominal (6S, 39), ∂z/∂nominal), the gains of the prior's mean, whose Type B u is U; otherwise None.
+    χ² stays the data's.
 
     ``extra`` (6S, m): further unknowns c that add ``extra·c`` to the means (an effect beyond eq. (1)/(2),
     linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
@@ -894,6 +896,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
     """
     n = len(theta0)
     n_rows = W.shape[0]
+    limits = UNINFORMATIVE_LIMITS if limits is None else np.asarray(limits, dtype=float)
     extra = np.zeros((len(observed), 0)) if extra is None else np.asarray(extra, dtype=float)
     if extra.shape[1]:
         basis = np.block([[basis, np.zeros((basis.shape[0], extra.shape[1]))],
@@ -915,7 +918,7 @@ def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.n
         return extra @ z[basis.shape[1] - m:] if m else 0.0
 
     # the data sheet's prior: whitened rows P·(θ − nominal), P = diag(1/U); none (zero rows) without it
-    P = np.diag(1.0 / np.asarray(limits, dtype=float)) if prior else np.zeros((0, n))
+    P = np.diag(1.0 / limits) if prior else np.zeros((0, n))
     nominal = nominal_parameters()
     X_prior = P @ basis[:n]
 
@@ -1249,8 +1252,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         fitted = model.means(theta, tilts) + ((E @ c).reshape(observed.shape) if n_extra else 0.0)
         hat = design @ gain_z
         # what the data sheet's prior puts into the fitted means (its mean's Type B u through their gain on it)
-        held_by_prior = 0.0 if prior_gains is None else \
-            (prior_gains[1] * limits[None, :]) @ (prior_gains[1] * limits[None, :]).T
+        prior_columns = None if prior_gains is None else prior_gains[1] * limits[None, :]
+        held_by_prior = 0.0 if prior_columns is None else prior_columns @ prior_columns.T
         # the fitted levels of the segment means and their uncertainties (for the quantiser's correlation)
         levels = (fitted, hat @ _prior_covariance(V, sources, noise, fitted, J) @ hat.T + held_by_prior)
         if iteration == 1:

@@ -537,9 +537,9 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
                 column[i] = 1.0
                 sources.add(column, math.sqrt(dark), max(2 * n_moves - basis.shape[1], 1), "between")
         if fit.prior_gain is not None:  # the joint fit's data-sheet prior (its estimate's gain on the nominal)
-            for k, column in enumerate((joint_sensitivity(Kg) @ fit.prior_gain).T):
+            for column, u in zip((joint_sensitivity(Kg) @ fit.prior_gain).T, fit.held.limits):
                 if np.any(column):
-                    sources.add(column, fit.held.limits[k], math.inf, "data_sheet")
+                    sources.add(column, u, math.inf, "data_sheet")
         # the joint fit's held_sources (its gain, not its weights, took them): here weighed by and propagated
         for column, u, dof, kind in zip(held_sources.columns, held_sources.u, held_sources.dof, held_sources.kind):
             sources.add(total @ column, u, dof, kind)
