@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.stats import chi2 as chi2_distribution
 
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
@@ -259,4 +260,76 @@ def weakly_determined(identified, u: np.ndarray, data_sheet: np.ndarray | None =
             continue
         out[spec.name] = (f"identified by the segments' geometry, but with {why}: read it as not determined (more "
                           "gravity directions or rates in the schedule would determine it)")
+    return out
+
+
+#: the family-wise level at which :func:`data_sheet_conflict` says the data contradict a group of the data sheet
+#: (Bonferroni over the groups it tests)
+DATA_SHEET_CONFLICT_ALPHA = 0.05
+
+
+def data_sheet_conflict(offset: np.ndarray, limits: np.ndarray, prior_gain: np.ndarray, fitted,
+                        alpha: float = DATA_SHEET_CONFLICT_ALPHA) -> dict:
+    """group -> ``{statistic, dof, p_value, contradicted}``: does the recording contradict the data sheet's entry for
+    each group of eq. (1)/(2) (Kg, Bg, G, Ka, Ba, P), where the joint fit carried the data sheet as a prior?
+
+    The prior enters the fit as whitened pseudo-observations r_k = (θ_k − nominal_k)/U_k of unit variance
+    (``plansim.fit.joint._solve``). At the solution their residuals are r = (θ̂ − nominal)/U and, if the data
+    sheet is right (the unit's parameter one draw of nominal ± U), their covariance is I − H, with H = P·A·P⁻¹
+    the prior rows' block of the augmented system's hat matrix (P = diag(1/U), A = ∂θ̂/∂nominal, *prior_gain*).
+    For a group g the statistic is the leverage-corrected residual
+
+        T_g = r_gᵀ (I − H)_gg⁺ r_g,   ~ χ²(rank (I − H)_gg) under the data sheet,
+
+    which is also the fall of the fit's whole objective when the group's prior rows are left out (the deletion
+    identity of least squares, Cook & Weisberg 1982, ch. 3): the likelihood ratio of "this group's data sheet
+    entry is wrong" against "it holds". A direction the data do not see has leverage 1 and adds no degree of
+    freedom: what only the prior says cannot contradict it. A group is *contradicted* where its p-value is below
+    *alpha* over the number of groups tested (Bonferroni).
+
+    Parameters
+    ----------
+    offset : (39,) array
+        θ̂ − nominal, SI, in the order of :data:`~plansim.model.parameters.PARAMETER_NAMES`.
+    limits : (39,) array
+        The data sheet's u per parameter (:attr:`HeldPriors.limits`), SI, > 0.
+    prior_gain : (39, 39) array
+        ∂θ̂/∂nominal of the fit with the prior.
+    fitted : (39,) bool
+        The parameters the fit estimates (the others are held and say nothing).
+    alpha : float
+        Family-wise level over the groups, 0 < alpha < 1.
+    """
+    n = len(PARAMETERS)
+    offset = np.asarray(offset, dtype=float)
+    limits = np.asarray(limits, dtype=float)
+    gain = np.asarray(prior_gain, dtype=float)
+    fitted = np.asarray(fitted, dtype=bool)
+    for name, value, shape in (("offset", offset, (n,)), ("limits", limits, (n,)), ("prior_gain", gain, (n, n)),
+                               ("fitted", fitted, (n,))):
+        if value.shape != shape:
+            raise ValueError(f"{name} has shape {value.shape}: expected {shape}")
+    if not np.all(limits > 0):
+        raise ValueError(f"limits: every data-sheet u must be > 0, got {limits[~(limits > 0)][:3]}")
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha = {alpha!r}: must be between 0 and 1")
+    r = np.where(fitted, offset / limits, 0.0)
+    hat = gain * limits[None, :] / limits[:, None]
+    residual_cov = np.eye(n) - 0.5 * (hat + hat.T)
+    out = {}
+    for group in dict.fromkeys(p.group for p in PARAMETERS):
+        idx = [k for k, p in enumerate(PARAMETERS) if p.group == group and fitted[k] and math.isfinite(r[k])]
+        if not idx:
+            continue
+        block = residual_cov[np.ix_(idx, idx)]
+        values, vectors = np.linalg.eigh(0.5 * (block + block.T))
+        keep = values > 1e-9
+        if not keep.any():
+            continue
+        projected = vectors[:, keep].T @ r[idx]
+        statistic = float(np.sum(projected**2 / values[keep]))
+        dof = int(keep.sum())
+        out[group] = {"statistic": statistic, "dof": dof, "p_value": float(chi2_distribution.sf(statistic, dof))}
+    for entry in out.values():
+        entry["contradicted"] = bool(entry["p_value"] < alpha / len(out))
     return out

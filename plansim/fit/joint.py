@@ -44,6 +44,7 @@ from plansim.fit.identify import (
     UNINFORMATIVE_LIMITS,
     HeldPriors,
     Identifiability,
+    data_sheet_conflict,
     identifiability,
     weakly_determined,
 )
@@ -328,6 +329,9 @@ class FitResult:
     #: with the data sheet as a prior (where the data leave a direction to it, :func:`_solve`): the joint
     #: estimate's gain on the prior's mean, ∂θ̂/∂nominal (39, 39), each input with u = held.limits; else None
     prior_gain: np.ndarray | None = field(default=None, repr=False)
+    #: with the data sheet as a prior: group -> {statistic, dof, p_value, contradicted}, whether the data contradict
+    #: that group's data-sheet entry (:func:`plansim.fit.identify.data_sheet_conflict`); empty without the prior
+    data_sheet_conflict: dict = field(default_factory=dict)
 
     @property
     def residuals(self) -> np.ndarray:
@@ -1258,8 +1262,18 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         levels = (fitted, hat @ _prior_covariance(V, sources, noise, fitted, J) @ hat.T + held_by_prior)
         if iteration == 1:
             residual_predicted = m - fitted.ravel()  # the fit with the predicted noise alone, for its χ²
+            if between_noise is None and prior_gains is not None:
+                # the noise between segments is the data's: estimated from the residual the data alone leave (one
+                # Gauss–Newton step without the prior, from here: exact where the model is linear), not from one the
+                # data sheet's pull puts into the means. Where the unit lies outside its data sheet, the pull's
+                # residual would otherwise read as slow noise, and the conflict it is (data_sheet_conflict) would
+                # hide in the noise it inflated; where the data sheet holds, the two residuals differ by (u/U)².
+                data_hat = design @ np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE) @ W
+                residual_data = (np.eye(len(m)) - data_hat) @ (m - fitted.ravel())
+            else:
+                data_hat, residual_data = hat, m - fitted.ravel()
             slow = between_noise if between_noise is not None else \
-                between_segment_noise(m - fitted.ravel(), V, hat, rows.reshape(observed.shape), times,
+                between_segment_noise(residual_data, V, data_hat, rows.reshape(observed.shape), times,
                                       coupled=model.n_tilts > 0)
             if not np.any(slow.variance > 0):
                 break
@@ -1281,6 +1295,17 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      "estimate and its u along those directions and pulls a well-determined one by (u/U)² of its "
                      "distance from nominal; a parameter that owes more than half its variance to it is listed as "
                      "determined only weakly")
+    conflict = {} if prior_gains is None else data_sheet_conflict(theta - nominal_parameters(), limits,
+                                                                   prior_gains[0], mask)
+    contradicted = [group for group, entry in conflict.items() if entry["contradicted"]]
+    if contradicted:
+        notes.append("the data contradict the data sheet's " + ", ".join(
+            f"{group} (chi2 {conflict[group]['statistic']:.3g} on {conflict[group]['dof']} dof, p "
+            + (f"= {conflict[group]['p_value']:.2g}" if conflict[group]["p_value"] > 0 else "< 1e-300") + ")"
+            for group in contradicted) +
+                     ": the unit lies outside what its data sheet states for them (or the data sheet's u is too "
+                     "small), and the prior pulls those estimates towards nominal; state the data sheet again "
+                     "(scenario [reduction] data_sheet_*) or fit with the consumer default")
     held_sources = _Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
         if held_cross else []
@@ -1355,7 +1380,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      segment_times=times, basis=step_basis, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
                      gain=gain, sources=sources, held_sources=held_sources, held=priors,
-                     prior_gain=None if prior_gains is None else prior_gains[0])
+                     prior_gain=None if prior_gains is None else prior_gains[0], data_sheet_conflict=conflict)
     if _judged is None and model.placed.any():
         # a pose's tilt as the import read it carries the accelerometers' biases (0.5 m/s² tilts the raw specific
         # force by 3°): judged again from this fit's tilts, a component no cross-coupling the shear's prior allows

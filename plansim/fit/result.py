@@ -17,7 +17,7 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
 JSON_KEYS = ("identified", "not_identified", "weakly_determined", "site", "turntable", "parameters", "noise",
-             "residuals", "chi2_dof", "moves")
+             "residuals", "chi2_dof", "moves", "data_sheet_conflict")
 
 
 def _number(value: float):
@@ -73,6 +73,9 @@ def fit_json(result: FitResult) -> dict:
                      "ratio": _number(result.chi2 / result.chi2_dof) if result.chi2_dof > 0 else None,
                      "verdict": result.chi2_verdict},
         "moves": _moves_json(result.moves),
+        "data_sheet_conflict": [{"group": group, "statistic": _number(entry["statistic"]), "dof": int(entry["dof"]),
+                                 "p_value": _number(entry["p_value"]), "contradicted": entry["contradicted"]}
+                                for group, entry in result.data_sheet_conflict.items()],
     }
 
 
@@ -181,6 +184,10 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
         "weakly_determined": "; ".join(f"{k}: {v}" for k, v in weak.items()),
         "moves": "none" if moves is None else (f"{len(moves.transitions)} used; chi2 {moves.chi2:.6g} on "
                                                f"{moves.chi2_dof} dof: {moves.chi2_verdict}"),
+        "data_sheet_conflict": "; ".join(
+            f"{group}: chi2 {e['statistic']:.6g} on {e['dof']} dof, p {e['p_value']:.3g}"
+            + (", contradicted" if e["contradicted"] else "") for group, e in result.data_sheet_conflict.items())
+        or "the data sheet was not carried as a prior",
         "unused_segments": "; ".join(f"{k}: {v}" for k, v in result.unused.items()),
         "notes": " | ".join(result.notes),
     })
