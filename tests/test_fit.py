@@ -431,6 +431,13 @@ def test_a_lab_states_its_units_data_sheet_and_the_data_can_contradict_it():
     assert fit.data_sheet_conflict["Ba"]["p_value"] < 1e-6
     assert any("contradict the data sheet's Ba" in note for note in fit.notes), fit.notes
     assert sheet.data_sheet_conflict == {}
+    from plansim.report.fit import fit_report
+
+    report = fit_report(fit, residuals=False)
+    assert "contradicted where p < 0.05/4" in report, report
+    lines = [line.split() for line in report.splitlines() if line.startswith("  ") and " dof, p = " in line]
+    assert [(w[0], w[-1]) for w in lines if w[-1] == "contradicted"] == [("Ba", "contradicted")], lines
+    assert "data sheet the fit carried" not in fit_report(sheet, residuals=False)
 
 
 def test_segments_it_cannot_fit_yet_are_listed_with_the_reason():

@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from plansim.fit.identify import DATA_SHEET_CONFLICT_ALPHA
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 from plansim.units import KINDS
@@ -138,6 +139,14 @@ def fit_report(result, residuals: bool = True) -> str:
 
     ratio = result.chi2 / result.chi2_dof if result.chi2_dof > 0 else math.nan
     lines += ["", f"chi2/dof = {_g(result.chi2, 5)}/{result.chi2_dof} = {_g(ratio, 4)}: {result.chi2_verdict}"]
+    if result.data_sheet_conflict:
+        tested = len(result.data_sheet_conflict)
+        lines += ["", "The data against the data sheet the fit carried as a prior, per group (the fall of the fit's "
+                  "objective without that group's prior; contradicted where p < "
+                  f"{DATA_SHEET_CONFLICT_ALPHA:g}/{tested})"]
+        for group, entry in result.data_sheet_conflict.items():
+            lines.append(f"  {group:3s} chi2 = {_g(entry['statistic'], 4)} on {entry['dof']} dof, "
+                         f"p = {_g(entry['p_value'], 3)}" + (": contradicted" if entry["contradicted"] else ""))
     if result.between:
         lines += ["", "Repeated settings (same up-axis and rate, any heading): scatter of the residuals between "
                   "segments, data against the prediction (noise model + per-setting Type B)",
