@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import chi2 as chi2_distribution
 
-from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
+from plansim.model.parameters import GROUPS, PARAMETER_NAMES, PARAMETERS
 
 #: standard uncertainty of a Kg entry that a fit holds at its nominal value (1 or 0) while it still matters: one the
 #: recording does not identify but the Earth rate reaches, or one the moves between poses determine only weakly:
@@ -317,13 +317,13 @@ def data_sheet_conflict(offset: np.ndarray, limits: np.ndarray, prior_gain: np.n
     hat = gain * limits[None, :] / limits[:, None]
     residual_cov = np.eye(n) - 0.5 * (hat + hat.T)
     out = {}
-    for group in dict.fromkeys(p.group for p in PARAMETERS):
+    for group in GROUPS:
         idx = [k for k, p in enumerate(PARAMETERS) if p.group == group and fitted[k] and math.isfinite(r[k])]
         if not idx:
             continue
         block = residual_cov[np.ix_(idx, idx)]
         values, vectors = np.linalg.eigh(0.5 * (block + block.T))
-        keep = values > 1e-9
+        keep = values > RANK_TOLERANCE  # leverage 1 to rounding: a direction only the prior sees
         if not keep.any():
             continue
         projected = vectors[:, keep].T @ r[idx]

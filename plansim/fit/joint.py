@@ -1269,9 +1269,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                 # residual would otherwise read as slow noise, and the conflict it is (data_sheet_conflict) would
                 # hide in the noise it inflated; where the data sheet holds, the two residuals differ by (u/U)².
                 data_hat = design @ np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE) @ W
-                residual_data = (np.eye(len(m)) - data_hat) @ (m - fitted.ravel())
+                residual_data = residual_predicted - data_hat @ residual_predicted
             else:
-                data_hat, residual_data = hat, m - fitted.ravel()
+                data_hat, residual_data = hat, residual_predicted
             slow = between_noise if between_noise is not None else \
                 between_segment_noise(residual_data, V, data_hat, rows.reshape(observed.shape), times,
                                       coupled=model.n_tilts > 0)
