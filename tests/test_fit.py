@@ -41,7 +41,7 @@ from plansim.fit.result import JSON_KEYS, fit_json
 from plansim.io.recording import Recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.kernels.layout import HEAD, PER_SEGMENT, SEG_POSITION_ACCURACY, draws_length
-from plansim.model.parameters import PARAMETER_NAMES
+from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 from plansim.runner import simulate_and_record
 from plansim.schedule import Schedule, Segment
 from plansim.schedule.builders import multi_position
@@ -435,8 +435,24 @@ def test_a_lab_states_its_units_data_sheet_and_the_data_can_contradict_it():
 
     report = fit_report(fit, residuals=False)
     assert "contradicted where p < 0.05/4" in report, report
-    lines = [line.split() for line in report.splitlines() if line.startswith("  ") and " dof, p = " in line]
-    assert [(w[0], w[-1]) for w in lines if w[-1] == "contradicted"] == [("Ba", "contradicted")], lines
+    lines = [line for line in report.splitlines() if line.startswith("  ") and " dof, p " in line]
+    assert [line.split()[0] for line in lines if "contradicted" in line] == ["Ba"], lines
+    # what the data alone say of each group, one Gauss-Newton step without the prior: for this linear model the fit
+    # without the data sheet, estimate and u alike; named in the note and the report for the contradicted group
+    for group, entry in fit.data_sheet_conflict.items():
+        assert set(entry["data_alone"]) == {n for n in fit.identified if PARAMETERS[PARAMETER_NAMES.index(n)].group
+                                            == group}, entry
+        for name, (estimate, u) in entry["data_alone"].items():
+            k = PARAMETER_NAMES.index(name)
+            assert abs(estimate - sheet.joint.estimate[k]) < 1e-6 * sheet.joint.u[k], (name, estimate)
+            assert u == pytest.approx(sheet.joint.u[k], rel=1e-6), (name, u)
+    bax = PARAMETER_NAMES.index("Bax")
+    shown = f"Bax {sheet.joint.estimate[bax] / 9.80665e-6:.1f} ± {sheet.joint.u[bax] / 9.80665e-6:.2g} ug"
+    assert any(shown in note for note in fit.notes), (shown, fit.notes)
+    assert [line.split()[0] for line in lines if shown in line] == ["Ba"], (shown, lines)
+    entry = next(e for e in fit_json(fit)["data_sheet_conflict"] if e["group"] == "Ba")
+    assert [(d["name"], d["unit"]) for d in entry["data_alone"]] == [(n, "m/s^2") for n in ("Bax", "Bay", "Baz")]
+    assert entry["data_alone"][0]["estimate"] == pytest.approx(sheet.joint.estimate[bax], rel=1e-9)
     assert "data sheet the fit carried" not in fit_report(sheet, residuals=False)
 
 

@@ -113,7 +113,7 @@ class HeldPriors:
         parts = []
         for group, value in self.data_sheet.items():
             spec = next(p for p in PARAMETERS if p.group == group)
-            unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"
+            unit = spec.unit_suffix
             parts.append(f"{group} {value / spec.display_factor:.3g}{unit}")
         return ", ".join(parts)
 
@@ -248,7 +248,7 @@ def weakly_determined(identified, u: np.ndarray, data_sheet: np.ndarray | None =
         if spec.name not in identified or not math.isfinite(u[k]):
             continue
         factor = spec.display_factor
-        unit = "" if spec.display_unit == "1" else f" {spec.display_unit}"
+        unit = spec.unit_suffix
         if u[k] > limit:
             why = (f"u = {u[k] / factor:.3g}{unit}, above {limit / factor:.3g}{unit}, beyond which an estimate says "
                    "no more of a MEMS unit than its data sheet")
@@ -333,3 +333,29 @@ def data_sheet_conflict(offset: np.ndarray, limits: np.ndarray, prior_gain: np.n
     for entry in out.values():
         entry["contradicted"] = bool(entry["p_value"] < alpha / len(out))
     return out
+
+
+def describe_conflict(entry: dict) -> str:
+    """One group's :func:`data_sheet_conflict` entry in words, the one wording of the note, the report and the
+    ``--out`` attribute: 'chi2 3.209e+06 on 3 dof, p < 1e-300' (a p-value the χ² survival function underflows to 0
+    is written as that bound), with ', contradicted' where it is, and then the
+    group's estimates from the data alone (``data_alone``, :func:`plansim.fit.joint.fit_recording`), in display
+    units, each to the last digit of its u's two: '; the data alone: Bax 3270.2 ± 2.6 ug, …' — what the user
+    needs to state the data sheet again."""
+    p_value = entry["p_value"]
+    text = (f"chi2 {entry['statistic']:.4g} on {entry['dof']} dof, p "
+            + (f"= {p_value:.3g}" if p_value > 0 else "< 1e-300") + (", contradicted" if entry["contradicted"] else ""))
+    alone = entry.get("data_alone") or {}
+    if alone and entry["contradicted"]:
+        parts = []
+        for name, (estimate, u) in alone.items():
+            spec = PARAMETERS[PARAMETER_NAMES.index(name)]
+            unit = spec.unit_suffix
+            value, spread = estimate / spec.display_factor, u / spec.display_factor
+            # the estimate to the last digit of its u's two (GUM 7.2.6)
+            places = min(15, max(0, 1 - math.floor(math.log10(spread)))) if math.isfinite(spread) and spread > 0 \
+                else None
+            shown = f"{value:.6g}" if places is None else f"{value:.{places}f}"
+            parts.append(f"{name} {shown} ± {spread:.2g}{unit}")
+        text += "; the data alone: " + ", ".join(parts)
+    return text

@@ -45,6 +45,7 @@ from plansim.fit.identify import (
     HeldPriors,
     Identifiability,
     data_sheet_conflict,
+    describe_conflict,
     identifiability,
     weakly_determined,
 )
@@ -753,6 +754,22 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
     return candidate
 
 
+def _data_alone(theta: np.ndarray, basis: np.ndarray, design: np.ndarray, W: np.ndarray, residual: np.ndarray,
+                sources: _Sources, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What the data alone say of the parameters, where the fit carried the data sheet as a prior: θ̂ + B·(W·D)⁺·W·r,
+    one Gauss–Newton step without the prior's rows from the solution θ̂ (the fit's own design D of the identified
+    combinations z, their basis B, the whitening W and the residual r = m − model(θ̂); exact where the model is
+    linear, and the same step that estimates the noise between segments), and its u through that gain by
+    JCGM 100 5.1.2 over the fit's *sources* (no data-sheet part). NaN where *mask* is False. Where the data sheet
+    holds, it differs from θ̂ by (u/U)² of θ̂'s distance from nominal; where the data contradict it
+    (:func:`plansim.fit.identify.data_sheet_conflict`), it is what the data put the unit at."""
+    n = len(theta)
+    step = np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE)[:basis.shape[1]] @ W
+    gain = basis[:n] @ step
+    u = _propagate("data_alone", gain, sources, mask).u
+    return np.where(mask, theta + gain @ residual, math.nan), u
+
+
 def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "",
                prior_gain: np.ndarray | None = None, prior_u: np.ndarray | None = None) -> Method:
     """θ̂ = gain · m (+ prior_gain · nominal): u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent
@@ -1297,20 +1314,25 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      "determined only weakly")
     conflict = {} if prior_gains is None else data_sheet_conflict(theta - nominal_parameters(), limits,
                                                                    prior_gains[0], mask)
-    contradicted = [group for group, entry in conflict.items() if entry["contradicted"]]
-    if contradicted:
-        notes.append("the data contradict the data sheet's " + ", ".join(
-            f"{group} (chi2 {conflict[group]['statistic']:.3g} on {conflict[group]['dof']} dof, p "
-            + (f"= {conflict[group]['p_value']:.2g}" if conflict[group]["p_value"] > 0 else "< 1e-300") + ")"
-            for group in contradicted) +
-                     ": the unit lies outside what its data sheet states for them (or the data sheet's u is too "
-                     "small), and the prior pulls those estimates towards nominal; state the data sheet again "
-                     "(scenario [reduction] data_sheet_*) or fit with the consumer default")
     held_sources = _Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
         if held_cross else []
     for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
         held_sources.add(J[:, a] + J[:, b], u, math.inf, "held")
+    if conflict:
+        alone, alone_u = _data_alone(theta, step_basis, design, W, m - fitted.ravel(), sources.joined(held_sources),
+                                     mask)
+        for group, entry in conflict.items():
+            entry["data_alone"] = {p.name: (float(alone[k]), float(alone_u[k])) for k, p in enumerate(PARAMETERS)
+                                   if p.group == group and mask[k]}
+    contradicted = [group for group, entry in conflict.items() if entry["contradicted"]]
+    if contradicted:
+        notes.append("the data contradict the data sheet's " + ", ".join(
+            f"{group} ({describe_conflict(conflict[group])})" for group in contradicted)
+            + ": the unit lies outside what its data sheet states for them (or the data sheet's u is too small), and "
+            "the prior pulls those estimates towards nominal (the data alone: one Gauss–Newton step without the "
+            "prior, u from the same sources); state the data sheet again (scenario [reduction] data_sheet_*) or fit "
+            "with the consumer default")
     joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask,
                        prior_gain=None if prior_gains is None else prior_gains[0], prior_u=limits)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)

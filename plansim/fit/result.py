@@ -11,6 +11,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from plansim.fit.identify import describe_conflict
 from plansim.fit.joint import FitResult
 from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
@@ -74,7 +75,10 @@ def fit_json(result: FitResult) -> dict:
                      "verdict": result.chi2_verdict},
         "moves": _moves_json(result.moves),
         "data_sheet_conflict": [{"group": group, "statistic": _number(entry["statistic"]), "dof": int(entry["dof"]),
-                                 "p_value": _number(entry["p_value"]), "contradicted": entry["contradicted"]}
+                                 "p_value": _number(entry["p_value"]), "contradicted": entry["contradicted"],
+                                 "data_alone": [{"name": name, "unit": PARAMETERS[PARAMETER_NAMES.index(name)].si_unit,
+                                                 "estimate": _number(estimate), "u": _number(u)}
+                                                for name, (estimate, u) in entry.get("data_alone", {}).items()]}
                                 for group, entry in result.data_sheet_conflict.items()],
     }
 
@@ -184,9 +188,8 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
         "weakly_determined": "; ".join(f"{k}: {v}" for k, v in weak.items()),
         "moves": "none" if moves is None else (f"{len(moves.transitions)} used; chi2 {moves.chi2:.6g} on "
                                                f"{moves.chi2_dof} dof: {moves.chi2_verdict}"),
-        "data_sheet_conflict": "; ".join(
-            f"{group}: chi2 {e['statistic']:.6g} on {e['dof']} dof, p {e['p_value']:.3g}"
-            + (", contradicted" if e["contradicted"] else "") for group, e in result.data_sheet_conflict.items())
+        "data_sheet_conflict": " | ".join(f"{group}: {describe_conflict(e)}"
+                                          for group, e in result.data_sheet_conflict.items())
         or "the data sheet was not carried as a prior",
         "unused_segments": "; ".join(f"{k}: {v}" for k, v in result.unused.items()),
         "notes": " | ".join(result.notes),

@@ -43,6 +43,11 @@ class ParameterSpec:
         """SI value × 1/display_factor = value in display unit."""
         return KINDS[self.kind][self.display_unit]
 
+    @property
+    def unit_suffix(self) -> str:
+        """What follows a value in display units in a sentence: ' ug', or '' for a dimensionless one."""
+        return "" if self.display_unit == "1" else f" {self.display_unit}"
+
 
 def _build() -> list[ParameterSpec]:
     specs: list[ParameterSpec] = []

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from plansim.fit.identify import DATA_SHEET_CONFLICT_ALPHA
+from plansim.fit.identify import DATA_SHEET_CONFLICT_ALPHA, describe_conflict
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 from plansim.units import KINDS
@@ -145,8 +145,7 @@ def fit_report(result, residuals: bool = True) -> str:
                   "objective without that group's prior; contradicted where p < "
                   f"{DATA_SHEET_CONFLICT_ALPHA:g}/{tested})"]
         for group, entry in result.data_sheet_conflict.items():
-            lines.append(f"  {group:3s} chi2 = {_g(entry['statistic'], 4)} on {entry['dof']} dof, "
-                         f"p = {_g(entry['p_value'], 3)}" + (": contradicted" if entry["contradicted"] else ""))
+            lines.append(f"  {group:3s} {describe_conflict(entry)}")
     if result.between:
         lines += ["", "Repeated settings (same up-axis and rate, any heading): scatter of the residuals between "
                   "segments, data against the prediction (noise model + per-setting Type B)",
