@@ -29,7 +29,7 @@ from scipy.stats import t as student
 
 from plansim.cli import main
 from plansim.fit import fit_recording
-from plansim.fit.joint import BETWEEN_LR_THRESHOLD, _chi2_verdict, _propagate, _Sources, recording_noise
+from plansim.fit.joint import recording_noise
 from plansim.fit.moves import KG_INDEX, KG_NAMES, _Moves, find_transitions, fit_moves
 from plansim.fit.site import Site
 from plansim.io.recording import Recording, read_recording
@@ -133,8 +133,7 @@ def _moves_given(rec, theta, fit):
     """fit_moves with the unit's own 39 parameters as the 'joint estimate' (exact inputs)."""
     exact = dataclasses.replace(fit, theta=theta)
     transitions, unused = find_transitions(rec)
-    return fit_moves(rec, exact, transitions, unused, recording_noise(rec), _Sources, _propagate,
-                     BETWEEN_LR_THRESHOLD, _chi2_verdict)
+    return fit_moves(rec, exact, transitions, unused, recording_noise(rec))
 
 
 def test_zero_noise_gives_kg_to_1e_9_with_the_units_own_accelerometer_model():

@@ -167,7 +167,7 @@ EXCESS_SCATTER_RATIO = 2.0
 
 def _excess_scatter(fit) -> list[dict]:
     """The channels whose segment means scatter far beyond what their samples predict, taken up by the base fit as
-    between-segment noise (:func:`plansim.fit.joint.between_segment_noise`).
+    between-segment noise (:func:`plansim.fit.between.between_segment_noise`).
 
     The lack-of-fit tests weigh the residual against a noise model that holds that between-segment noise, estimated
     from the same residuals: slow noise the segments are too short to show (a bias instability over minutes) and a

@@ -594,7 +594,7 @@ def _step_likelihood_ratios(fit, g: _Geometry, columns: np.ndarray, where: list,
     *where* giving its channel first, is scored the same way: the odd segment's too (:func:`outlier_columns`).
 
     A bias that jumps part-way through a run puts a step into the residuals, and the between-segment noise the
-    base fit estimates from those same residuals (:func:`plansim.fit.joint.between_segment_noise`: a term of
+    base fit estimates from those same residuals (:func:`plansim.fit.between.between_segment_noise`: a term of
     variance σ_c² correlated as exp(−|t_s − t_r|/τ_c) between segments) takes it up: scored against that
     inflated noise a step scores almost the same whatever its size (a linear_gaussian recording's p went from
     0.020 at 10× to 0.008 at 20× and 0.004 at 40× a segment mean's u). So the nuisance is re-estimated under each
@@ -625,7 +625,7 @@ def _profile_likelihood_ratios(fit, g: _Geometry, WS: np.ndarray, channel: np.nd
         ℓ₁(σ², τ) = ℓ₀ + ½ (Σ w_i x_i z_i)² / Σ w_i x_i²,   w_i = 1/(1 + σ²λ_i),
 
     and the statistic 2·(max ℓ₁ − max ℓ₀), both maximised over τ in
-    :data:`plansim.fit.joint.BETWEEN_CORRELATION_TIMES` and σ² on :data:`STEP_PROFILE_GRID` — for the data and
+    :data:`plansim.fit.between.BETWEEN_CORRELATION_TIMES` and σ² on :data:`STEP_PROFILE_GRID` — for the data and
     for each null draw alike, so the simulated null calibrates it whatever the grid. The other channels' between
     terms stay as the fit estimated them. At σ² = 0 with no between term in c it is the efficient score.
 
@@ -642,7 +642,7 @@ def _profile_likelihood_ratios(fit, g: _Geometry, WS: np.ndarray, channel: np.nd
     (K,) statistics, (K, B) the same on each null draw, (K,) each column's size at its maximum (the GLS estimate
     of its coefficient).
     """
-    from plansim.fit.joint import BETWEEN_CORRELATION_TIMES, time_correlation
+    from plansim.fit.between import BETWEEN_CORRELATION_TIMES, time_correlation
 
     times = np.asarray(fit.segment_times, dtype=float)
     fitted = np.asarray(fit.fitted_rows, dtype=bool)

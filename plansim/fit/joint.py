@@ -38,6 +38,14 @@ from threadpoolctl import threadpool_limits
 from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.estimate.segmentation import APPROXIMATE_TILT, MAD_TO_SIGMA
+from plansim.fit.between import (
+    BetweenSegmentNoise,
+    BetweenSegments,
+    add_between_segment_noise,
+    between_segment_noise,
+    between_segments,
+)
+from plansim.fit.budget import Method, Sources, chi2_quantile, chi2_verdict, propagate
 from plansim.fit.identify import (
     NULL_TOLERANCE,
     RANK_TOLERANCE,
@@ -56,211 +64,10 @@ from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.schedule.segments import Schedule
-from plansim.uncertainty.metrology.propagation import combine
 from plansim.units import to_unit
-
-#: two-sided probability outside which a χ² (fit, or between-segment comparison) is flagged
-CHI2_FLAG_PROBABILITY = 0.01
 
 METHOD_SPEC = "jjf2003"
 METHOD_JOINT = "joint_wls"
-
-
-@dataclass(frozen=True)
-class Method:
-    """The estimates of one method (39 each, SI; NaN where not identified).
-
-    ``contributions`` maps a kind of input (``noise``, ``table``, ``angle``, ``site``, ``held``, ``data_sheet``) to
-    the (39,) root-sum-square of its contributions: the budget in short.
-    """
-
-    name: str
-    estimate: np.ndarray
-    u: np.ndarray
-    dof: np.ndarray
-    contributions: dict = field(repr=False)
-    note: str = ""
-
-
-@dataclass(frozen=True)
-class BetweenSegmentNoise:
-    """Noise of the segment means beyond the predicted, per channel (gx gy gz ax ay az), from the fit's residuals.
-
-    ``variance`` (6,) σ_c², SI², zero where the residuals show none; ``correlation_time`` (6,) τ_c, s, of its
-    correlation exp(−|t_s − t_r|/τ_c) between segments (0: independent); ``dof`` (6,) the degrees of freedom
-    of σ_c²; ``ratio`` (6,) the mean of r_i²/d_i over the channel's fitted rows (1 when the prediction holds).
-    """
-
-    variance: np.ndarray
-    correlation_time: np.ndarray
-    dof: np.ndarray
-    ratio: np.ndarray
-
-    def covariance(self, c: int, times: np.ndarray) -> np.ndarray:
-        """(S, S) covariance of channel *c*'s term over segments at middle *times* (s)."""
-        return self.variance[c] * time_correlation(times, self.correlation_time[c])
-
-
-#: the likelihood-ratio statistic 2·Δlog L (against σ² = 0) above which the between-segment noise is taken:
-#: calibrated by simulation — 5 % of the channels of recordings with no such noise (scenario linear_gaussian,
-#: 40 recordings × 6 channels) exceed 2.95; the asymptotic ½χ²₀ + ½χ²₁ mixture has its 95 % point at 2.71,
-#: and the best of the six correlation times adds a little
-BETWEEN_LR_THRESHOLD = 3.0
-#: correlation times tried for the between-segment noise, s (0: independent segments); the likelihood picks one
-BETWEEN_CORRELATION_TIMES = (0.0, 30.0, 100.0, 300.0)
-
-
-def time_correlation(times: np.ndarray, tau: float) -> np.ndarray:
-    """(S, S) exp(−|t_s − t_r|/τ) between segments at middle *times* (s); the identity for τ ≤ 0."""
-    lag = np.abs(np.asarray(times, dtype=float)[:, None] - np.asarray(times, dtype=float)[None, :])
-    return np.eye(lag.shape[0]) if tau <= 0 else np.exp(-lag / tau)
-
-
-def between_segment_noise(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, rows: np.ndarray,
-                          times: np.ndarray, coupled: bool = False) -> BetweenSegmentNoise:
-    """The noise σ_c² (correlated over τ_c in time) of each channel's segment means that the residuals show
-    beyond V.
-
-    Segment means carry noise their own samples cannot show: a bias-instability process whose correlation
-    time is longer than a segment moves each segment's mean by up to its stationary σ, while within a 30 s
-    segment it hardly varies, so neither the scatter nor the Allan deviation of the segments sees it. The
-    residuals *between* segments do. Model for channel c: an added term b_s with Cov(b_s, b_r) =
-    σ_c²·exp(−|t_s − t_r|/τ_c) (t the segments' middle times); the residuals r = R·(e + b), R = I − H (H
-    the fit's hat matrix), have covariance Ω = R_c V R_cᵀ + σ_c²·R_cc Σ(τ_c) R_ccᵀ on the channel's fitted
-    rows. σ_c² is the restricted maximum likelihood on the residual subspace (the eigenvectors of R V Rᵀ
-    that carry variance), for each τ of :data:`BETWEEN_CORRELATION_TIMES`, and τ_c the one of largest
-    likelihood; σ_c² = 0 when the data show nothing beyond V. ν_c = Σ(1 − H_ii) over the channel's rows.
-
-    This is the "dark uncertainty" of interlaboratory comparisons (a random effect estimated from the
-    scatter beyond the stated uncertainties), per channel and correlated in time; it enters the segment
-    means' covariance as a Type A input. docs/fitting.md.
-
-    *coupled*: the fit's per-pose nuisance parameters (the tilts of poses placed by hand) couple the channels'
-    residuals — a pose's tilt moves all three accelerometers — so one channel's term shows in another's rows,
-    and each channel's own estimate counts it again there. Then the channels that took a term are estimated
-    once more together (:func:`_joint_between_variances`: the restricted likelihood of every fitted row at
-    once, each τ_c held). On a simulated 30-pose hand session with an accelerometer K2 on ax alone, the
-    channel-by-channel terms were 0.64, 1.91 and 1.34 mg on ax, ay and az; together 0.59, 0.06 and 0.10 mg
-    (test).
-    """
-    R = np.eye(residual.size) - hat
-    C = R @ V @ R.T
-    variance, taus, dof, ratio = np.zeros(6), np.zeros(6), np.zeros(6), np.ones(6)
-    for c in range(6):
-        segments = np.flatnonzero(rows[:, c])
-        idx = segments * 6 + c
-        if idx.size < 2:
-            continue
-        block = C[np.ix_(idx, idx)]
-        d = np.diag(block)
-        if not np.all(d > 0):
-            continue
-        ratio[c] = float(np.mean(residual[idx] ** 2 / d))
-        dof[c] = max(float(np.sum(1.0 - np.diag(hat)[idx])), 1.0)
-        values, vectors = np.linalg.eigh(block)
-        keep = values > 1e-9 * values.max()
-        U = vectors[:, keep] / np.sqrt(values[keep])  # whitens the predicted residual covariance
-        y = U.T @ residual[idx]
-        Rcc = R[np.ix_(idx, idx)]
-        scale = float(np.median(d))  # σ² is searched relative to the predicted residual variance
-        best = (0.0, 0.0, -0.5 * float(y @ y))  # σ² = 0: the prediction alone
-        for tau in BETWEEN_CORRELATION_TIMES:
-            A = U.T @ Rcc @ time_correlation(times[segments], tau) @ Rcc.T @ U
-            lam, Q = np.linalg.eigh(A)
-            lam = np.maximum(lam, 0.0)
-            z2 = (Q.T @ y) ** 2
-            if lam.max() <= 0:
-                continue
-            s2, log_likelihood = _reml_variance(lam, z2, scale)  # relative to the predicted scale
-            if log_likelihood > best[2]:
-                best = (s2, tau, log_likelihood)
-        gain = best[2] + 0.5 * float(y @ y)  # log-likelihood ratio against σ² = 0
-        if best[0] > 0 and 2.0 * gain > BETWEEN_LR_THRESHOLD:
-            variance[c], taus[c] = best[0], best[1]
-    if coupled and np.count_nonzero(variance) > 1:
-        variance = _joint_between_variances(residual, C, R, rows, times, variance, taus)
-    return BetweenSegmentNoise(variance, taus, dof, ratio)
-
-
-#: coordinate-ascent sweeps of :func:`_joint_between_variances`
-JOINT_BETWEEN_SWEEPS = 4
-
-
-def _joint_between_variances(residual, C, R, rows, times, variance, taus) -> np.ndarray:
-    """The between-segment variances of the channels that took one, re-estimated together: the restricted
-    likelihood of every fitted row's residual, covariance C + Σ_c σ_c² R E_c Σ(τ_c) E_cᵀ Rᵀ (E_c placing channel
-    c's segments), maximised over the σ_c² by coordinate ascent (:data:`JOINT_BETWEEN_SWEEPS` sweeps, each a
-    one-dimensional search as the channel-by-channel one (:func:`_reml_variance`), the others held), each τ_c as
-    that estimate chose it."""
-    on = np.flatnonzero(variance > 0)
-    values, vectors = np.linalg.eigh(0.5 * (C + C.T))
-    keep = values > 1e-9 * values.max()
-    U = vectors[:, keep] / np.sqrt(values[keep])
-    y = U.T @ residual
-    shapes = {}
-    for c in on:
-        segments = np.flatnonzero(rows[:, c])
-        G = U.T @ R[:, segments * 6 + c]
-        shapes[c] = G @ time_correlation(times[segments], taus[c]) @ G.T
-    out = np.array(variance, dtype=float)
-    for _ in range(JOINT_BETWEEN_SWEEPS):
-        for c in on:
-            others = np.eye(y.size) + sum(out[k] * shapes[k] for k in on if k != c)
-            b_values, b_vectors = np.linalg.eigh(others)
-            L = (b_vectors / np.sqrt(b_values)) @ b_vectors.T
-            lam, Q = np.linalg.eigh(L @ shapes[c] @ L)
-            lam = np.maximum(lam, 0.0)
-            if lam.max() <= 0:
-                out[c] = 0.0
-                continue
-            z2 = (Q.T @ (L @ y)) ** 2
-            s2, log_likelihood = _reml_variance(lam, z2, 1.0 / lam.max())
-            out[c] = s2 if log_likelihood > -0.5 * float(np.sum(z2)) else 0.0  # against σ_c² = 0
-    return out
-
-
-def _reml_variance(lam: np.ndarray, z2: np.ndarray, scale: float) -> tuple[float, float]:
-    """The σ² that maximises the restricted log-likelihood −½ Σ_i [log(1 + σ²λ_i) + z_i²/(1 + σ²λ_i)] of a whitened
-    residual with squared components *z2* along the eigenvectors of an added term of eigenvalues *lam*, searched
-    from 12 decades below *scale* to 6 above; (σ², its log-likelihood). σ² = 0 gives −½ Σ z_i²."""
-    from scipy.optimize import minimize_scalar
-
-    def negative_log_likelihood(log_ratio):
-        s2 = scale * math.exp(log_ratio)
-        return 0.5 * float(np.sum(np.log1p(s2 * lam) + z2 / (1.0 + s2 * lam)))
-
-    result = minimize_scalar(negative_log_likelihood, bounds=(-12 * math.log(10), 6 * math.log(10)), method="bounded")
-    return scale * math.exp(result.x), -float(result.fun)
-
-
-def _add_between_segment_noise(sources: _Sources, slow: BetweenSegmentNoise, rows: np.ndarray,
-                               times: np.ndarray) -> None:
-    """Independent Type A inputs (kind ``between``) carrying each channel's between-segment covariance."""
-    S = rows.shape[0]
-    for c in np.flatnonzero(slow.variance > 0):
-        segments = np.flatnonzero(rows[:, c])
-        values, vectors = np.linalg.eigh(slow.covariance(c, times[segments]))
-        for value, vector in zip(values, vectors.T):
-            if value > 1e-12 * values.max():
-                column = np.zeros((S, 6))
-                column[segments, c] = vector
-                sources.add(column.ravel(), math.sqrt(value), slow.dof[c], "between")
-
-
-@dataclass(frozen=True)
-class BetweenSegments:
-    """Repeated settings of one channel: the data's scatter between segments against the prediction."""
-
-    channel: str
-    groups: int
-    dof: int
-    observed_sd: float  # r.m.s. within-group deviation of the residuals (data), SI
-    predicted_sd: float  # the same predicted from the noise model and the Type B table errors
-    predicted_noise_sd: float  # ... from the noise alone
-    predicted_table_sd: float  # ... from the per-setting table errors alone
-    component_sd: float  # between-segment component from the data: sqrt(max(observed² − noise part, 0))
-    ratio: float  # observed² / predicted²
-    verdict: str
 
 
 @dataclass(frozen=True)
@@ -470,66 +277,6 @@ def _segment_use(schedule: Schedule, recording=None) -> _Use:
     return _Use(used, unused, model_segments, gyro_only, tuple(sorted(hand_axes)))
 
 
-def _chi2_quantile(dof: int, probability: float) -> float:
-    """The *probability* quantile of χ² with *dof* degrees of freedom."""
-    from scipy.special import chdtri
-
-    return float(chdtri(dof, 1.0 - probability))
-
-
-def _chi2_verdict(chi2: float, dof: int) -> str:
-    from scipy.special import chdtrc
-
-    if dof <= 0:
-        return "no degrees of freedom left: the fit is exact by construction"
-    upper = float(chdtrc(dof, chi2))  # P(χ² ≥ observed)
-    if upper < CHI2_FLAG_PROBABILITY / 2:
-        return (f"the residuals are larger than the estimated noise and table errors predict (P = {upper:.2g}): "
-                "an effect the model lacks, or noise that does not average down")
-    if upper > 1 - CHI2_FLAG_PROBABILITY / 2:
-        return f"the residuals are smaller than predicted (P = {1 - upper:.2g} of so small a χ²): the stated " \
-               "uncertainties may be too large"
-    return f"consistent with the estimated noise and table errors (P(χ² ≥ observed) = {upper:.2g})"
-
-
-class _Sources:
-    """The independent inputs of the segment means: sensitivity columns (6S, n), standard uncertainties,
-    degrees of freedom and kinds. Their covariance is V = D·diag(u²)·Dᵀ."""
-
-    def __init__(self, size: int):
-        self.size = size
-        self.columns: list[np.ndarray] = []
-        self.u: list[float] = []
-        self.dof: list[float] = []
-        self.kind: list[str] = []
-
-    def add(self, column, u, dof, kind):
-        self.columns.append(np.asarray(column, dtype=float))
-        self.u.append(float(u))
-        self.dof.append(float(dof))
-        self.kind.append(kind)
-
-    def joined(self, other: _Sources) -> _Sources:
-        """These sources and *other*'s (the same size), as a new set."""
-        out = _Sources(self.size)
-        for source in (self, other):
-            out.columns += source.columns
-            out.u += source.u
-            out.dof += source.dof
-            out.kind += source.kind
-        return out
-
-    def matrix(self) -> np.ndarray:
-        """(6S, n) sensitivity × u."""
-        return np.column_stack(self.columns) * np.asarray(self.u)[None, :] if self.columns else np.zeros((self.size, 0))
-
-    def covariance(self, kinds=None) -> np.ndarray:
-        d = self.matrix()
-        if kinds is not None:
-            d = d[:, [k in kinds for k in self.kind]]
-        return d @ d.T
-
-
 #: harmonics of the quantiser's covariance summed over every pair of segments; beyond them only the pairs whose
 #: damping e^{−2π²k²·Var(δ_s − δ_r)/q²} is still above e^{−DAMPED_EXPONENT} (the diagonal, segments at one level)
 FULL_HARMONICS = 64
@@ -566,7 +313,7 @@ def quantiser_covariance(b: np.ndarray, difference: np.ndarray, var_diff: np.nda
     return cov
 
 
-def _prior_covariance(V: np.ndarray, sources: _Sources, noise: NoiseEstimate, fitted: np.ndarray,
+def _prior_covariance(V: np.ndarray, sources: Sources, noise: NoiseEstimate, fitted: np.ndarray,
                       jacobian: np.ndarray) -> np.ndarray:
     """V with its quantisation part a priori: the covariance from which the uncertainty of the fitted levels is
     taken, for the damping of the quantiser's correlation (:func:`quantiser_covariance`).
@@ -608,9 +355,9 @@ def _prior_covariance(V: np.ndarray, sources: _Sources, noise: NoiseEstimate, fi
 
 
 def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, turntable, site_inputs,
-                   held: list[int], jacobian: np.ndarray, levels, tilts, priors: HeldPriors) -> _Sources:
+                   held: list[int], jacobian: np.ndarray, levels, tilts, priors: HeldPriors) -> Sources:
     S = model.n_segments
-    sources = _Sources(6 * S)
+    sources = Sources(6 * S)
     quantisation = noise.quantisation_variance
     variance = (noise.mean_variance - quantisation).ravel()
     dof = noise.mean_variance_dof.ravel()
@@ -715,7 +462,7 @@ def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank
     X = W @ design
     information = X.T @ X
     covariance = local.basis @ np.linalg.pinv(information) @ local.basis.T
-    factor = 1.0 if rank > nominal_rank else math.sqrt(_chi2_quantile(local.rank - nominal_rank, 0.99) / 3.0)
+    factor = 1.0 if rank > nominal_rank else math.sqrt(chi2_quantile(local.rank - nominal_rank, 0.99) / 3.0)
     for k, (a, b) in enumerate(pairs):
         v = np.zeros(covariance.shape[0])
         v[[a, b]] = 0.5  # the symmetric part (Ka_ij + Ka_ji)/2
@@ -755,7 +502,7 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
 
 
 def _data_alone(theta: np.ndarray, basis: np.ndarray, design: np.ndarray, W: np.ndarray, residual: np.ndarray,
-                sources: _Sources, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                sources: Sources, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """What the data alone say of the parameters, where the fit carried the data sheet as a prior: θ̂ + B·(W·D)⁺·W·r,
     one Gauss–Newton step without the prior's rows from the solution θ̂ (the fit's own design D of the identified
     combinations z, their basis B, the whitening W and the residual r = m − model(θ̂); exact where the model is
@@ -766,32 +513,8 @@ def _data_alone(theta: np.ndarray, basis: np.ndarray, design: np.ndarray, W: np.
     n = len(theta)
     step = np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE)[:basis.shape[1]] @ W
     gain = basis[:n] @ step
-    u = _propagate("data_alone", gain, sources, mask).u
+    u = propagate("data_alone", gain, sources, mask).u
     return np.where(mask, theta + gain @ residual, math.nan), u
-
-
-def _propagate(name: str, gain: np.ndarray, sources: _Sources, mask: np.ndarray, note: str = "",
-               prior_gain: np.ndarray | None = None, prior_u: np.ndarray | None = None) -> Method:
-    """θ̂ = gain · m (+ prior_gain · nominal): u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent
-    sources, and, with *prior_gain* (·, 39), the data sheet's prior of the joint fit (:func:`_solve`), one Type B
-    input per parameter with u = *prior_u* (39,) (the fit's :attr:`~plansim.fit.identify.HeldPriors.limits`; kind
-    ``data_sheet``)."""
-    contributions = gain @ sources.matrix()  # (39, n)
-    dofs = np.asarray(sources.dof)
-    kinds = np.asarray(sources.kind, dtype=object)
-    if prior_gain is not None:
-        contributions = np.hstack([contributions, prior_gain * np.asarray(prior_u)[None, :]])
-        dofs = np.concatenate([dofs, np.full(len(prior_u), math.inf)])
-        kinds = np.concatenate([kinds, np.full(len(prior_u), "data_sheet", dtype=object)])
-    u = np.full(gain.shape[0], math.nan)
-    nu = np.full(gain.shape[0], math.nan)
-    for k in np.flatnonzero(mask):
-        u[k], nu[k] = combine(contributions[k], dofs)
-    by_kind = {}
-    for kind in dict.fromkeys(kinds.tolist()):
-        part = np.sqrt(np.sum(contributions[:, kinds == kind] ** 2, axis=1))
-        by_kind[kind] = np.where(mask, part, math.nan)
-    return Method(name, np.full(gain.shape[0], math.nan), u, nu, by_kind, note)
 
 
 #: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
@@ -880,7 +603,7 @@ def _short(decrease: float, weak: float, n_weak: int) -> bool:
     more than :data:`STALLED_CHI2` left along what the data determine, or, along the directions they determine
     only weakly, more than the 99 % point of χ² for as many degrees of freedom (what freeing them would have to
     take off to count, as for the combinations :func:`fit_recording` frees at the fitted tilts)."""
-    return decrease > STALLED_CHI2 or (n_weak > 0 and weak > _chi2_quantile(n_weak, 0.99))
+    return decrease > STALLED_CHI2 or (n_weak > 0 and weak > chi2_quantile(n_weak, 0.99))
 
 
 def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
@@ -1215,7 +938,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         if iteration == 1:
             V_predicted = sources.covariance()
         if slow is not None:
-            _add_between_segment_noise(sources, slow, rows.reshape(observed.shape), times)
+            add_between_segment_noise(sources, slow, rows.reshape(observed.shape), times)
         V = sources.covariance()
         # the weights: a working covariance with each segment's quantisation error on its own. The full V (errors
         # of segments at nearly the same level shared, through the quantiser's harmonics) is what u propagates
@@ -1225,7 +948,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         if levels is not None and np.any(noise.quantisation_variance > 0):
             work = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, None, tilts, priors)
             if slow is not None:
-                _add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
+                add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
             working = work.covariance()
         W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
         stall: list = []
@@ -1252,7 +975,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                     stalled=second_stall, prior=use_prior, limits=limits)
                 except ValueError:
                     second = None
-                if second is not None and chi2 - second[5] > _chi2_quantile(local.rank - rank, 0.99):
+                if second is not None and chi2 - second[5] > chi2_quantile(local.rank - rank, 0.99):
                     theta, tilts, gain, design, gain_z, chi2, c, prior_gains = second
                     rank, step_basis, stall = local.rank, local.basis, second_stall
         if not use_prior and _weak_directions(
@@ -1314,7 +1037,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      "determined only weakly")
     conflict = {} if prior_gains is None else data_sheet_conflict(theta - nominal_parameters(), limits,
                                                                    prior_gains[0], mask)
-    held_sources = _Sources(len(m))
+    held_sources = Sources(len(m))
     bound = _held_bound(model, theta, tilts, rows, W, ident.rank, rank, held_cross, priors.accel_cross) \
         if held_cross else []
     for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
@@ -1333,8 +1056,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             "the prior pulls those estimates towards nominal (the data alone: one Gauss–Newton step without the "
             "prior, u from the same sources); state the data sheet again (scenario [reduction] data_sheet_*) or fit "
             "with the consumer default")
-    joint = _propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask,
-                       prior_gain=None if prior_gains is None else prior_gains[0], prior_u=limits)
+    joint = propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask,
+                      prior_gain=None if prior_gains is None else prior_gains[0], prior_u=limits)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
@@ -1349,9 +1072,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     extra_method = None
     if n_extra:
         every = np.ones(n_extra, dtype=bool)
-        extra_method = _propagate("joint_wls_extra", gain_z[gain_z.shape[0] - n_extra:], sources, every,
-                                  prior_gain=None if prior_gains is None else
-                                  prior_gains[2][gain_z.shape[0] - n_extra:], prior_u=limits)
+        extra_method = propagate("joint_wls_extra", gain_z[gain_z.shape[0] - n_extra:], sources, every,
+                                 prior_gain=None if prior_gains is None else
+                                 prior_gains[2][gain_z.shape[0] - n_extra:], prior_u=limits)
         extra_method = Method("joint_wls_extra", np.asarray(c, dtype=float), extra_method.u, extra_method.dof,
                               extra_method.contributions)
 
@@ -1378,15 +1101,15 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                 spec_gain = M[rows6].T  # (39, 6S_used)
                 estimate = means_all.ravel() @ M
                 all_mask = np.ones(len(PARAMETER_NAMES), bool)
-                spec = _propagate(METHOD_SPEC, spec_gain, sources, all_mask,
-                                  f"JJF 2003 eq. (3)-(13), 1 g = {g_ref:.8g} m/s^2")
+                spec = propagate(METHOD_SPEC, spec_gain, sources, all_mask,
+                                 f"JJF 2003 eq. (3)-(13), 1 g = {g_ref:.8g} m/s^2")
                 spec = Method(METHOD_SPEC, estimate, spec.u, spec.dof, spec.contributions, spec.note)
                 if mask.all():
                     spec_bias = spec_gain @ fitted.ravel() - theta
     if spec is None and not spec_note:
         spec_note = "not run"
     # repeated settings against the prediction (not against the between-segment noise fitted to these residuals)
-    between = _between_segments(used_schedule, residual, project @ V_predicted @ project.T, project, sources)
+    between = between_segments(used_schedule, residual, project @ V_predicted @ project.T, project, sources)
     result = FitResult(site=site, turntable_source=turntable_source, identifiability=ident, used=tuple(used),
                      tilts=np.asarray(tilts)[:2 * int(model.placed.sum())].reshape(-1, 2),
                      placed=tuple(np.asarray(used)[model.placed].tolist()),
@@ -1395,7 +1118,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      unused=unused, labels=tuple(s.label for s in used_schedule.segments), observed=observed,
                      fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
                      spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,
-                     chi2_verdict=_chi2_verdict(chi2, chi2_dof), between=between,
+                     chi2_verdict=chi2_verdict(chi2, chi2_dof), between=between,
                      attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes,
                      model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
                      covariance=V, whitening=W, design=design, rows=rows,
@@ -1423,8 +1146,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     if moves:
         transitions, unused_moves = find_transitions(recording)
         try:
-            move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise, _Sources, _propagate,
-                                 BETWEEN_LR_THRESHOLD, _chi2_verdict)
+            move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise)
         except MovesNotFitted as why:  # the poses' fit stands without them; say why
             move_fit = None
             result = dataclasses.replace(result, notes=result.notes + (str(why),))
@@ -1442,58 +1164,3 @@ def _middle_times(recording, used) -> np.ndarray:
                      for k in used], dtype=float)
 
 
-def _repeat_groups(schedule: Schedule) -> list[list[int]]:
-    """Segments that repeat one setting (same up-axis, rate and rate axis; the heading may differ)."""
-    groups: dict[tuple, list[int]] = {}
-    for k, s in enumerate(schedule.segments):
-        if s.orientation != "known":  # a pose placed by hand is not a repeat of a setting
-            continue
-        key = (s.up, s.rate, s.rate_axis if s.is_rotating else None)
-        groups.setdefault(key, []).append(k)
-    return [g for g in groups.values() if len(g) >= 2]
-
-
-def _between_segments(schedule: Schedule, residual: np.ndarray, residual_cov: np.ndarray, project: np.ndarray,
-                      sources: _Sources) -> tuple[BetweenSegments, ...]:
-    """Within-group scatter of the residuals of repeated settings, per channel, against its prediction.
-
-    For channel c, Q_c projects the residuals of each group onto their deviations from the group's mean;
-    the observed sum of squares is rᵀQ_c r, its expectation under the model trace(Q_c·R V Rᵀ) with
-    R = I − H (H the fit's hat matrix), split into the noise's and the table's parts. The data's
-    between-segment component beyond the noise is sqrt(max(observed − noise part, 0)/ν).
-    """
-    from scipy.special import chdtrc
-
-    groups = _repeat_groups(schedule)
-    if not groups:
-        return ()
-    n = residual.size
-    V_noise = sources.covariance({"noise"})
-    V_table = sources.covariance({"table", "angle"})
-    out = []
-    for c, name in enumerate(("gx", "gy", "gz", "ax", "ay", "az")):
-        Q = np.zeros((n, n))
-        dof = 0
-        for g in groups:
-            idx = np.array(g) * 6 + c
-            block = np.eye(len(g)) - 1.0 / len(g)
-            Q[np.ix_(idx, idx)] = block
-            dof += len(g) - 1
-        observed = float(residual @ Q @ residual)
-        expected = float(np.trace(Q @ residual_cov))
-        noise_part = float(np.trace(Q @ project @ V_noise @ project.T))
-        table_part = max(float(np.trace(Q @ project @ V_table @ project.T)), 0.0)
-        noise_part = max(noise_part, 0.0)
-        ratio = observed / expected if expected > 0 else math.inf
-        upper = float(chdtrc(dof, dof * ratio)) if math.isfinite(ratio) else 0.0
-        if upper < CHI2_FLAG_PROBABILITY / 2:
-            verdict = "the data scatter more than predicted"
-        elif upper > 1 - CHI2_FLAG_PROBABILITY / 2:
-            verdict = "the data scatter less than predicted"
-        else:
-            verdict = "consistent"
-        observed, expected = max(observed, 0.0), max(expected, 0.0)  # quadratic forms, ≥ 0 but for rounding
-        out.append(BetweenSegments(name, len(groups), dof, math.sqrt(observed / dof), math.sqrt(expected / dof),
-                                   math.sqrt(noise_part / dof), math.sqrt(table_part / dof),
-                                   math.sqrt(max(observed - noise_part, 0.0) / dof), ratio, verdict))
-    return tuple(out)

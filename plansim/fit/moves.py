@@ -30,7 +30,7 @@ G as known inputs):
 Kg (9 entries) minimises rᵀV⁻¹r over every transition (``scipy.optimize.least_squares``, with the analytic
 Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kernel's sensitivities S_k = ∂(Rᵀû)/∂ω_k).
 
-**Uncertainty** (JCGM 100 5.1.2, independent inputs, as in :mod:`plansim.fit.joint`):
+**Uncertainty** (JCGM 100 5.1.2, independent inputs, as in :mod:`plansim.fit.budget`):
 
 - the gyro noise of the move's own samples: white, per sample variance N²/dt + q²/12 (the motion dithers the
   quantiser), through S_k·Kg⁻¹, and a slow part held over the move, (2 ln 2/π)·B² + K²·T/3 (IEEE Std 952's
@@ -51,7 +51,7 @@ Jacobian ∂r/∂Kg = −Eⱼᵀ·Σ_k S_k·Kg⁻¹·e_a·ω̂_k,b from the kern
   start with two gyro axes flipped came out below the true one's, :data:`SIGN_EVIDENCE`);
 - noise between moves beyond all of that (a hand that shakes at the ends of a pose, timing, effects beyond
   eq. (1)): one variance per residual component, estimated by restricted maximum likelihood and taken when
-  2·Δlog L passes :data:`plansim.fit.joint.BETWEEN_LR_THRESHOLD`, as the joint fit's noise between segments.
+  2·Δlog L passes :data:`plansim.fit.between.BETWEEN_LR_THRESHOLD`, as the joint fit's noise between segments.
 
 **Identifiability and the frame.** ∂r/∂Kg at Kg = I on the recorded motion goes through
 :func:`plansim.fit.identify.identifiability`. The moves see the body through the accelerometers, so Kg comes
@@ -78,6 +78,8 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_distribution
 
 from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
+from plansim.fit.between import BETWEEN_LR_THRESHOLD
+from plansim.fit.budget import Sources, chi2_verdict, propagate
 from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation
 from plansim.model.environment import EARTH_RATE
@@ -410,13 +412,12 @@ def _dark_variance(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, thresho
     return scale * math.exp(result.x) if 2.0 * gain > threshold else 0.0
 
 
-def fit_moves(recording, fit, transitions, unused, noise, sources_class, propagate, threshold,
-              verdict) -> MoveFit | None:
+def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
     """Kg from the transitions (module docstring), given the joint fit *fit* (its θ̂, gain and sources).
 
-    *noise* is the recording's :class:`plansim.fit.noise.NoiseEstimate` (its channels' N, B, K and q);
-    *sources_class*, *propagate*, *threshold* and *verdict* are the joint fit's input bookkeeping, GUM
-    propagation, likelihood-ratio threshold and χ² verdict (one of each in :mod:`plansim.fit.joint`).
+    *noise* is the recording's :class:`plansim.fit.noise.NoiseEstimate` (its channels' N, B, K and q). The
+    inputs are kept, propagated and judged as the joint fit's are (:mod:`plansim.fit.budget`), and the noise between
+    moves is taken at the joint fit's likelihood-ratio threshold (:data:`plansim.fit.between.BETWEEN_LR_THRESHOLD`).
     Returns None when fewer than :data:`MIN_TRANSITIONS` transitions are usable.
     """
     if len(transitions) < MIN_TRANSITIONS:
@@ -497,12 +498,12 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     slow_dof = max(float(min(ch.static_segments for ch in gyro_noise)) - 1.0, 1.0)
     joint_gain = fit.gain  # (39, 6S)
     joint_sources = fit.sources
-    held_sources = fit.held_sources if fit.held_sources is not None else sources_class(joint_gain.shape[1])
+    held_sources = fit.held_sources if fit.held_sources is not None else Sources(joint_gain.shape[1])
 
     held_kg: list[int] = []
 
     def build(Kg, dark):
-        sources = sources_class(2 * n_moves)
+        sources = Sources(2 * n_moves)
         jacobian = np.zeros((2 * n_moves, 9))
         angles = np.zeros(n_moves)
         for m in range(n_moves):
@@ -630,7 +631,7 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
             hat = Jz @ _solve_information(Jz.T @ Vinv @ Jz, Jz.T @ Vinv, Kg)
             if iteration == 1:
                 residual_predicted = r
-                dark = _dark_variance(r, V, hat, threshold)
+                dark = _dark_variance(r, V, hat, BETWEEN_LR_THRESHOLD)
                 if dark == 0.0:
                     break
         sources, jacobian, angles = build(Kg, dark)
@@ -706,5 +707,5 @@ def fit_moves(recording, fit, transitions, unused, noise, sources_class, propaga
     return MoveFit(transitions=tuple(transitions), unused=dict(unused), method=method, identified=tuple(identified),
                    relative=relative, not_identified=not_identified, residual=r.reshape(n_moves, 2),
                    residual_sd=residual_sd, angle=angles, duration=moves.duration, chi2=chi2, chi2_dof=dof,
-                   chi2_verdict=verdict(chi2, dof), between_sd=math.sqrt(dark),
+                   chi2_verdict=chi2_verdict(chi2, dof), between_sd=math.sqrt(dark),
                    between_dof=float(dof), notes=tuple(notes), covariance=V)
