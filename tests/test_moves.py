@@ -697,18 +697,18 @@ def test_a_linear_start_that_falls_into_a_false_minimum_is_not_taken(tmp_path, m
     stops short and is retried anyway.)"""
     from scipy.stats import chi2 as chi2_distribution
 
-    from plansim.fit import joint
+    from plansim.fit import joint, solve
     from plansim.io.log_import import import_log
 
-    monkeypatch.setattr(joint, "MAX_EVALUATIONS", 2000)
+    monkeypatch.setattr(solve, "MAX_EVALUATIONS", 2000)
     solved = []
 
-    def recorded(*args, solve=joint._solve, **kwargs):
-        out = solve(*args, **kwargs)
+    def recorded(*args, solver=solve.solve, **kwargs):
+        out = solver(*args, **kwargs)
         solved.append(out[5])  # its χ²
         return out
 
-    monkeypatch.setattr(joint, "_solve", recorded)
+    monkeypatch.setattr(joint, "solve", recorded)
     turns = _about_both_axes(20)
     t, x, _ = _table_log(turns, seed=4)
     recording = import_log(_write_log(tmp_path / "tilted.csv", t, x), time_column="time",

@@ -215,7 +215,7 @@ class _Geometry:
         self.V_root = vectors * np.sqrt(np.maximum(values, 0.0))  # V = V_root V_rootᵀ
         self.V_basis = vectors  # V_root V_basisᵀ is V's symmetric square root (coupled_null_residuals)
         self.channel_of_row = np.tile(np.arange(6), fit.observed.shape[0])[rows]
-        # W = Λ^{-1/2} Uᵀ (on the fitted rows: plansim.fit.joint.whitening) whitens along V's eigenvectors, so an
+        # W = Λ^{-1/2} Uᵀ (on the fitted rows: plansim.fit.solve.whitening) whitens along V's eigenvectors, so an
         # entry of r_w is not one segment's channel; U r_w is the residual whitened by V's symmetric root
         # U Λ^{-1/2} Uᵀ, whose entries are the fitted rows (a channel's rows exactly when V does not couple
         # channels, nearly when it does): what a statistic over one channel's rows must sum

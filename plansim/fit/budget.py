@@ -105,7 +105,7 @@ def propagate(name: str, gain: np.ndarray, sources: Sources, mask: np.ndarray, n
               prior_gain: np.ndarray | None = None, prior_u: np.ndarray | None = None) -> Method:
     """θ̂ = gain · m (+ prior_gain · nominal): u(θ̂_k) and ν_eff by JCGM 100 5.1.2 and G.4.1 over the independent
     sources, and, with *prior_gain* (·, 39), the data sheet's prior of the joint fit
-    (:func:`plansim.fit.joint._solve`), one Type B input per parameter with u = *prior_u* (39,) (the fit's
+    (:func:`plansim.fit.solve.solve`), one Type B input per parameter with u = *prior_u* (39,) (the fit's
     :attr:`~plansim.fit.identify.HeldPriors.limits`; kind ``data_sheet``)."""
     contributions = gain @ sources.matrix()  # (39, n)
     dofs = np.asarray(sources.dof)

@@ -274,7 +274,7 @@ def data_sheet_conflict(offset: np.ndarray, limits: np.ndarray, prior_gain: np.n
     each group of eq. (1)/(2) (Kg, Bg, G, Ka, Ba, P), where the joint fit carried the data sheet as a prior?
 
     The prior enters the fit as whitened pseudo-observations r_k = (θ_k − nominal_k)/U_k of unit variance
-    (``plansim.fit.joint._solve``). At the solution their residuals are r = (θ̂ − nominal)/U and, if the data
+    (:func:`plansim.fit.solve.solve`). At the solution their residuals are r = (θ̂ − nominal)/U and, if the data
     sheet is right (the unit's parameter one draw of nominal ± U), their covariance is I − H, with H = P·A·P⁻¹
     the prior rows' block of the augmented system's hat matrix (P = diag(1/U), A = ∂θ̂/∂nominal, *prior_gain*).
     For a group g the statistic is the leverage-corrected residual

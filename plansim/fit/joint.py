@@ -32,7 +32,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
 from threadpoolctl import threadpool_limits
 
 from plansim.config.scenario import ErrorDistribution, Turntable
@@ -49,7 +48,6 @@ from plansim.fit.budget import Method, Sources, chi2_quantile, chi2_verdict, pro
 from plansim.fit.identify import (
     NULL_TOLERANCE,
     RANK_TOLERANCE,
-    UNINFORMATIVE_LIMITS,
     HeldPriors,
     Identifiability,
     data_sheet_conflict,
@@ -61,6 +59,7 @@ from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.moves import MovesNotFitted, find_transitions, fit_moves
 from plansim.fit.noise import UNITS_SI, NoiseEstimate, channel_kind, estimate_noise_models, quantisation_harmonics
 from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
+from plansim.fit.solve import solve, weak_directions, whitening
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.schedule.segments import Schedule
@@ -134,7 +133,7 @@ class FitResult:
     moves: object = None
     #: the Type B standard uncertainties of what the fit (and the moves) hold at nominal
     held: HeldPriors = field(default_factory=HeldPriors)
-    #: with the data sheet as a prior (where the data leave a direction to it, :func:`_solve`): the joint
+    #: with the data sheet as a prior (where the data leave a direction to it, :func:`solve`): the joint
     #: estimate's gain on the prior's mean, ∂θ̂/∂nominal (39, 39), each input with u = held.limits; else None
     prior_gain: np.ndarray | None = field(default=None, repr=False)
     #: with the data sheet as a prior: group -> {statistic, dof, p_value, contradicted}, whether the data contradict
@@ -175,7 +174,7 @@ class FitResult:
         variance to the data sheet's prior (:func:`plansim.fit.identify.weakly_determined`)."""
         joint = set(self.identifiability.identified)
         u = np.array([self.joint.u[k] if name in joint else math.inf for k, name in enumerate(PARAMETER_NAMES)])
-        # the data sheet's part of that u, where the joint fit carried it as a prior (_solve)
+        # the data sheet's part of that u, where the joint fit carried it as a prior (solve)
         zero = np.zeros(len(PARAMETER_NAMES))
         data_sheet = np.nan_to_num(self.joint.contributions.get("data_sheet", zero))
         if self.moves is not None:
@@ -517,28 +516,6 @@ def _data_alone(theta: np.ndarray, basis: np.ndarray, design: np.ndarray, W: np.
     return np.where(mask, theta + gain @ residual, math.nan), u
 
 
-#: evaluations of the model the non-linear fit (poses placed by hand) may take before it gives up
-MAX_EVALUATIONS = 400
-#: a non-linear fit that has used its MAX_EVALUATIONS is taken where it stopped when one more Gauss–Newton step would
-#: lower χ² along what the data determine by less than this — less than one degree of freedom's expected share, so no
-#: test or u reads it — and along what they determine only weakly by less than the 99 % point of χ² for as many
-#: degrees of freedom (:func:`_short`). It stops
-#: short only in a direction the data barely determine (a curved valley, walked in ever smaller steps: poses placed
-#: by hand whose gravity directions all lie in one cap leave the accelerometers' ellipsoid so), where the estimate's
-#: u says as much (docs/fitting.md)
-STALLED_CHI2 = 1.0
-#: eigenvalues of the means' covariance V below this fraction of its largest are raised to it before V is
-#: inverted: a channel that shows no noise at all (noise-free data) must not make V singular to rounding
-EIGENVALUE_FLOOR = 1e-14
-
-
-def whitening(V: np.ndarray) -> np.ndarray:
-    """W with W·V·Wᵀ = I (V = U Λ Uᵀ, W = Λ^{-1/2} Uᵀ), eigenvalues floored at :data:`EIGENVALUE_FLOOR`·max."""
-    values, vectors = np.linalg.eigh(V)
-    values = np.maximum(values, EIGENVALUE_FLOOR * max(values.max(), 1e-300))
-    return (vectors / np.sqrt(values)).T
-
-
 #: a hand-placed pose's fitted tilt component (its biases taken out) beyond this many times the Type B u of the
 #: accelerometers' shear the fit holds (HeldPriors.accel_cross; 5 × 0.01 rad = 2.9° by default) is a tilt: no
 #: cross-coupling the prior allows could stand in for it
@@ -569,163 +546,6 @@ def _far_tilts(tilts: np.ndarray, n_placed: int, beyond: float = APPROXIMATE_TIL
     placed = np.asarray(tilts[:2 * n_placed], dtype=float)
     out[:2 * n_placed] = np.where(np.abs(placed) > beyond, placed, 0.0)
     return out
-
-
-def _gauss_newton_decrease(X: np.ndarray, residual: np.ndarray, theta_basis: np.ndarray,
-                           limits: np.ndarray) -> tuple[float, float, int]:
-    """What one more Gauss–Newton step would take off χ² where a search stopped: the whitened *residual*'s part in
-    the column space of the whitened design *X* (its columns the fit's unknowns z, θ = θ0 + *theta_basis*·z),
-    split by the design's singular directions into the part along directions the data determine and the part
-    along directions they determine only weakly — where a step of one standard uncertainty moves some parameter
-    beyond its group's *limits* ((39,), the fit's data sheet; the parameters :attr:`FitResult.weakly_determined`
-    flags). Returns (determined part, weak part, number of weak directions)."""
-    left, weak = _weak_directions(X, theta_basis, limits)
-    parts = (left.T @ residual) ** 2
-    return float(parts[~weak].sum()), float(parts[weak].sum()), int(weak.sum())
-
-
-def _weak_directions(X: np.ndarray, theta_basis: np.ndarray, limits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The whitened design *X*'s left singular vectors (those above lstsq's cut), and for each whether the data
-    determine it only weakly: a step of one standard uncertainty along it (θ = θ0 + *theta_basis*·z) moves some
-    parameter beyond its group's *limits* ((39,), the fit's data sheet: :attr:`plansim.fit.identify.HeldPriors.
-    limits`)."""
-    if X.shape[1] == 0:
-        return np.zeros((X.shape[0], 0)), np.zeros(0, dtype=bool)
-    left, singular, right = np.linalg.svd(X, full_matrices=False)
-    kept = singular > np.finfo(float).eps * max(X.shape) * max(singular.max(initial=0.0), 1e-300)  # lstsq's cut
-    one_sigma = (theta_basis @ right[kept].T) / singular[kept]  # (39, k): θ's step of 1 u along each direction
-    weak = np.max(np.abs(one_sigma) / np.asarray(limits)[:, None], axis=0, initial=0.0) > 1.0
-    return left[:, kept], weak
-
-
-def _short(decrease: float, weak: float, n_weak: int) -> bool:
-    """Whether a search that used up its evaluations stopped short of the minimum (:func:`_gauss_newton_decrease`):
-    more than :data:`STALLED_CHI2` left along what the data determine, or, along the directions they determine
-    only weakly, more than the 99 % point of χ² for as many degrees of freedom (what freeing them would have to
-    take off to count, as for the combinations :func:`fit_recording` frees at the fitted tilts)."""
-    return decrease > STALLED_CHI2 or (n_weak > 0 and weak > chi2_quantile(n_weak, 0.99))
-
-
-def _solve(model: MeanModel, basis: np.ndarray, theta0: np.ndarray, tilts0: np.ndarray, observed: np.ndarray,
-           W: np.ndarray, J_linear: np.ndarray, linear_start: bool = True, extra: np.ndarray | None = None,
-           stalled: list | None = None, prior: bool = False, limits: np.ndarray | None = None):
-    """Generalised least squares by scipy.optimize.least_squares on the residuals whitened by W.
-
-    The unknowns are z, with (θ, tilts) = (θ0, tilts0) + basis·z: the identified combinations of the 39
-    parameters and of the tilts of the hand-placed poses. Without hand-placed poses the model is linear
-    (``J_linear``·θ); with them it is evaluated by the kernel at each step.
-
-    Returns θ̂ (39,), the tilts (n_placed, 2), the gain A (39, 6S) of θ̂ on the means, the design of the
-    identified combinations D (6S, rank) at the solution and the gain G (rank, 6S) of z (the fit's hat matrix
-    is D·G), χ² = ‖W·(m − model)‖², the sizes of the extra unknowns, and the data sheet's part (below).
-
-    ``prior``: the data sheet as a prior of every parameter, θ_k ~ N(nominal_k, U_k²) with U the data sheet's
-    *limits* ((39,), :attr:`plansim.fit.identify.HeldPriors.limits`; default the consumer MEMS data sheet's,
-    :data:`plansim.fit.identify.UNINFORMATIVE_LIMITS`), also what judges a stopped search (:func:`_short`); as
-    further whitened residuals (θ_k − nominal_k)/U_k (a ridge regression towards the nominal point; the tilts get
-    none). Where the data determine a combination far better than a data sheet its pull is (u/U)² of the estimate's
-    distance from nominal — 10⁻⁶ of it for a scale factor known to 10⁻⁴; along a direction they determine only
-    weakly it holds the estimate and its u where the data sheet does. The last element is then (∂θ̂/∂nominal (39,
-    39), ∂(D·z)/∂nominal (6S, 39), ∂z/∂nominal), the gains of the prior's mean, whose Type B u is U; otherwise None.
-    χ² stays the data's.
-
-    ``extra`` (6S, m): further unknowns c that add ``extra·c`` to the means (an effect beyond eq. (1)/(2),
-    linear in its size); they are the last m entries of z, and the last m columns of D and rows of G.
-
-    A non-linear fit that uses up :data:`MAX_EVALUATIONS` is taken where it stopped if one more Gauss–Newton
-    step would lower χ² by at most :data:`STALLED_CHI2` along what the data determine, and by less than its
-    99 % point along what they determine only weakly (:func:`_gauss_newton_decrease`, :func:`_short`), and
-    ``(evaluations, the two decreases, the number of weak directions)`` is appended to *stalled*; otherwise a
-    ``ValueError``.
-    """
-    n = len(theta0)
-    n_rows = W.shape[0]
-    limits = UNINFORMATIVE_LIMITS if limits is None else np.asarray(limits, dtype=float)
-    extra = np.zeros((len(observed), 0)) if extra is None else np.asarray(extra, dtype=float)
-    if extra.shape[1]:
-        basis = np.block([[basis, np.zeros((basis.shape[0], extra.shape[1]))],
-                          [np.zeros((extra.shape[1], basis.shape[1])), np.eye(extra.shape[1])]])
-    if basis.shape[1] == 0:
-        empty = np.zeros((len(observed), 0))
-        chi2 = float(np.sum((W @ (observed - J_linear @ theta0)) ** 2)) if model.n_tilts == 0 else \
-            float(np.sum((W @ (observed - model.means(theta0, tilts0).ravel())) ** 2))
-        return theta0.copy(), tilts0.copy(), np.zeros((n, len(observed))), empty, empty.T, chi2, np.zeros(0), None
-
-    m = extra.shape[1]
-    nt = basis.shape[0] - m  # θ and the nuisance parameters
-
-    def unpack(z):
-        step = basis[:nt] @ z
-        return theta0 + step[:n], tilts0 + step[n:].reshape(tilts0.shape)
-
-    def shift(z):
-        return extra @ z[basis.shape[1] - m:] if m else 0.0
-
-    # the data sheet's prior: whitened rows P·(θ − nominal), P = diag(1/U); none (zero rows) without it
-    P = np.diag(1.0 / limits) if prior else np.zeros((0, n))
-    nominal = nominal_parameters()
-    X_prior = P @ basis[:n]
-
-    if model.n_tilts == 0:
-        design = np.hstack([J_linear, extra]) @ basis
-        X = np.vstack([W @ design, X_prior])
-        y = np.concatenate([W @ (observed - J_linear @ theta0), P @ (nominal - theta0)])
-        result = least_squares(lambda z: X @ z - y, np.zeros(basis.shape[1]), jac=lambda z: X, method="lm",
-                               x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    else:
-        def design_at(z):
-            theta, tilts = unpack(z)
-            return np.hstack([model.parameter_jacobian(tilts=tilts), model.tilt_jacobian(theta, tilts), extra]) @ basis
-
-        def residual(z):
-            theta, tilts = unpack(z)
-            return np.concatenate([W @ (model.means(theta, tilts).ravel() + shift(z) - observed),
-                                   P @ (theta - nominal)])
-
-        def jacobian(z):
-            return np.vstack([W @ design_at(z), X_prior])
-
-        def run(z0):
-            result = least_squares(residual, z0, jac=jacobian, method="lm", x_scale="jac",
-                                   xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=MAX_EVALUATIONS)
-            if result.success:
-                return result, 0.0, 0.0, 0
-            # it used up its evaluations: the χ² one more Gauss–Newton step would take off (the residual's part in
-            # the design's column space)
-            return (result, *_gauss_newton_decrease(jacobian(result.x), result.fun, basis[:n], limits))
-
-        # start from the linear solution with the tilts held at their first guess, then free them together; where
-        # that start leads the search astray (a near-null direction the linear step takes at full length: hand
-        # poses whose gravity directions lie in one cap), from the first guess itself: where it stops short, or
-        # ends above the first guess's own χ² (a minimum the linear step fell into)
-        z0 = np.zeros(basis.shape[1])
-        if linear_start:
-            outcome = run(np.linalg.lstsq(jacobian(z0), -residual(z0), rcond=None)[0])
-            if _short(*outcome[1:]) or outcome[0].cost > 0.5 * float(np.sum(residual(z0) ** 2)):
-                outcome = min(outcome, run(z0), key=lambda r: r[0].cost)
-        else:
-            outcome = run(z0)
-        result, decrease, weak, n_weak = outcome
-        if _short(decrease, weak, n_weak):
-            raise ValueError(f"the fit of the hand-placed poses did not converge in {MAX_EVALUATIONS} evaluations "
-                             f"({result.message}; one more step would lower chi2 by {decrease + weak:.3g}, "
-                             f"{decrease:.3g} of it along what the data determine); check the segment table's poses "
-                             "(docs/fitting.md)")
-        if not result.success and stalled is not None:
-            stalled.append((int(result.nfev), decrease, weak, n_weak))
-        design = design_at(result.x)
-        X = jacobian(result.x)
-    # the gain of z on (the means, the prior's mean): X's rows are W·(means) and P·(θ − nominal)
-    inputs = np.zeros((X.shape[0], W.shape[1] + P.shape[0]))
-    inputs[:n_rows, :W.shape[1]] = W
-    if prior:
-        inputs[n_rows:, W.shape[1]:] = P
-    gain_all = np.linalg.lstsq(X, inputs, rcond=None)[0]
-    gain_z, gain_prior = gain_all[:, :W.shape[1]], gain_all[:, W.shape[1]:]
-    theta, tilts = unpack(result.x)
-    chi2 = float(np.sum(result.fun[:n_rows] ** 2))
-    prior_gains = (basis[:n] @ gain_prior, design @ gain_prior, gain_prior) if prior else None
-    return theta, tilts, basis[:n] @ gain_z, design, gain_z, chi2, result.x[len(result.x) - m:], prior_gains
 
 
 def _noise_segments(schedule) -> list[int]:
@@ -928,7 +748,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                             model.tilt_jacobian(theta0, nominal_tilts, earth_rate=False)])[rows])
     theta, tilts, levels = theta0, tilts0, None
     slow = None
-    # the data sheet as a prior (_solve), once the data leave some direction to it: then in every later solve
+    # the data sheet as a prior (solve), once the data leave some direction to it: then in every later solve
     use_prior = False
     limits = priors.limits
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
@@ -953,14 +773,14 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         W = whitening(working[np.ix_(rows, rows)]) @ select  # only the fitted rows
         stall: list = []
         try:
-            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=use_prior,
+            solution = solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=use_prior,
                               limits=limits)
         except ValueError:
             if use_prior:
                 raise
             # a search that stops short may be walking a valley only the data sheet bounds: with it
             stall, use_prior = [], True
-            solution = _solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True, limits=limits)
+            solution = solve(model, basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True, limits=limits)
         theta, tilts, gain, design, gain_z, chi2, c, prior_gains = solution
         rank, step_basis = ident.rank, basis
         if model.n_tilts:
@@ -971,25 +791,25 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             if local.rank > rank:
                 second_stall: list = []
                 try:
-                    second = _solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E,
+                    second = solve(model, local.basis, theta, tilts, m, W, J, linear_start=False, extra=E,
                                     stalled=second_stall, prior=use_prior, limits=limits)
                 except ValueError:
                     second = None
                 if second is not None and chi2 - second[5] > chi2_quantile(local.rank - rank, 0.99):
                     theta, tilts, gain, design, gain_z, chi2, c, prior_gains = second
                     rank, step_basis, stall = local.rank, local.basis, second_stall
-        if not use_prior and _weak_directions(
+        if not use_prior and weak_directions(
                 W @ design, np.hstack([step_basis[:len(theta0)], np.zeros((len(theta0), n_extra))]), limits)[1].any():
             # the data leave a direction to what a data sheet already says: the data sheet holds it (estimate and
             # u alike), from here on
             use_prior, stall = True, []
             try:  # from where the data alone left it, or, where the prior's pull along a curved valley takes
                 # longer than the search may walk, from the start
-                solution = _solve(model, step_basis, theta, tilts, m, W, J, linear_start=False, extra=E,
+                solution = solve(model, step_basis, theta, tilts, m, W, J, linear_start=False, extra=E,
                                   stalled=stall, prior=True, limits=limits)
             except ValueError:
                 stall = []
-                solution = _solve(model, step_basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True,
+                solution = solve(model, step_basis, theta0, tilts0, m, W, J, extra=E, stalled=stall, prior=True,
                                   limits=limits)
             theta, tilts, gain, design, gain_z, chi2, c, prior_gains = solution
         J = model.parameter_jacobian(earth_rate=True, tilts=tilts)
