@@ -236,6 +236,24 @@ def test_the_data_sheets_conflict_is_the_fall_of_the_fit_when_a_groups_prior_is_
         data_sheet_conflict(theta - nominal, -limits, gain, fitted)
 
 
+def test_a_conflict_is_written_one_way_with_the_data_alone_to_the_digits_of_their_u():
+    """describe_conflict, the one wording of the note, the report and the --out attribute: a p-value chi2.sf
+    underflows to 0 is written '< 1e-300', not 'p = 0'; the data alone are shown only for a contradicted group,
+    in display units, each estimate rounded to the last digit of its u's two (GUM 7.2.6)."""
+    from plansim.fit.identify import describe_conflict
+
+    g = 9.80665e-6  # 1 ug in m/s^2
+    entry = {"statistic": 3209360.45, "dof": 3, "p_value": 0.0, "contradicted": True,
+             "data_alone": {"Bax": (3270.19 * g, 2.58 * g), "Bay": (-435.706 * g, 26.1 * g)}}
+    assert describe_conflict(entry) == ("chi2 3.209e+06 on 3 dof, p < 1e-300, contradicted; the data alone: "
+                                        "Bax 3270.2 ± 2.6 ug, Bay -436 ± 26 ug")
+    held = dict(entry, p_value=0.31, statistic=3.6, contradicted=False)
+    assert describe_conflict(held) == "chi2 3.6 on 3 dof, p = 0.31"
+    scale = {"statistic": 50.0, "dof": 2, "p_value": 1.4e-11, "contradicted": True,
+             "data_alone": {"Kaxx": (1.000139312, 2.6e-6)}}
+    assert describe_conflict(scale).endswith("; the data alone: Kaxx 1.0001393 ± 2.6e-06")
+
+
 def test_six_positions_identify_ka_ba_bg_g_and_nothing_of_kg_or_p():
     result = _identified(multi_position(6))
     assert set(result.identified) == set(GROUP["Ka"] + GROUP["Ba"] + GROUP["Bg"] + GROUP["G"])
