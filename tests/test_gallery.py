@@ -3,8 +3,9 @@
 The examples are run in this process (``runpy``, with their command-line arguments), small: the hand-held coverage
 over 2 sessions, the bandwidth without its optional Monte Carlo but for 5 trials. What they print is checked
 against what each claims, not against stored output: the hidden effect is named; the headerless log's poses
-and moves are found and its gyro scale factors land within 5 u of the truth; the fitted curve reads the
-bandwidth to 1e-9 Hz where the chord is off by more than 0.5 Hz.
+and moves are found and its gyro scale factors land within 5 u of the truth; the data sheet the data contradict
+is Ba's, and restated it holds, with Bax where the data alone had put it; the fitted curve reads the bandwidth to
+1e-9 Hz where the chord is off by more than 0.5 Hz.
 """
 
 from __future__ import annotations
@@ -48,6 +49,18 @@ def test_headerless_log_to_gyro_scale_factors(capsys):
     assert len(rows) == 3
     for _name, estimate, u, truth in rows:
         assert abs(float(estimate) - float(truth)) <= 5 * float(u)
+
+
+def test_data_sheet_conflict_names_ba_and_the_restated_data_sheet_holds(capsys):
+    out = run_example("data_sheet_conflict.py", capsys=capsys)
+    verdicts = re.findall(r"^contradicted: (.*)$", out, flags=re.M)
+    assert verdicts == ["Ba", "none"], out
+    alone = re.search(r"the data alone: Bax (-?[\d.]+) ± ([\d.]+) ug", out)
+    fitted = re.findall(r"Bax = (-?[\d.]+) ± ([\d.]+) ug", out)
+    assert alone and len(fitted) == 2, out
+    # what the data alone said is what the fit gives once the data sheet no longer pulls, to the printed digits
+    assert abs(float(alone[1]) - float(fitted[1][0])) <= 0.1 + 1e-9, out
+    assert abs(float(fitted[0][0]) - float(alone[1])) > 10 * float(alone[2]), out  # the prior had pulled it
 
 
 def test_bandwidth_chord_vs_curve(capsys):
