@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import chi2 as chi2_distribution
 
-from plansim.model.parameters import GROUPS, PARAMETER_NAMES, PARAMETERS
+from plansim.model.parameters import GROUPS, PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 
 #: standard uncertainty of a Kg entry that a fit holds at its nominal value (1 or 0) while it still matters: one the
 #: recording does not identify but the Earth rate reaches, or one the moves between poses determine only weakly:
@@ -349,13 +349,12 @@ def describe_conflict(entry: dict) -> str:
     if alone and entry["contradicted"]:
         parts = []
         for name, (estimate, u) in alone.items():
-            spec = PARAMETERS[PARAMETER_NAMES.index(name)]
-            unit = spec.unit_suffix
+            spec = PARAMETERS[PARAMETER_INDEX[name]]
             value, spread = estimate / spec.display_factor, u / spec.display_factor
             # the estimate to the last digit of its u's two (GUM 7.2.6)
             places = min(15, max(0, 1 - math.floor(math.log10(spread)))) if math.isfinite(spread) and spread > 0 \
                 else None
             shown = f"{value:.6g}" if places is None else f"{value:.{places}f}"
-            parts.append(f"{name} {shown} ± {spread:.2g}{unit}")
+            parts.append(f"{name} {shown} ± {spread:.2g}{spec.unit_suffix}")
         text += "; the data alone: " + ", ".join(parts)
     return text

@@ -500,6 +500,13 @@ def _held_at_nominal(basis: np.ndarray, held: list[int], rank: int, design: np.n
     return candidate
 
 
+def _step_without_prior(W: np.ndarray, design: np.ndarray) -> np.ndarray:
+    """(W·D)⁺·W: the gain of one Gauss–Newton step of the unknowns z on the means' residual without the data sheet's
+    prior rows (the whitening *W*, the design *D* of z), the data-alone step of :func:`fit_recording`'s noise between
+    segments and of :func:`_data_alone`."""
+    return np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE) @ W
+
+
 def _data_alone(theta: np.ndarray, basis: np.ndarray, design: np.ndarray, W: np.ndarray, residual: np.ndarray,
                 sources: Sources, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """What the data alone say of the parameters, where the fit carried the data sheet as a prior: θ̂ + B·(W·D)⁺·W·r,
@@ -509,9 +516,7 @@ def _data_alone(theta: np.ndarray, basis: np.ndarray, design: np.ndarray, W: np.
     JCGM 100 5.1.2 over the fit's *sources* (no data-sheet part). NaN where *mask* is False. Where the data sheet
     holds, it differs from θ̂ by (u/U)² of θ̂'s distance from nominal; where the data contradict it
     (:func:`plansim.fit.identify.data_sheet_conflict`), it is what the data put the unit at."""
-    n = len(theta)
-    step = np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE)[:basis.shape[1]] @ W
-    gain = basis[:n] @ step
+    gain = basis[:len(theta)] @ _step_without_prior(W, design)[:basis.shape[1]]
     u = propagate("data_alone", gain, sources, mask).u
     return np.where(mask, theta + gain @ residual, math.nan), u
 
@@ -828,7 +833,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                 # data sheet's pull puts into the means. Where the unit lies outside its data sheet, the pull's
                 # residual would otherwise read as slow noise, and the conflict it is (data_sheet_conflict) would
                 # hide in the noise it inflated; where the data sheet holds, the two residuals differ by (u/U)².
-                data_hat = design @ np.linalg.pinv(W @ design, rcond=RANK_TOLERANCE) @ W
+                data_hat = design @ _step_without_prior(W, design)
                 residual_data = residual_predicted - data_hat @ residual_predicted
             else:
                 data_hat, residual_data = hat, residual_predicted
@@ -862,9 +867,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         if held_cross else []
     for (a, b), u in zip(held_cross, bound):  # at the fitted tilts (J): the part the tilts do not take up
         held_sources.add(J[:, a] + J[:, b], u, math.inf, "held")
+    every_source = sources.joined(held_sources)
     if conflict:
-        alone, alone_u = _data_alone(theta, step_basis, design, W, m - fitted.ravel(), sources.joined(held_sources),
-                                     mask)
+        alone, alone_u = _data_alone(theta, step_basis, design, W, m - fitted.ravel(), every_source, mask)
         for group, entry in conflict.items():
             entry["data_alone"] = {p.name: (float(alone[k]), float(alone_u[k])) for k, p in enumerate(PARAMETERS)
                                    if p.group == group and mask[k]}
@@ -876,7 +881,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             "the prior pulls those estimates towards nominal (the data alone: one Gauss–Newton step without the "
             "prior, u from the same sources); state the data sheet again (scenario [reduction] data_sheet_*) or fit "
             "with the consumer default")
-    joint = propagate(METHOD_JOINT, gain, sources.joined(held_sources), mask,
+    joint = propagate(METHOD_JOINT, gain, every_source, mask,
                       prior_gain=None if prior_gains is None else prior_gains[0], prior_u=limits)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
     residual = m - fitted.ravel()

@@ -15,7 +15,7 @@ from plansim.fit.identify import describe_conflict
 from plansim.fit.joint import FitResult
 from plansim.fit.noise import UNITS_SI, channel_kind
 from plansim.kernels.layout import CHANNELS
-from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 
 JSON_KEYS = ("identified", "not_identified", "weakly_determined", "site", "turntable", "parameters", "noise",
              "residuals", "chi2_dof", "moves", "data_sheet_conflict")
@@ -76,7 +76,7 @@ def fit_json(result: FitResult) -> dict:
         "moves": _moves_json(result.moves),
         "data_sheet_conflict": [{"group": group, "statistic": _number(entry["statistic"]), "dof": int(entry["dof"]),
                                  "p_value": _number(entry["p_value"]), "contradicted": entry["contradicted"],
-                                 "data_alone": [{"name": name, "unit": PARAMETERS[PARAMETER_NAMES.index(name)].si_unit,
+                                 "data_alone": [{"name": name, "unit": PARAMETERS[PARAMETER_INDEX[name]].si_unit,
                                                  "estimate": _number(estimate), "u": _number(u)}
                                                 for name, (estimate, u) in entry.get("data_alone", {}).items()]}
                                 for group, entry in result.data_sheet_conflict.items()],
