@@ -505,6 +505,35 @@ def test_rows_dropped_here_and_there_are_not_gaps(tmp_path):
     assert abs(rotation.integrated[2] - 2 * math.pi) < math.radians(1.0)
 
 
+def test_a_host_that_stamps_rows_in_bursts_as_a_serial_link_delivers_them(tmp_path):
+    """A logger on a PC stamps each row when the USB-serial link hands it over: rows come four at a time, stamped
+    20 us apart, then 40 ms later the next four. The median step (20 us) read as the sample period made the log
+    50 kHz with a gap every fourth row, and no pose could be found. The stamps are delivery times now (a named
+    warning): the rate is the rows over the time, the samples evenly spaced, and the poses, the turn and its angle
+    are those of the same log stamped by its sampling clock."""
+    t, x = synthetic_log(seconds_rest=6.0)
+    k = np.arange(t.size)
+    burst = k // 4 * 4
+    delay = np.repeat(np.random.default_rng(4).uniform(0.0, 0.004, t.size // 4 + 1), 4)[:t.size]
+    stamps = 12.0 + t[burst + 3] + 0.002 + delay + (k - burst) * 20e-6  # seconds since the logger started
+    write_synthetic(tmp_path / "clock.csv", t, x)
+    write_synthetic(tmp_path / "host.csv", stamps, x)
+    clock = import_log(tmp_path / "clock.csv", time_column="time")
+    host = import_log(tmp_path / "host.csv", time_column="time")
+    assert [w.name for w in host.warnings] == ["delivery_times"] and not clock.warnings
+    assert host.timing.delivery and not clock.timing.delivery
+    assert host.timing.sample_rate == pytest.approx(100.0, rel=1e-3) and host.timing.gaps == ()
+    assert host.recording.attrs["time_stamps"].startswith("delivery") and clock.recording.attrs["time_stamps"] == \
+        "sampling"
+    assert [(s.kind, s.start, s.stop) for s in host.segmentation.spans] == \
+        [(s.kind, s.start, s.stop) for s in clock.segmentation.spans]
+    turn = host.segmentation.of_kind("rotation")[0].integrated[2]
+    assert turn == pytest.approx(clock.segmentation.of_kind("rotation")[0].integrated[2], abs=math.radians(0.5))
+    # the samples' times are the sampling clock's, to within the deliveries' spread about their mean
+    times = host.recording.time - host.recording.time[0]
+    assert np.max(np.abs(times - t)) < 0.01
+
+
 def test_unit_and_scale_parsing():
     assert parse_units(None) == ("rad/s",) * 3 + ("m/s^2",) * 3
     assert parse_units("deg/s,g") == ("deg/s",) * 3 + ("g",) * 3
@@ -592,6 +621,10 @@ def test_a_commented_header_and_ns_timestamps_as_euroc_writes_them(tmp_path):
     assert result.timing.sample_rate == pytest.approx(100.0, rel=1e-6)
     assert [s.test for s in result.recording.schedule.segments] == ["static", "rotation", "static"]
     assert result.table.header_line == 1 and not result.table.preamble
+    # the time column named as the header line reads, '#' and all, is the same column
+    same = import_log(tmp_path / "data.csv", columns=tuple(names), time_column="#timestamp [ns]", time_unit="ns")
+    np.testing.assert_array_equal(same.recording.samples, result.recording.samples)
+    np.testing.assert_array_equal(same.recording.time, result.recording.time)
 
 
 def test_semicolons_and_decimal_commas_as_a_spreadsheet_exports_them(tmp_path, capsys):

@@ -132,6 +132,28 @@ def test_a_clock_coarser_than_the_sampling_and_a_misstamped_sample():
     assert [k for k, _ in analyse_time(glitch, 1000).gaps] == [600]
 
 
+def test_delivery_stamps_are_not_read_as_dropped_samples_and_a_real_gap_still_is():
+    """A clock that jitters by 30 % of the period (0.3 ms RMS per stamp at 1 kHz, a host's stamps) passes 1.5 periods
+    in 11 % of its steps: read as a sampling clock, each was a dropped sample (2264 of them), and the rate, taken
+    over the other steps, came out 10 % high (1097.8 Hz). The steps are no whole number of the usual one, so they are read as delivery
+    times (DELIVERY_FRACTION): no sample dropped, the rate the mean one, the samples' times the clock's to the
+    jitter. A real gap of 0.5 s (500 samples) is still found, with its count, and the stretch after it is placed
+    on its own stamps."""
+    rng = np.random.default_rng(8)
+    true = np.arange(20000) / 1000.0
+    true[12000:] += 0.5
+    stamps = np.sort(true + rng.normal(0.0, 0.3e-3, true.size))
+    report = analyse_time(stamps, true.size)
+    assert report.delivery and report.dropped == ()
+    assert [k for k, _ in report.gaps] == [12000] and report.missing_samples == 500
+    assert report.sample_rate == pytest.approx(1000.0, rel=1e-4)
+    assert np.max(np.abs(report.sample_times - true)) < 1e-4
+    # the same clock jittering by 1 % of the period is a sampling clock: its stamps are the samples' times
+    steady = true + rng.normal(0.0, 0.01e-3, true.size)
+    report = analyse_time(steady, true.size)
+    assert not report.delivery and report.sample_times is None and [k for k, _ in report.gaps] == [12000]
+
+
 def test_a_steady_turn_between_two_rests_is_a_rotation_with_its_rate_and_no_angle():
     """A table holding -90 deg/s for 4 s about z (up): its steady part is a rotation with its measured rate and no
     angle (step 9: the table's rate is the reference), the few samples where the windows straddle the rest and the

@@ -139,6 +139,14 @@ GAP_FACTOR = 1.5
 #: now and then), not a gap: a pose's mean does not need it, and a turn is integrated over the time column, which
 #: bridges it (:func:`analyse_time`)
 DROPPED_MAX = 2
+#: a time column where more than this fraction of the steps are not a whole number of its usual step (within
+#: ``DELIVERY_SLACK`` of one) stamps the samples' delivery, not their sampling: a host that stamps what a serial or
+#: wireless link hands it in bursts, or a clock that jitters by a large part of the period (:func:`analyse_time`)
+DELIVERY_FRACTION = 0.05
+DELIVERY_SLACK = 0.25
+#: with delivery stamps, a break is a step longer than GAP_FACTOR times this quantile of the steps (the longest
+#: usual delivery), not than GAP_FACTOR periods, which a late delivery passes without a sample missing
+DELIVERY_QUANTILE = 0.999
 #: a time column whose span holds more than this many times the samples its median step implies comes from a clock
 #: coarser than the sampling (:func:`analyse_time`)
 COARSE_CLOCK_FACTOR = 1.05
@@ -191,6 +199,11 @@ class TimeReport:
         Time steps of exactly zero.
     dropped : tuple of (int, int)
         ``(k, m)``: m ≤ :data:`DROPPED_MAX` samples dropped before sample k — not a gap.
+    delivery : bool
+        Whether the time column stamps the samples' delivery, not their sampling (:data:`DELIVERY_FRACTION`).
+    sample_times : (N,) array or None
+        With delivery stamps, the samples' times: a uniform clock at ``sample_rate`` between breaks, each stretch
+        placed on its stamps' mean, s; ``None`` otherwise (the stamps are the sample times).
     """
 
     sample_rate: float
@@ -201,6 +214,8 @@ class TimeReport:
     missing_samples: int
     repeated: int
     dropped: tuple[tuple[int, int], ...] = ()
+    delivery: bool = False
+    sample_times: np.ndarray | None = None
 
     @property
     def dropped_samples(self) -> int:
@@ -228,6 +243,19 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
         holds more than :data:`COARSE_CLOCK_FACTOR` times the samples that step implies (a clock coarser than the
         sampling: its steps of 0 are reported as ``repeated``, and a gap is then a step of more than
         ``GAP_FACTOR`` clock steps): a step longer than ``GAP_FACTOR`` times that period.
+
+    Notes
+    -----
+    A sampling clock, even a jittering or coarse one, advances by whole numbers of its usual step (the median
+    step): 1 between samples, 2 or more over a dropped one, 0 where it is coarser than the sampling. A host that
+    stamps the rows as a serial, USB or wireless link hands them over does not: rows come in bursts stamped
+    microseconds apart, then a step of the burst's length. Where more than :data:`DELIVERY_FRACTION` of the steps
+    are further than :data:`DELIVERY_SLACK` from a whole number of the usual step, the column is read as delivery
+    times: a break (gap or dropped samples) is then a step longer than ``GAP_FACTOR`` times the
+    :data:`DELIVERY_QUANTILE` quantile of the steps (a sample dropped among late deliveries cannot be told), the
+    rate is 1 / the least-squares slope of the stamps against the sample number (common to the stretches between
+    breaks), and the samples' times are a uniform clock at that rate between breaks (``sample_times``), each
+    stretch placed on its stamps' mean.
     """
     if time is None:
         if sample_rate is None:
@@ -252,6 +280,10 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     nominal = estimated if sample_rate is None else float(sample_rate)
     period = 1.0 / nominal
     step = max(period, tick)
+    ratio = positive / tick
+    delivery = bool(np.mean(np.abs(ratio - np.round(ratio)) > DELIVERY_SLACK) > DELIVERY_FRACTION)
+    if delivery:
+        step = max(step, float(np.quantile(dt, DELIVERY_QUANTILE)))
     gap = dt > GAP_FACTOR * step
     # one sample stamped with its predecessor's time (a step of 0, then one of two periods) is a glitch of the
     # clock, not a gap: nothing is missing
@@ -264,6 +296,26 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
         estimated = float(np.count_nonzero(~gap)) / float(np.sum(dt[~gap]))
         nominal = estimated if sample_rate is None else float(sample_rate)
         period = 1.0 / nominal
+    sample_times = None
+    if delivery:
+        # a uniform clock between breaks: its period the least-squares slope of the stamps against the sample
+        # number, common to the stretches (a burst's stamp is late by up to the burst, at either end of the log:
+        # the steps' mean would carry that over the log's length), each stretch placed on its stamps' mean
+        t = np.asarray(time, dtype=np.float64)
+        edges = [0, *(int(k) + 1 for k in np.flatnonzero(gap)), samples]
+        stretches = [(a, b) for a, b in zip(edges[:-1], edges[1:])]
+        centred = [(np.arange(b - a) - (b - a - 1) / 2.0, t[a:b] - np.mean(t[a:b])) for a, b in stretches]
+        slope = sum(float(k @ y) for k, y in centred) / sum(float(k @ k) for k, _ in centred)
+        if slope > 0:
+            estimated = 1.0 / slope
+            nominal = estimated if sample_rate is None else float(sample_rate)
+            period = 1.0 / nominal
+        sample_times = np.empty_like(t)
+        for a, b in stretches:
+            offset = np.arange(b - a) * period
+            sample_times[a:b] = np.mean(t[a:b] - offset) + offset
+        # a break's length between the placed stretches, not between two late or early stamps
+        dt = np.where(gap, np.diff(sample_times), dt)
     breaks = [(int(k) + 1, float(dt[k]), max(round(dt[k] * nominal) - 1, 1)) for k in np.flatnonzero(gap)]
     gaps = tuple((k, d) for k, d, m in breaks if m > DROPPED_MAX)
     missing = int(sum(m for _, _, m in breaks if m > DROPPED_MAX))
@@ -272,7 +324,7 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
     jitter_rms = float(np.sqrt(np.mean(regular**2))) if regular.size else 0.0
     jitter_max = float(np.max(np.abs(regular))) if regular.size else 0.0
     return TimeReport(nominal, estimated, jitter_rms, jitter_max, gaps, missing, int(np.count_nonzero(dt == 0)),
-                      dropped)
+                      dropped, delivery, sample_times)
 
 
 @dataclass(frozen=True)

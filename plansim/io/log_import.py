@@ -73,7 +73,7 @@ FULL_SCALE_EXCEEDED = 0.02
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
-                 "rest_turning_about_vertical", "glitch")
+                 "delivery_times", "rest_turning_about_vertical", "glitch")
 #: up to this many glitch rows are listed by line in the warning
 GLITCHES_LISTED = 10
 #: two saturated stretches of one channel at most this many detector windows apart are one episode (a shake hits
@@ -266,9 +266,13 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 continue
             if stripped.startswith("#"):
                 # a commented header names the columns too (EuRoC, TUM-VI, Kalibr: "#timestamp [ns],w_RS_S_x …")
+                # read without its '#' ("timestamp [ns]") or as it stands ("#timestamp [ns]", as a user copies it)
                 uncommented = stripped.lstrip("#").strip()
                 if uncommented and set(wanted) <= set(_names(uncommented)):
                     header = uncommented
+                    break
+                if set(wanted) <= set(_names(stripped)):
+                    header = stripped
                     break
                 continue
             if _all_numbers(stripped) and _next_row_alike(fh, stripped):
@@ -581,7 +585,15 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if timing.repeated:
         warnings.append(LogWarning("repeated_time", f"{timing.repeated} time step(s) of exactly 0 s: the time "
                                                     "column's resolution is coarser than the sample period?"))
-    if timing.jitter_rms > JITTER_WARNING * period:
+    if timing.delivery:
+        warnings.append(LogWarning("delivery_times", f"column {table.time_column!r} stamps the rows' delivery, not "
+                                                     "their sampling (its steps are no whole number of its usual "
+                                                     f"step: bursts, or jitter of {timing.jitter_rms:.3g} s RMS, "
+                                                     f"largest {timing.jitter_max:.3g} s, against a period of "
+                                                     f"{period:.6g} s): the samples are taken as evenly spaced at "
+                                                     f"{timing.sample_rate:.6g} Hz between gaps; a dropped sample "
+                                                     "cannot be told from a late one"))
+    elif timing.jitter_rms > JITTER_WARNING * period:
         warnings.append(LogWarning("jitter", f"timing jitter {timing.jitter_rms:.3g} s RMS (largest "
                                              f"{timing.jitter_max:.3g} s) is more than {JITTER_WARNING:.0%} of the "
                                              f"sample period {period:.6g} s"))
@@ -609,6 +621,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                            "column? plansim fit refuses a channel that never "
                                                            "changes"))
 
+    if timing.sample_times is not None:
+        time_s = timing.sample_times
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
                                gap_starts=timing.gap_starts, full_scale=rail_si)
     statics = segmentation.of_kind("static")
@@ -746,7 +760,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                       "time_jitter_max_s": timing.jitter_max, "time_gaps": len(timing.gaps),
                       "time_gap_missing_samples": timing.missing_samples,
                       "time_gap_largest_s": max((dt for _, dt in timing.gaps), default=0.0),
-                      "time_dropped_samples": timing.dropped_samples})
+                      "time_dropped_samples": timing.dropped_samples,
+                      "time_stamps": "delivery: the samples taken as evenly spaced between gaps" if timing.delivery
+                      else "sampling"})
     if table.temperature is None:
         how = "given (--temperature)" if temperature is not None else "assumed (the log has no temperature)"
         attrs["segment_temperature"] = f"{segment_temperature:g} degC, {how}"
