@@ -25,7 +25,14 @@ import pytest
 
 from plansim.cli import main
 from plansim.estimate.segmentation import segment_log
-from plansim.io.log_import import MAX_PREAMBLE_LINES, import_log, parse_offset, parse_scale, parse_units
+from plansim.io.log_import import (
+    MAX_PREAMBLE_LINES,
+    MAX_TRAILING_LINES,
+    import_log,
+    parse_offset,
+    parse_scale,
+    parse_units,
+)
 from plansim.io.recording import nominal_time, read_recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.runner import simulate_and_record
@@ -532,6 +539,39 @@ def test_a_host_that_stamps_rows_in_bursts_as_a_serial_link_delivers_them(tmp_pa
     # the samples' times are the sampling clock's, to within the deliveries' spread about their mean
     times = host.recording.time - host.recording.time[0]
     assert np.max(np.abs(times - t)) < 0.01
+
+
+def test_a_units_row_a_footer_and_a_row_the_logger_did_not_finish(tmp_path):
+    """Loggers write a row of units under the header, a footer after the data, or stop inside their last row (no
+    line break). Each stopped the import; each is now skipped with a named warning, and the samples are those of
+    the clean log. A line that is not a sample with samples after it, or more than MAX_TRAILING_LINES of them at
+    the end, still stops it, naming the line."""
+    t, x = synthetic_log()
+    write_synthetic(tmp_path / "clean.csv", t, x)
+    text = (tmp_path / "clean.csv").read_text()
+    header, *rows = text.splitlines()
+    clean = import_log(tmp_path / "clean.csv", time_column="time")
+    cases = {
+        "units": ("\n".join([header, "s,rad/s,rad/s,rad/s,m/s^2,m/s^2,m/s^2", *rows]) + "\n", "units_row", "line 2"),
+        "footer": ("\n".join([header, *rows, "END OF LOG", f"rows,{len(rows)}"]) + "\n", "trailing_lines",
+                   "2 line(s)"),
+        "cut": ("\n".join([header, *rows, rows[-1][:9]]), "trailing_lines", "no line break"),
+        "short": ("\n".join([header, *rows, rows[-1][:9]]) + "\n", "trailing_lines", "2 values, not 7"),
+    }
+    for name, (content, warning, words) in cases.items():
+        (tmp_path / f"{name}.csv").write_text(content)
+        result = import_log(tmp_path / f"{name}.csv", time_column="time")
+        assert [w.name for w in result.warnings] == [warning], name
+        assert words in result.warnings[0].message, (name, result.warnings[0].message)
+        np.testing.assert_array_equal(result.recording.samples, clean.recording.samples)
+    middle = "\n".join([header, *rows[:50], "END OF LOG", *rows[50:]]) + "\n"
+    (tmp_path / "middle.csv").write_text(middle)
+    with pytest.raises(ValueError, match="line 52 has 1 values, fewer than the 7 columns"):
+        import_log(tmp_path / "middle.csv", time_column="time")
+    long_footer = "\n".join([header, *rows, *[f"note {k}" for k in range(MAX_TRAILING_LINES + 1)]]) + "\n"
+    (tmp_path / "long.csv").write_text(long_footer)
+    with pytest.raises(ValueError, match=f"line {len(rows) + 2} has 1 values"):
+        import_log(tmp_path / "long.csv", time_column="time")
 
 
 def test_unit_and_scale_parsing():

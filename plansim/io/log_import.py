@@ -37,7 +37,7 @@ from plansim.estimate.segmentation import (
     analyse_time,
     segment_log,
 )
-from plansim.io.recording_csv import _check_line_end, _text_file
+from plansim.io.recording_csv import _text_file, _unterminated_last_line
 from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
 from plansim.schedule.segments import Schedule, Segment
 from plansim.units import KINDS, STANDARD_GRAVITY
@@ -59,6 +59,9 @@ RATE_MISMATCH_WARNING = 0.01
 #: lines a logger may write before the header (its own metadata, such as "Fs,100"): the header is the first line
 #: that names every column asked for, searched this far; those before it are skipped and reported
 MAX_PREAMBLE_LINES = 50
+#: lines after the last sample that are not samples (a logger's footer, a row it did not finish when stopped):
+#: skipped and reported up to this many; more, or one followed by samples, stops the import
+MAX_TRAILING_LINES = 10
 #: rows converted to numbers at a time while reading
 _BLOCK_ROWS = 65536
 #: the range of a lab temperature given with --temperature, degC: the widest a MEMS IMU is rated for (automotive
@@ -73,7 +76,7 @@ FULL_SCALE_EXCEEDED = 0.02
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
-                 "delivery_times", "rest_turning_about_vertical", "glitch")
+                 "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines")
 #: up to this many glitch rows are listed by line in the warning
 GLITCHES_LISTED = 10
 #: two saturated stretches of one channel at most this many detector windows apart are one episode (a shake hits
@@ -130,6 +133,11 @@ class LogTable:
     decimal_comma: bool = False  # some values were written with a decimal comma (";"- or tab-separated logs)
     #: False: the log has no header line; its columns are named by their position, "1" for the first
     has_header: bool = True
+    #: a row of units just under the header ("s,deg/s,…"): its line and the channels' six entries, skipped
+    units_row: tuple[int, tuple[str, ...]] | None = None
+    #: ``(line, why)`` of the lines after the last sample that are not samples (a footer, a row the logger did
+    #: not finish, a last line with no line break): skipped (:data:`MAX_TRAILING_LINES` at most)
+    trailing: tuple[tuple[int, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -333,16 +341,28 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         block: list[list[float]] = []
         lines: list[int] = []
         line_number = header_line
+        cut = _unterminated_last_line(target)  # a logger stopped while writing its last row
+        units_row = None
+        trailing: list[tuple[int, str, str]] = []  # (line, why, the error it is if a sample follows)
         for row in _rows(fh, delimiter):
             line_number += 1
             if not row or all(not cell.strip() for cell in row):
                 continue
             if row[0].lstrip().startswith("#"):
                 continue
+            if line_number == cut:
+                trailing.append((line_number, "no line break", ""))
+                continue
+            if has_header and not lines and units_row is None and len(row) == width and all(
+                    row[k].strip() and not _is_number(row[k].strip(), delimiter) for k in index):
+                units_row = (line_number, tuple(row[k].strip() for k in index[:6]))  # "s,deg/s,…" under the header
+                continue
             if len(row) != width:
                 word = "more" if len(row) > width else "fewer"
-                raise ValueError(f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
-                                 f"of the header (line {header_line}); every row holds one value per column")
+                trailing.append((line_number, f"{len(row)} values, not {width}",
+                                 f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
+                                 f"of the header (line {header_line}); every row holds one value per column"))
+                continue
             try:
                 numbers = [float(row[k]) for k in index]
             except ValueError:
@@ -356,8 +376,12 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                         numbers = None
             if numbers is None:
                 j = next(j for j, k in enumerate(index) if not _is_number(row[k], delimiter))
-                raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
-                                 "expected a number") from None
+                trailing.append((line_number, f"{wanted[j]} is {row[index[j]].strip()!r}",
+                                 f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
+                                 "expected a number"))
+                continue
+            if trailing:  # a line that is not a sample, followed by samples: the log is broken there
+                raise ValueError(trailing[0][2])
             if not all(map(math.isfinite, numbers)):
                 j = next(j for j, v in enumerate(numbers) if not math.isfinite(v))
                 raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
@@ -370,15 +394,18 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 block = []
         if block:
             blocks.append(np.array(block, dtype=np.float64))
-    _check_line_end(target, where)
     if not blocks:
+        if trailing and trailing[0][2]:
+            raise ValueError(trailing[0][2])
         raise ValueError(f"{where}: no sample after the header (line {header_line})")
+    if len(trailing) > MAX_TRAILING_LINES:
+        raise ValueError(next(error for _, _, error in trailing if error))
     data = np.concatenate(blocks)
     time = data[:, 6] if time_column is not None else None
     temperature = data[:, -1] if temperature_column is not None else None
     return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
                     lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
-                    has_header)
+                    has_header, units_row, tuple((line, why) for line, why, _ in trailing))
 
 
 def _delimiter(line: str) -> str:
@@ -555,6 +582,18 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                  "reads (in --units), e.g. 2000,16 with --units deg/s,g")
 
     warnings: list[LogWarning] = []
+    if table.units_row is not None:
+        line, entries = table.units_row
+        warnings.append(LogWarning("units_row", f"line {line}, under the header, reads {', '.join(entries)} for "
+                                                f"{', '.join(CHANNELS)}: a row of units, skipped, not read; the "
+                                                f"channels are read in {', '.join(dict.fromkeys(unit_names))} "
+                                                "(--units): check that they agree"))
+    if table.trailing:
+        shown = "; ".join(f"line {line}: {why}" for line, why in table.trailing[:4])
+        warnings.append(LogWarning("trailing_lines", f"{len(table.trailing)} line(s) after the last sample (line "
+                                                     f"{table.lines[-1]}) are not samples, skipped: {shown}"
+                                                     + ("; …" if len(table.trailing) > 4 else "")
+                                                     + " (a footer, or a row the logger did not finish)"))
     time_s = None
     if table.time is not None:
         seconds = (1.0 / sample_rate) if time_unit == "samples" else TIME_UNITS[time_unit]

@@ -180,23 +180,29 @@ def _not_utf8(where: str, exc: UnicodeDecodeError) -> str:
             "a NetCDF file renamed .csv? A CSV recording is UTF-8 text (docs/recording.md)")
 
 
+def _unterminated_last_line(path: Path) -> int | None:
+    """The number (1-based) of a file's last line if it does not end with a line break, else None."""
+    with open(path, "rb") as raw:
+        size = raw.seek(0, os.SEEK_END)
+        raw.seek(max(0, size - 64))
+        tail = raw.read().rstrip(b" \t")
+        if not tail or tail[-1:] in (b"\n", b"\r"):
+            return None
+        raw.seek(0)
+        return sum(block.count(b"\n") for block in iter(lambda: raw.read(1 << 20), b"")) + 1
+
+
 def _check_line_end(path: Path, where: str) -> None:
     """A complete file ends with a line break: text after the last one may be a number cut short.
 
     A file cut inside its last number keeps every row and column, so no count shows it; plansim ends
     every line it writes, and so do spreadsheet and acquisition exports.
     """
-    with open(path, "rb") as raw:
-        size = raw.seek(0, os.SEEK_END)
-        raw.seek(max(0, size - 64))
-        tail = raw.read().rstrip(b" \t")
-        if not tail or tail[-1:] in (b"\n", b"\r"):
-            return
-        raw.seek(0)
-        breaks = sum(block.count(b"\n") for block in iter(lambda: raw.read(1 << 20), b""))
-    raise ValueError(f"{where}: the last line (line {breaks + 1}) does not end with a line break: the file may "
-                     "have been cut short inside its last number (a copy or transfer that stopped); if the file is "
-                     "complete, end it with a line break")
+    last = _unterminated_last_line(path)
+    if last is not None:
+        raise ValueError(f"{where}: the last line (line {last}) does not end with a line break: the file may "
+                         "have been cut short inside its last number (a copy or transfer that stopped); if the file "
+                         "is complete, end it with a line break")
 
 
 def _read_header(fh, where: str) -> tuple[dict, list[str], int]:
