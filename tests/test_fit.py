@@ -26,6 +26,7 @@ from plansim.fit.identify import identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.noise import (
     TERM_THRESHOLD,
+    _on_grid,
     allan_deviation,
     dither_for_error,
     fit_allan,
@@ -639,6 +640,18 @@ def test_quantisation_step_from_the_data():
     mixed = [s.copy() for s in segments]
     mixed[0] = mixed[0] + 0.3 * q * np.sin(np.arange(mixed[0].size))
     assert quantisation_step(mixed) == 0.0
+    # a 16-bit gyro's step (2000/32768 deg/s) printed to 4 decimals (a log's fixed format): each level rounded by up
+    # to 5e-5, 8e-4 of a step, so that no gap is a whole multiple of the smallest; the step is still found, to that
+    # rounding, and continuous noise printed so is quantised by the printing
+    lsb = 2000.0 / 32768.0
+    printed = [np.round(lsb * np.round((level + 1.5 * lsb * rng.normal(size=2000)) / lsb), 4)
+               for level in rng.normal(0, 1, 10)]
+    assert not _on_grid(np.diff(np.unique(np.concatenate(printed))), min(np.diff(np.unique(printed[0]))))
+    assert quantisation_step(printed) == pytest.approx(lsb, abs=1e-4)
+    assert quantisation_step([np.round(level + 0.05 * rng.normal(size=2000), 3) for level in range(5)]) == \
+        pytest.approx(1e-3, rel=1e-6)
+    # the segment not quantised, printed to 4 decimals too: the printing's step is what every level sits on
+    assert quantisation_step([np.round(s, 4) for s in mixed]) == pytest.approx(1e-4, rel=1e-6)
     assert float(quantisation_error_variance(q, 0.0)) == pytest.approx(q**2 / 12, rel=1e-3)
     assert float(quantisation_error_variance(q, q)) < 1e-12 * q**2  # dithered
 

@@ -58,6 +58,9 @@ QUANTISATION_MATCH = 1e-6
 #: … and never by more than this fraction of a step
 QUANTISATION_OFF_GRID = 0.01
 QUANTISATION_DISTINCT = 0.5
+#: the gaps of one step may differ by at most this fraction of it where the log's printing rounded the levels
+#: (:func:`quantisation_step`)
+QUANTISATION_PRINTED = 5e-3
 #: the drop in χ² for which the Allan fit takes a bias-instability or random-walk term (per term); calibrated by
 #: simulation (tests/test_fit.py): pure white noise in 21 segments of 3000 samples gets one in 0.9 % of 1000 channels
 TERM_THRESHOLD = 13.0
@@ -196,7 +199,10 @@ def quantisation_step(segments: list[np.ndarray]) -> float:
     between distinct values within any segment, accepted when every such gap is a whole multiple of it
     (to :data:`QUANTISATION_MATCH`) and at most :data:`QUANTISATION_DISTINCT` of those segments' samples
     are distinct. A channel constant within every segment (no noise at all, or noise far below the step)
-    shows no step: 0.
+    shows no step: 0. A log printed to a fixed number of decimals rounds every level: the gaps then miss whole
+    multiples of the smallest one by up to the rounding, so where they do, the step is the median of the gaps of
+    one step, accepted where those differ by at most :data:`QUANTISATION_PRINTED` of it and every gap of n steps is
+    within (n + 1) times their spread of n steps (at most :data:`QUANTISATION_OFF_GRID`).
 
     Parameters
     ----------
@@ -216,7 +222,21 @@ def quantisation_step(segments: list[np.ndarray]) -> float:
     q = float(gaps.min())
     if q <= 0:
         return 0.0
-    return q if _on_grid(gaps, q) else 0.0
+    if _on_grid(gaps, q):
+        return q
+    # a log printed to a fixed number of decimals rounds each level: its gaps miss whole multiples of the step by up
+    # to twice that rounding, and the smallest gap is the step less it. The gaps of one step show the rounding: the
+    # step is their median, and every gap of n steps may miss n steps by (n + 1) times their spread
+    one = np.rint(gaps / q) == 1
+    q = float(np.median(gaps[one]))
+    spread = float(np.max(np.abs(gaps[one] - q)))
+    if spread > QUANTISATION_PRINTED * q:
+        return 0.0
+    ratio = gaps / q
+    n = np.rint(ratio)
+    allowance = np.minimum((n + 1.0) * spread / q + QUANTISATION_MATCH * np.maximum(ratio, 1.0),
+                           QUANTISATION_OFF_GRID)
+    return q if bool(np.all(np.abs(ratio - n) <= allowance)) else 0.0
 
 
 def _on_grid(gaps: np.ndarray, q: float) -> bool:
