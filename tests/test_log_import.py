@@ -576,6 +576,11 @@ def test_a_units_row_a_footer_and_a_row_the_logger_did_not_finish(tmp_path):
 
 def test_unit_and_scale_parsing():
     assert parse_units(None) == ("rad/s",) * 3 + ("m/s^2",) * 3
+    # the spellings logs and data sheets use; a scaled unit is refused with how to read it
+    assert parse_units("dps,m/s2") == ("deg/s",) * 3 + ("m/s^2",) * 3
+    assert parse_units("°/s,m/s²") == parse_units("deg/sec,m/s/s") == ("deg/s",) * 3 + ("m/s^2",) * 3
+    with pytest.raises(ValueError, match=r"'mdps' for channel gx \(1e-3 deg/s: give --units deg/s with --scale 1000"):
+        parse_units("mdps,mg")
     assert parse_units("deg/s,g") == ("deg/s",) * 3 + ("g",) * 3
     assert parse_units("deg/s,deg/s,rad/s,g,mg,m/s^2")[2:4] == ("rad/s", "g")
     with pytest.raises(ValueError, match="3 entries; expected 2 .* or 6"):

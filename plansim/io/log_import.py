@@ -177,10 +177,22 @@ def parse_units(text: str | None) -> tuple[str, ...]:
                          f"(one per channel {', '.join(CHANNELS)})")
     for k, unit in enumerate(items):
         kind = "angular_rate" if k < 3 else "acceleration"
+        items[k] = unit = UNIT_SPELLINGS.get(unit, unit)
         if unit not in KINDS[kind]:
-            raise ValueError(f"--units {text!r}: {unit!r} for channel {CHANNELS[k]}; allowed: "
+            hint = f" ({SCALED_UNITS[unit]})" if unit in SCALED_UNITS else ""
+            raise ValueError(f"--units {text!r}: {unit!r} for channel {CHANNELS[k]}{hint}; allowed: "
                              f"{', '.join(u for u in KINDS[kind] if u)}")
     return tuple(items)
+
+
+#: other spellings of the units of :data:`plansim.units.KINDS` that logs and data sheets use (``--units``)
+UNIT_SPELLINGS = {"dps": "deg/s", "deg/sec": "deg/s", "°/s": "deg/s", "degree/s": "deg/s", "degrees/s": "deg/s",
+                  "rad/sec": "rad/s", "rps": "rad/s", "°/h": "deg/h", "dph": "deg/h", "m/s2": "m/s^2",
+                  "m/s²": "m/s^2", "m/s/s": "m/s^2", "m/sec^2": "m/s^2", "µg": "ug", "μg": "ug"}
+#: units that are a scaled unit of KINDS: how to read them (``--units``' error)
+SCALED_UNITS = {"mdps": "1e-3 deg/s: give --units deg/s with --scale 1000", "mdeg/s": "give --units deg/s with "
+                "--scale 1000", "mrad/s": "give --units rad/s with --scale 1000", "m/s^2*1000": "give --units m/s^2 "
+                "with --scale 1000", "mm/s^2": "give --units m/s^2 with --scale 1000"}
 
 
 def parse_scale(text: str | None) -> tuple[float, ...] | None:
