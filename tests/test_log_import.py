@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import datetime
 import io
 import json
 import math
@@ -572,6 +573,44 @@ def test_a_units_row_a_footer_and_a_row_the_logger_did_not_finish(tmp_path):
     (tmp_path / "long.csv").write_text(long_footer)
     with pytest.raises(ValueError, match=f"line {len(rows) + 2} has 1 values"):
         import_log(tmp_path / "long.csv", time_column="time")
+
+
+def test_a_time_column_of_clock_times(tmp_path, capsys):
+    """Loggers stamp rows with the clock: '2024-11-27 14:22:31.504' (ISO 8601, or with 'T' and 'Z'), unpadded
+    '2024-11-7 9:05:01.5' (WitMotion's software), or the time of day alone, which may pass midnight. Each is read
+    in seconds from the first sample and gives the clean log's rate and segments; a row whose time is not a clock
+    time stops the import naming its line, and --time-unit does not apply to clock times."""
+    t, x = synthetic_log()
+    write_synthetic(tmp_path / "seconds.csv", t, x)
+    reference = import_log(tmp_path / "seconds.csv", time_column="time")
+    start = datetime.datetime(2024, 11, 27, 23, 59, 55, 504000)  # passes midnight 4.5 s in
+    forms = {
+        "iso": lambda d: d.isoformat(sep=" ", timespec="milliseconds"),
+        "isoz": lambda d: d.isoformat(timespec="microseconds") + "Z",
+        "unpadded": lambda d: f"{d.year}-{d.month}-{d.day} {d.hour}:{d.minute:02d}:{d.second:02d}.{d.microsecond:06d}",
+        "time_of_day": lambda d: d.strftime("%H:%M:%S.%f"),
+    }
+    header, *rows = (tmp_path / "seconds.csv").read_text().splitlines()
+    for name, form in forms.items():
+        stamps = [form(start + datetime.timedelta(seconds=float(v))) for v in t]
+        text = "\n".join([header, *(f"{stamp},{row.split(',', 1)[1]}" for stamp, row in zip(stamps, rows))]) + "\n"
+        (tmp_path / f"{name}.csv").write_text(text)
+        result = import_log(tmp_path / f"{name}.csv", time_column="time")
+        assert result.table.clock_start == stamps[0], name
+        np.testing.assert_allclose(result.recording.time - result.recording.time[0], t - t[0], atol=1e-3)
+        assert result.timing.sample_rate == pytest.approx(100.0, rel=1e-4), name
+        assert [(s.kind, s.start, s.stop) for s in result.segmentation.spans] == \
+            [(s.kind, s.start, s.stop) for s in reference.segmentation.spans], name
+        assert not result.warnings and result.recording.attrs["time_clock_start"] == stamps[0]
+    assert main(["import", str(tmp_path / "iso.csv"), "--out", str(tmp_path / "r.nc"), "--time", "time"]) == 0
+    assert "holds clock times, read in seconds from the first (2024-11-27 23:59:55.504)" in capsys.readouterr().out
+    with pytest.raises(ValueError, match="holds clock times .* leave --time-unit out"):
+        import_log(tmp_path / "iso.csv", time_column="time", time_unit="ms")
+    broken = (tmp_path / "iso.csv").read_text().splitlines()
+    broken[40] = "NaT" + broken[40][broken[40].index(","):]
+    (tmp_path / "broken.csv").write_text("\n".join(broken) + "\n")
+    with pytest.raises(ValueError, match="column 'time' is 'NaT' at line 41; expected a clock time"):
+        import_log(tmp_path / "broken.csv", time_column="time")
 
 
 def test_unit_and_scale_parsing():

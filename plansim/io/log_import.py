@@ -17,8 +17,10 @@ log may still be used for despite a flaw (a gap, a saturated stretch, timing jit
 from __future__ import annotations
 
 import csv
+import datetime
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -138,6 +140,9 @@ class LogTable:
     #: ``(line, why)`` of the lines after the last sample that are not samples (a footer, a row the logger did
     #: not finish, a last line with no line break): skipped (:data:`MAX_TRAILING_LINES` at most)
     trailing: tuple[tuple[int, str], ...] = ()
+    #: the first sample's clock time where the time column holds clock times (``time`` is then in seconds from
+    #: it), else None
+    clock_start: str | None = None
 
 
 @dataclass(frozen=True)
@@ -250,7 +255,10 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         The column names of gx gy gz ax ay az; columns not named (and not the time or temperature column)
         are ignored. ``None``: the columns must be named ``gx gy gz ax ay az`` and the log may hold no other.
     time_column, temperature_column : str or None
-        Names of the time and temperature columns, if any.
+        Names of the time and temperature columns, if any. A time column of clock times (ISO 8601 date and time,
+        ``2024-11-27 14:22:31.504`` or with ``T``, ``/`` or unpadded fields, or the time of day alone,
+        ``14:22:31.504``) is read as such, in seconds from its first sample (:func:`_clock_time`); the first
+        sample decides.
 
     Raises
     ------
@@ -354,6 +362,9 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         lines: list[int] = []
         line_number = header_line
         cut = _unterminated_last_line(target)  # a logger stopped while writing its last row
+        clock = None  # the time column holds clock times (decided on the first sample): (days, seconds) of it
+        day = 0  # whole days a time of day alone has passed midnight
+        previous_stamp = 0.0
         units_row = None
         trailing: list[tuple[int, str, str]] = []  # (line, why, the error it is if a sample follows)
         for row in _rows(fh, delimiter):
@@ -375,6 +386,30 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                                  f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
                                  f"of the header (line {header_line}); every row holds one value per column"))
                 continue
+            stamp = None
+            if time_column is not None:
+                text = row[index[6]].strip()
+                if clock is None and not lines:
+                    first_clock = None if _is_number(text, delimiter) else _clock_time(text)
+                    clock = False if first_clock is None else first_clock
+                if clock:
+                    stamp = _clock_time(text)
+                    if stamp is not None and (stamp[0] is None) != (clock[0] is None):
+                        stamp = None  # a date where the first sample had none, or none where it had one
+                    if stamp is None:
+                        trailing.append((line_number, f"{time_column} is {text!r}",
+                                         f"{where}: column {time_column!r} is {text!r} at line {line_number}; "
+                                         f"expected a clock time, as the first sample's ({clock[2]!r})"))
+                        continue
+                    if stamp[0] is None:  # a time of day: it passes midnight where it falls by more than 12 h
+                        if lines and stamp[1] + day * 86400.0 < previous_stamp - 43200.0:
+                            day += 1
+                        seconds = stamp[1] + day * 86400.0
+                    else:
+                        seconds = (stamp[0] - clock[0]) * 86400.0 + stamp[1]
+                    previous_stamp = seconds
+                    row = list(row)
+                    row[index[6]] = "0"
             try:
                 numbers = [float(row[k]) for k in index]
             except ValueError:
@@ -394,6 +429,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 continue
             if trailing:  # a line that is not a sample, followed by samples: the log is broken there
                 raise ValueError(trailing[0][2])
+            if stamp is not None:
+                numbers[6] = seconds - clock[1]  # seconds from the first sample
             if not all(map(math.isfinite, numbers)):
                 j = next(j for j, v in enumerate(numbers) if not math.isfinite(v))
                 raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
@@ -417,7 +454,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     temperature = data[:, -1] if temperature_column is not None else None
     return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
                     lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
-                    has_header, units_row, tuple((line, why) for line, why, _ in trailing))
+                    has_header, units_row, tuple((line, why) for line, why, _ in trailing),
+                    clock[2] if clock else None)
 
 
 def _delimiter(line: str) -> str:
@@ -475,6 +513,28 @@ def _next_row_alike(fh, line: str) -> bool:
         return True
     finally:
         fh.seek(position)
+
+
+#: a clock time in a time column: an optional date (year, month, day; '-', '/' or '.' between, unpadded fields too)
+#: and a time of day (hours, minutes, seconds with a fraction after '.' or ','), an optional zone that is ignored
+_CLOCK_TIME = re.compile(r"^(?:(\d{4})[-/.](\d{1,2})[-/.](\d{1,2})[ T])?(\d{1,2}):(\d{2}):(\d{2}(?:[.,]\d+)?)"
+                         r"\s*(?:Z|[+-]\d{2}:?\d{2})?$")
+
+
+def _clock_time(text: str) -> tuple[int | None, float, str] | None:
+    """A clock time's (day number or None for a time of day alone, seconds into the day, the text); None if the
+    text is not one (:data:`_CLOCK_TIME`)."""
+    match = _CLOCK_TIME.match(text.strip())
+    if match is None:
+        return None
+    year, month, day, hours, minutes, seconds = match.groups()
+    try:
+        days = None if year is None else datetime.date(int(year), int(month), int(day)).toordinal()
+    except ValueError:
+        return None
+    if int(hours) > 23 or int(minutes) > 59 or float(seconds.replace(",", ".")) >= 61.0:
+        return None
+    return days, int(hours) * 3600.0 + int(minutes) * 60.0 + float(seconds.replace(",", ".")), text.strip()
 
 
 def _is_number(text: str, delimiter: str = ",") -> bool:
@@ -607,6 +667,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                      + ("; …" if len(table.trailing) > 4 else "")
                                                      + " (a footer, or a row the logger did not finish)"))
     time_s = None
+    if table.clock_start is not None and time_unit != "s":
+        raise ValueError(f"--time-unit {time_unit}: column {table.time_column!r} holds clock times "
+                         f"({table.clock_start!r}), read in seconds from the first; leave --time-unit out")
     if table.time is not None:
         seconds = (1.0 / sample_rate) if time_unit == "samples" else TIME_UNITS[time_unit]
         time_s = table.time * seconds
@@ -814,6 +877,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                       "time_dropped_samples": timing.dropped_samples,
                       "time_stamps": "delivery: the samples taken as evenly spaced between gaps" if timing.delivery
                       else "sampling"})
+        if table.clock_start is not None:
+            attrs["time_clock_start"] = table.clock_start
     if table.temperature is None:
         how = "given (--temperature)" if temperature is not None else "assumed (the log has no temperature)"
         attrs["segment_temperature"] = f"{segment_temperature:g} degC, {how}"
@@ -905,6 +970,9 @@ def format_summary(result: ImportResult) -> str:
         shown = "; ".join(table.preamble[:4]) + ("; …" if len(table.preamble) > 4 else "")
         where = f"the header (line {table.header_line})" if table.has_header else f"line {table.first_line}"
         lines.append(f"  before {where}: {len(table.preamble)} line(s) skipped, not read as data: {shown}")
+    if table.clock_start is not None:
+        lines.append(f"  time: column {table.time_column!r} holds clock times, read in seconds from the first "
+                     f"({table.clock_start})")
     if table.time is None:
         lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (given; no time column: gaps and jitter cannot be "
                      "seen)")
