@@ -42,7 +42,7 @@ from plansim.fit.result import JSON_KEYS, fit_json
 from plansim.io.recording import Recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.kernels.layout import HEAD, PER_SEGMENT, SEG_POSITION_ACCURACY, draws_length
-from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
+from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 from plansim.runner import simulate_and_record
 from plansim.schedule import Schedule, Segment
 from plansim.schedule.builders import multi_position
@@ -1092,6 +1092,55 @@ def test_the_ferraris_example_session_imports_and_fits():
     assert [estimate[f"Kg{a}{a}"] for a in "xyz"] == pytest.approx([1.0278, 0.9825, 0.9982], abs=0.001)
     assert result.chi2 / result.chi2_dof > 3 and "larger than" in result.chi2_verdict
     assert len(result.placed) == 13 and result.hand_axes == (0, 1, 2)
+
+
+def test_a_gyro_reversed_in_the_log_is_named_and_reading_it_reversed_gives_the_fit_back(tmp_path):
+    """The Ferraris log with gyr_y's sign reversed (a column mapped with the wrong sign, as a logger or a user's
+    --columns can do): the import proposes the y turn as +360 deg (from the gyro's own integral), so the joint fit
+    gives Kgyy +0.98, while the moves between poses, which see the turns through the accelerometers, give -0.99.
+    A sensor's axes are built parallel, so the fit says the axis is reversed, names the fix, and the log read
+    with '-gyr_y' fits as the original does to the last digit. A unit whose scale factors are all positive gets
+    no such note (reversed_axis_notes on the original fit)."""
+    log = FERRARIS / "example_ferraris_session.csv"
+    if not log.exists():
+        pytest.skip(f"the shared real data is not beside the repository ({FERRARIS})")
+    from plansim.fit.identify import reversed_axis_notes
+    from plansim.io.log_import import import_log
+
+    columns = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
+    text = log.read_text().splitlines()
+    header = text[0].split(",")
+    y = header.index("gyr_y")
+    rows = [line.split(",") for line in text[1:]]
+    for row in rows:
+        row[y] = row[y][1:] if row[y].startswith("-") else "-" + row[y]
+    (tmp_path / "flipped.csv").write_text("\n".join([text[0], *(",".join(row) for row in rows)]) + "\n")
+    original = fit_recording(import_log(log, columns=columns, units="deg/s,m/s^2", sample_rate=102.4).recording)
+    flipped = fit_recording(import_log(tmp_path / "flipped.csv", columns=columns, units="deg/s,m/s^2",
+                                       sample_rate=102.4).recording)
+    notes = [n for n in flipped.notes if n.startswith("Kgyy = ")]
+    assert len(notes) == 1 and "(moves)" in notes[0] and "y gyro reads opposite" in notes[0]
+    assert "(joint WLS) has it positive" in notes[0] and "'-' on its column" in notes[0]
+    k = PARAMETER_INDEX["Kgyy"]
+    assert flipped.moves.method.estimate[k] == pytest.approx(-0.990, abs=0.002)
+    assert not any(n.startswith(("Kg", "Ka")) and " = " in n[:8] for n in original.notes)
+    assert reversed_axis_notes({"joint WLS": original.joint.estimate, "moves": original.moves.method.estimate}) == []
+    reread = import_log(tmp_path / "flipped.csv", columns=("gyr_x", "-gyr_y", *columns[2:]), units="deg/s,m/s^2",
+                        sample_rate=102.4)
+    assert reread.reversed_channels == ("gy",)
+    again = fit_recording(reread.recording)
+    np.testing.assert_array_equal(again.joint.estimate, original.joint.estimate)
+    np.testing.assert_array_equal(again.moves.method.estimate, original.moves.method.estimate)
+
+
+def test_a_negative_scale_factor_is_named_whichever_method_finds_it():
+    from plansim.fit.identify import reversed_axis_notes
+
+    theta = np.array([1.0 if p.name[:2] in ("Kg", "Ka") and p.name[2] == p.name[3] else 0.0 for p in PARAMETERS])
+    assert reversed_axis_notes({"joint WLS": theta, "moves": None}) == []
+    theta[PARAMETER_INDEX["Kazz"]] = -1.002
+    (note,) = reversed_axis_notes({"joint WLS": theta, "moves": np.full(39, np.nan)})
+    assert note.startswith("Kazz = -1.002 (joint WLS): the z accelerometer reads opposite") and "positive" not in note
 
 
 def test_a_given_noise_estimate_gives_the_same_fit_and_a_wrong_one_is_refused():

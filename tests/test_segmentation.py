@@ -135,10 +135,10 @@ def test_a_clock_coarser_than_the_sampling_and_a_misstamped_sample():
 def test_delivery_stamps_are_not_read_as_dropped_samples_and_a_real_gap_still_is():
     """A clock that jitters by 30 % of the period (0.3 ms RMS per stamp at 1 kHz, a host's stamps) passes 1.5 periods
     in 11 % of its steps: read as a sampling clock, each was a dropped sample (2264 of them), and the rate, taken
-    over the other steps, came out 10 % high (1097.8 Hz). The steps are no whole number of the usual one, so they are read as delivery
-    times (DELIVERY_FRACTION): no sample dropped, the rate the mean one, the samples' times the clock's to the
-    jitter. A real gap of 0.5 s (500 samples) is still found, with its count, and the stretch after it is placed
-    on its own stamps."""
+    over the other steps, came out 10 % high (1097.8 Hz). The steps are no whole number of the usual one, so they
+    are read as delivery times (DELIVERY_FRACTION): no sample dropped, the rate the mean one, the samples' times the
+    clock's to the jitter. A real gap of 0.5 s (500 samples) is still found, with its count, and the stretch after
+    it is placed on its own stamps."""
     rng = np.random.default_rng(8)
     true = np.arange(20000) / 1000.0
     true[12000:] += 0.5

@@ -52,7 +52,8 @@ def _add_import_command(sub) -> None:
     p.add_argument("--columns", default=None, metavar="GX,GY,GZ,AX,AY,AZ",
                    help="the six channel columns in this order (default gx,gy,gz,ax,ay,az); other columns are "
                         "then ignored. A log with no header line names them by position, 1 for the first (imu_tk's "
-                        "'time ax ay az gx gy gz': --columns 5,6,7,2,3,4 --time 1)")
+                        "'time ax ay az gx gy gz': --columns 5,6,7,2,3,4 --time 1). A leading '-' reverses a channel "
+                        "whose sign the log has the other way (gyr_x,-gyr_y,…)")
     p.add_argument("--units", default=None,
                    help="the channels' units: gyro,accelerometer (e.g. deg/s,m/s^2) or one per channel; with "
                         "--scale, the unit the counts are per; default rad/s,m/s^2")

@@ -358,3 +358,45 @@ def describe_conflict(entry: dict) -> str:
             parts.append(f"{name} {shown} ± {spread:.2g}{spec.unit_suffix}")
         text += "; the data alone: " + ", ".join(parts)
     return text
+
+
+#: the diagonal scale factors whose sign says whether an axis reads the way the others see it turn or tilt
+SCALE_FACTORS = ("Kgxx", "Kgyy", "Kgzz", "Kaxx", "Kayy", "Kazz")
+
+
+def reversed_axis_notes(methods: dict) -> list[str]:
+    """What a negative scale factor says: the axis reads opposite to what the rest of the recording sees.
+
+    A MIMU's gyro and accelerometer axes are built parallel, so a diagonal scale factor near −1 is not a sensor's
+    error but the log's: a column whose sign is reversed, or one mapped to the wrong axis. ``methods`` maps a
+    method's name (``joint WLS``, ``moves``) to its (39,) estimates, NaN where not identified. A gyro reversed in
+    the log also turns the import's proposed angles the other way (they follow the gyro's own integral), so the
+    joint fit may give it +1 while the moves between poses, which see the turns through the accelerometers, give
+    −1: the two disagreeing in sign say so too.
+
+    Returns
+    -------
+    list of str
+        One note per scale factor found negative by some method (empty when none is).
+    """
+    notes = []
+    for name in SCALE_FACTORS:
+        k = PARAMETER_INDEX[name]
+        values = {method: float(estimate[k]) for method, estimate in methods.items()
+                  if estimate is not None and math.isfinite(float(estimate[k]))}
+        negative = {method: v for method, v in values.items() if v < 0.0}
+        if not negative:
+            continue
+        axis, sensor = name[2], "gyro" if name.startswith("Kg") else "accelerometer"
+        found = ", ".join(f"{v:.4g} ({method})" for method, v in negative.items())
+        text = (f"{name} = {found}: the {axis} {sensor} reads opposite to what the rest of the recording sees; a "
+                "sensor's axes are built parallel, so its column's sign is reversed in the log, or --columns maps "
+                "another axis to it. Reverse it (a leading '-' on its column in plansim import's --columns) and import "
+                "again")
+        positive = {method: v for method, v in values.items() if v > 0.0}
+        if positive:
+            text += (f"; {', '.join(f'{v:.4g} ({method})' for method, v in positive.items())} has it positive "
+                     "because the turns' angles were proposed from the same gyro's integral (check them against "
+                     "what was done)")
+        notes.append(text)
+    return notes

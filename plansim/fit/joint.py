@@ -53,6 +53,7 @@ from plansim.fit.identify import (
     data_sheet_conflict,
     describe_conflict,
     identifiability,
+    reversed_axis_notes,
     weakly_determined,
 )
 from plansim.fit.model import MeanModel, nominal_parameters
@@ -979,6 +980,10 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             unused_note = {k: v for k, v in unused.items() if "a move between poses" not in v}
             result = dataclasses.replace(result, moves=move_fit, unused=unused_note,
                                          notes=result.notes + move_fit.notes)
+    reversed_axes = [] if _judged is not None else reversed_axis_notes(  # once, on the outermost fit
+        {"joint WLS": result.joint.estimate, "moves": result.moves.method.estimate if result.moves else None})
+    if reversed_axes:
+        result = dataclasses.replace(result, notes=result.notes + tuple(reversed_axes))
     return result
 
 

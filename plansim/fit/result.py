@@ -80,6 +80,7 @@ def fit_json(result: FitResult) -> dict:
                                                  "estimate": _number(estimate), "u": _number(u)}
                                                 for name, (estimate, u) in entry.get("data_alone", {}).items()]}
                                 for group, entry in result.data_sheet_conflict.items()],
+        "notes": list(result.notes),
     }
 
 

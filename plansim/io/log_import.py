@@ -157,6 +157,8 @@ class ImportResult:
     scale: tuple[float, ...] | None
     warnings: tuple[LogWarning, ...]
     offset: tuple[float, ...] | None = None  # counts at zero input (--offset), or None
+    #: the channels read reversed (a leading '-' in ``columns``: an axis whose sign the log has the other way)
+    reversed_channels: tuple[str, ...] = ()
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -636,11 +638,17 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
             raise ValueError(f"{option} {value!r}: expected a number from {lowest:g} to {highest:g} {unit}")
         site[key] = float(value)
 
+    # a leading '-' reverses a channel: an axis whose sign the log has the other way (plansim fit says where a
+    # scale factor comes out negative)
+    signs = np.ones(6)
+    if columns is not None:
+        signs = np.array([-1.0 if str(name).startswith("-") and len(str(name)) > 1 else 1.0 for name in columns])
+        columns = tuple(str(name)[1:].strip() if sign < 0 else name for name, sign in zip(columns, signs))
     table = read_log(path, columns, time_column, temperature_column)
     where = f"log {str(table.path)!r}"
     n = table.channels.shape[0]
     factors = np.array([KINDS["angular_rate" if k < 3 else "acceleration"][u] for k, u in enumerate(unit_names)])
-    divisors = np.ones(6) if counts_per_unit is None else np.array(counts_per_unit)
+    divisors = (np.ones(6) if counts_per_unit is None else np.array(counts_per_unit)) * signs
     offsets = np.zeros(6) if zero_counts is None else np.array(zero_counts)
     samples = (table.channels - offsets) / divisors * factors
     rail_si = None if rails is None else np.array(rails) * factors
@@ -828,7 +836,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         details.append(_detail(span, table))
     schedule = Schedule(tuple(segments), procedure="imported", notes={"import": {
         "log": table.path.name,
-        "columns": dict(zip(CHANNELS, table.names)),
+        "columns": dict(zip(CHANNELS, [("-" if sign < 0 else "") + name for name, sign in zip(table.names, signs)])),
         "ignored_columns": list(table.ignored),
         "units": dict(zip(CHANNELS, unit_names)),
         "counts_per_unit": None if counts_per_unit is None else dict(zip(CHANNELS, counts_per_unit)),
@@ -890,7 +898,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: {exc}") from None
     return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings),
-                        zero_counts)
+                        zero_counts, tuple(CHANNELS[c] for c in range(6) if signs[c] < 0))
 
 
 def _saturation_episodes(saturation, apart: int) -> list[list]:
@@ -911,7 +919,7 @@ def _as_logged(value: float, c: int, factors, divisors, offsets, unit_names, cou
     si_unit = "rad/s" if c < 3 else "m/s^2"
     if counts:
         return f"{value / factors[c] * divisors[c] + offsets[c]:.6g} counts ({value:.6g} {si_unit})"
-    return f"{value / factors[c]:.6g} {unit_names[c]}"
+    return f"{value / factors[c] * divisors[c]:.6g} {unit_names[c]}"
 
 
 def _segment(span: Span, number: int, sample_rate: float, temperature: float) -> Segment:
@@ -959,7 +967,8 @@ def format_summary(result: ImportResult) -> str:
         unit_text = "counts: " + ", ".join(f"{c:g}/{u}" for c, u in zip(result.scale, result.units))
         if result.offset is not None:
             unit_text += " after subtracting " + ", ".join(f"{c:g}" for c in result.offset) + " counts (--offset)"
-    lines.append("  channels: " + " ".join(f"{c}={n}" for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
+    lines.append("  channels: " + " ".join(f"{c}={'-' if c in result.reversed_channels else ''}{n}"
+                                           for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
                  + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
     if not table.has_header:
         lines.append(f"  no header line: columns named by position, 1 for the first (first sample on line "
