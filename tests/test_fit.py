@@ -1100,7 +1100,9 @@ def test_a_gyro_reversed_in_the_log_is_named_and_reading_it_reversed_gives_the_f
     gives Kgyy +0.98, while the moves between poses, which see the turns through the accelerometers, give -0.99.
     A sensor's axes are built parallel, so the fit says the axis is reversed, names the fix, and the log read
     with '-gyr_y' fits as the original does to the last digit. A unit whose scale factors are all positive gets
-    no such note (reversed_axis_notes on the original fit)."""
+    no such note (reversed_axis_notes on the original fit). The y accelerometer reversed instead makes the triad the
+    moves see the gyros through a mirror image: Kgxx and Kgzz come out negative, and the note names the y
+    accelerometer."""
     log = FERRARIS / "example_ferraris_session.csv"
     if not log.exists():
         pytest.skip(f"the shared real data is not beside the repository ({FERRARIS})")
@@ -1119,12 +1121,22 @@ def test_a_gyro_reversed_in_the_log_is_named_and_reading_it_reversed_gives_the_f
     flipped = fit_recording(import_log(tmp_path / "flipped.csv", columns=columns, units="deg/s,m/s^2",
                                        sample_rate=102.4).recording)
     notes = [n for n in flipped.notes if n.startswith("Kgyy = ")]
-    assert len(notes) == 1 and "(moves)" in notes[0] and "y gyro reads opposite" in notes[0]
-    assert "(joint WLS) has it positive" in notes[0] and "'-' on its column" in notes[0]
+    assert len(notes) == 2 and "(moves): the y gyro reads opposite" in notes[0] and "'-' on its column" in notes[0]
+    assert notes[1].startswith("Kgyy = 0.98") and "(joint WLS) but -0.98" in notes[1]
     k = PARAMETER_INDEX["Kgyy"]
     assert flipped.moves.method.estimate[k] == pytest.approx(-0.990, abs=0.002)
-    assert not any(n.startswith(("Kg", "Ka")) and " = " in n[:8] for n in original.notes)
-    assert reversed_axis_notes({"joint WLS": original.joint.estimate, "moves": original.moves.method.estimate}) == []
+    assert not any(n.startswith(("Kg", "Ka")) for n in original.notes)
+    assert reversed_axis_notes(original.joint.estimate, original.moves.method.estimate) == []
+    # the y accelerometer reversed instead: the moves see the gyros through a mirrored triad, x and z negative
+    a = header.index("acc_y")
+    rows = [line.split(",") for line in text[1:]]
+    for row in rows:
+        row[a] = row[a][1:] if row[a].startswith("-") else "-" + row[a]
+    (tmp_path / "mirrored.csv").write_text("\n".join([text[0], *(",".join(row) for row in rows)]) + "\n")
+    mirrored = fit_recording(import_log(tmp_path / "mirrored.csv", columns=columns, units="deg/s,m/s^2",
+                                        sample_rate=102.4).recording)
+    (note,) = [n for n in mirrored.notes if n.startswith(("Kg", "Ka"))]
+    assert note.startswith("Kgxx = -1.0") and ", Kgzz = -0.99" in note and "the y accelerometer's sign" in note
     reread = import_log(tmp_path / "flipped.csv", columns=("gyr_x", "-gyr_y", *columns[2:]), units="deg/s,m/s^2",
                         sample_rate=102.4)
     assert reread.reversed_channels == ("gy",)
@@ -1137,10 +1149,16 @@ def test_a_negative_scale_factor_is_named_whichever_method_finds_it():
     from plansim.fit.identify import reversed_axis_notes
 
     theta = np.array([1.0 if p.name[:2] in ("Kg", "Ka") and p.name[2] == p.name[3] else 0.0 for p in PARAMETERS])
-    assert reversed_axis_notes({"joint WLS": theta, "moves": None}) == []
+    assert reversed_axis_notes(theta, None) == []
     theta[PARAMETER_INDEX["Kazz"]] = -1.002
-    (note,) = reversed_axis_notes({"joint WLS": theta, "moves": np.full(39, np.nan)})
-    assert note.startswith("Kazz = -1.002 (joint WLS): the z accelerometer reads opposite") and "positive" not in note
+    (note,) = reversed_axis_notes(theta, np.full(39, np.nan))
+    assert note.startswith("Kazz = -1.002 (joint WLS): the z accelerometer reads the segment table's turns or poses")
+    # the moves seeing the gyros through a triad with its y accelerometer reversed: x and z negative, y not
+    theta[PARAMETER_INDEX["Kazz"]] = 1.0
+    moves = theta.copy()
+    moves[PARAMETER_INDEX["Kgxx"]], moves[PARAMETER_INDEX["Kgzz"]] = -1.01, -0.99
+    (note,) = reversed_axis_notes(theta, moves)
+    assert note.startswith("Kgxx = -1.01, Kgzz = -0.99 (moves): two gyros") and "the y accelerometer" in note
 
 
 def test_a_given_noise_estimate_gives_the_same_fit_and_a_wrong_one_is_refused():

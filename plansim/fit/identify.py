@@ -360,43 +360,60 @@ def describe_conflict(entry: dict) -> str:
     return text
 
 
-#: the diagonal scale factors whose sign says whether an axis reads the way the others see it turn or tilt
-SCALE_FACTORS = ("Kgxx", "Kgyy", "Kgzz", "Kaxx", "Kayy", "Kazz")
+def reversed_axis_notes(joint, moves=None) -> list[str]:
+    """What a negative diagonal scale factor says: an axis the log has the other way round.
 
+    A MIMU's gyro and accelerometer axes are built parallel and right-handed, so a scale factor near −1 is not the
+    sensor's error but the log's: a column whose sign is reversed, or one mapped to the wrong axis. ``joint`` and
+    ``moves`` are the (39,) estimates of the poses' fit and of the moves between poses (NaN where not identified;
+    ``moves`` None without them).
 
-def reversed_axis_notes(methods: dict) -> list[str]:
-    """What a negative scale factor says: the axis reads opposite to what the rest of the recording sees.
-
-    A MIMU's gyro and accelerometer axes are built parallel, so a diagonal scale factor near −1 is not a sensor's
-    error but the log's: a column whose sign is reversed, or one mapped to the wrong axis. ``methods`` maps a
-    method's name (``joint WLS``, ``moves``) to its (39,) estimates, NaN where not identified. A gyro reversed in
-    the log also turns the import's proposed angles the other way (they follow the gyro's own integral), so the
-    joint fit may give it +1 while the moves between poses, which see the turns through the accelerometers, give
-    −1: the two disagreeing in sign say so too.
+    The moves see the gyros through the accelerometers. One accelerometer axis reversed makes that triad
+    left-handed, and a rotation read in a mirror is a rotation about the mirrored axis with its sense reversed
+    (ω' = det(M)·M·ω): the gyros then come out as diag(−1, +1, −1) for a reversed y accelerometer — two negative,
+    the same as a gyro mounted turned 180° about y. So one or three negative gyro scale factors from the moves say
+    those gyros are reversed; two say the third axis's accelerometer is (or those two gyros are). A gyro reversed
+    in the log also turns the import's proposed angles the other way (they follow its own integral), so the poses'
+    fit may give it +1 while the moves give −1: that disagreement is said too. In the poses' fit (a table's known
+    turns and poses), a negative scale factor is that sensor's axis against the table's.
 
     Returns
     -------
     list of str
-        One note per scale factor found negative by some method (empty when none is).
+        The notes (empty when no scale factor is negative).
     """
     notes = []
-    for name in SCALE_FACTORS:
-        k = PARAMETER_INDEX[name]
-        values = {method: float(estimate[k]) for method, estimate in methods.items()
-                  if estimate is not None and math.isfinite(float(estimate[k]))}
-        negative = {method: v for method, v in values.items() if v < 0.0}
-        if not negative:
-            continue
-        axis, sensor = name[2], "gyro" if name.startswith("Kg") else "accelerometer"
-        found = ", ".join(f"{v:.4g} ({method})" for method, v in negative.items())
-        text = (f"{name} = {found}: the {axis} {sensor} reads opposite to what the rest of the recording sees; a "
-                "sensor's axes are built parallel, so its column's sign is reversed in the log, or --columns maps "
-                "another axis to it. Reverse it (a leading '-' on its column in plansim import's --columns) and import "
-                "again")
-        positive = {method: v for method, v in values.items() if v > 0.0}
-        if positive:
-            text += (f"; {', '.join(f'{v:.4g} ({method})' for method, v in positive.items())} has it positive "
-                     "because the turns' angles were proposed from the same gyro's integral (check them against "
-                     "what was done)")
-        notes.append(text)
+    fix = "reverse it with a leading '-' on its column in plansim import's --columns and import again"
+
+    def value(estimate, name):
+        return math.nan if estimate is None else float(estimate[PARAMETER_INDEX[name]])
+
+    gyro_moves = {a: value(moves, f"Kg{a}{a}") for a in "xyz"}
+    negative = [a for a, v in gyro_moves.items() if v < 0.0]
+    if negative:
+        shown = ", ".join(f"Kg{a}{a} = {gyro_moves[a]:.4g}" for a in negative)
+        if len(negative) == 2:
+            (other,) = set("xyz") - set(negative)
+            notes.append(f"{shown} (moves): two gyros read opposite to how the accelerometers see the unit turn, as "
+                         f"they do when the {other} accelerometer is reversed (a mirrored triad turns the rotations "
+                         f"seen through it) or the gyros are mounted turned 180° about {other}; a MIMU's axes are "
+                         f"built parallel: most likely the {other} accelerometer's sign is reversed in the log — "
+                         f"{fix}")
+        else:
+            notes.append(f"{shown} (moves): the {', '.join(negative)} gyro{'s read' if len(negative) > 1 else ' reads'}"
+                         " opposite to how the accelerometers see the unit turn; a MIMU's axes are built parallel, so "
+                         "its sign is reversed in the log, or --columns maps another axis to it — " + fix)
+        for a in negative if len(negative) != 2 else ():
+            joint_value = value(joint, f"Kg{a}{a}")
+            if joint_value > 0.0:
+                notes.append(f"Kg{a}{a} = {joint_value:.4g} (joint WLS) but {gyro_moves[a]:.4g} (moves): the turns' "
+                             f"angles were proposed from the {a} gyro's own integral, so a reversed gyro reads them "
+                             "as turned the other way; check them against what was done")
+    for name in ("Kgxx", "Kgyy", "Kgzz", "Kaxx", "Kayy", "Kazz"):
+        v = value(joint, name)
+        if v < 0.0 and not (name.startswith("Kg") and gyro_moves[name[2]] < 0.0):
+            sensor = "gyro" if name.startswith("Kg") else "accelerometer"
+            notes.append(f"{name} = {v:.4g} (joint WLS): the {name[2]} {sensor} reads the segment table's turns or "
+                         "poses with the opposite sign; a sensor's axes are built parallel, so the table's sign or "
+                         f"the {sensor}'s is reversed — check the turns and poses, or {fix}")
     return notes

@@ -981,7 +981,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
             result = dataclasses.replace(result, moves=move_fit, unused=unused_note,
                                          notes=result.notes + move_fit.notes)
     reversed_axes = [] if _judged is not None else reversed_axis_notes(  # once, on the outermost fit
-        {"joint WLS": result.joint.estimate, "moves": result.moves.method.estimate if result.moves else None})
+        result.joint.estimate, result.moves.method.estimate if result.moves else None)
     if reversed_axes:
         result = dataclasses.replace(result, notes=result.notes + tuple(reversed_axes))
     return result

@@ -684,12 +684,8 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
                                   "accelerometers, whose rotation no pose placed by hand fixes; the gravity_sequence "
                                   f"estimate is in the frame where Ka is symmetric, i.e. Kg{x}{y} − (Ka{x}{y} − "
                                   f"Ka{y}{x})/2 to first order")
-    flipped = [a for a in range(3) if kg_mask[4 * a] and Kg[a, a] < 0]
-    if flipped:
-        notes.append("the scale factor of the " + ", ".join(f"{'xyz'[a]} gyro" for a in flipped) + " is negative "
-                     f"({', '.join(f'{Kg[a, a]:+.4g}' for a in flipped)}): its sign is opposite to the accelerometer "
-                     "triad's — a gyro, or an accelerometer, wired or mapped with its axis flipped (check --columns "
-                     "and the axes' signs)")
+    # a negative scale factor (a gyro or an accelerometer whose sign the log has the other way) is said once, for
+    # the moves and the poses' fit together, by plansim.fit.identify.reversed_axis_notes
     scaled = [a for a in range(3) if kg_mask[4 * a] and not 0.5 <= abs(Kg[a, a]) <= 2.0]
     if scaled:
         degrees = [a for a in scaled if abs(abs(Kg[a, a]) / math.degrees(1.0) - 1.0) < 0.02
