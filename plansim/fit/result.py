@@ -18,7 +18,7 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 
 JSON_KEYS = ("identified", "not_identified", "weakly_determined", "site", "turntable", "parameters", "noise",
-             "residuals", "chi2_dof", "moves", "data_sheet_conflict")
+             "residuals", "chi2_dof", "moves", "data_sheet_conflict", "notes")
 
 
 def _number(value: float):
