@@ -104,7 +104,8 @@ def test_family_wise_false_alarms_are_at_most_alpha():
 
 
 @pytest.mark.parametrize("pattern, test", [
-    ("sine", "periodic"), ("step", "step"), ("burst", "burst"), ("noisier", "scatter"), ("trend", "trend")])
+    ("sine", "periodic"), ("step", "step"), ("burst", "burst"), ("noisier", "scatter"), ("trend", "trend"),
+    ("settling", "transient")])
 def test_patterns_inside_one_segment_are_found_and_named(pattern, test):
     segments = static_segments()
     rng = np.random.default_rng(7)
@@ -120,6 +121,8 @@ def test_patterns_inside_one_segment_are_found_and_named(pattern, test):
         x += 3.0 * SIGMA * rng.standard_normal(n) * ((t > 2.0) & (t < 3.0))
     elif pattern == "noisier":
         x += 1.5 * SIGMA * rng.standard_normal(n)
+    elif pattern == "settling":  # a decay from the segment's start, 3 % of it (t from 0)
+        x += 3.0 * SIGMA * np.exp(-t / (0.03 * n / FS))
     else:
         x += 0.12 * SIGMA * t
     result = within_segment_tests(samples, segments, noise(), alpha=0.05, draws=199, seed=1)
@@ -133,6 +136,10 @@ def test_patterns_inside_one_segment_are_found_and_named(pattern, test):
     if pattern == "step":
         step = next(f for f in result.flagged if f["test"] == "step")
         assert step["at_s"] == pytest.approx(4.0, abs=0.5)
+    if pattern == "settling":
+        transient = next(f for f in result.flagged if f["test"] == "transient")
+        assert transient["time_constant_s"] == pytest.approx(0.03 * n / FS)
+        assert transient["size"] == pytest.approx(3.0 * SIGMA, rel=0.15)
 
 
 def test_turning_segments_are_tested_without_the_tables_harmonics():

@@ -8,9 +8,10 @@
    unknown within its step: docs/closing-the-loop.md, step 1; its step, change in time and odd segment, which
    leave the undithered channels out, are scored on M0 itself, their null draws coupled with the omnibus's:
    :func:`plansim.diagnose.scores.coupled_null_residuals`),
-   and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, against
-   a null simulated from the recording's own noise (:func:`plansim.diagnose.within.within_segment_tests`); each at
-   α/4 (:data:`SEGMENT_LEVEL_SHARE`, :data:`WITHIN_SHARE`), so that "something is unexplained" keeps the level α/2.
+   and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, a transient
+   from the start, against a null simulated from the recording's own noise
+   (:func:`plansim.diagnose.within.within_segment_tests`); each at α/4 (:data:`SEGMENT_LEVEL_SHARE`,
+   :data:`WITHIN_SHARE`), so that "something is unexplained" keeps the level α/2.
 3. **Candidates** (:mod:`plansim.diagnose.catalogue`): identifiability first, then likelihood-ratio tests with the
    family-wise error over the catalogue held at α/2 (:data:`SELECTION_SHARE`) by the simulated min-p null
    (:func:`plansim.diagnose.scores.score_candidates`). The selections and the unexplained residual share α

@@ -24,7 +24,12 @@ deviation and n their number:
 - ``burst``: the largest variance of :data:`BLOCKS` equal blocks of the segment over their median (extra noise
   over part of a segment);
 - ``scatter``: s² over the median s² of the channel's tested segments (a segment noisier than the others: a
-  burst that covers it). Both are free of the noise's scale, which the fit estimates with some error.
+  burst that covers it). Both are free of the noise's scale, which the fit estimates with some error;
+- ``transient``: max over the time constants τ = :data:`TRANSIENT_FRACTIONS` × the segment's duration of
+  |Σ x·f̃_τ| / (s·‖f̃_τ‖), f̃_τ the centred e^{−t/τ} (t from the segment's start): the t-statistic of a decay from
+  the segment's start — a warm-up settling after power-on, a unit settling after it was placed — which the step
+  test, kept off the segment's ends, and the trend, a straight line, both fit poorly; its time constant and the
+  size at the start are reported.
 
 A channel whose quantiser the noise does not dither (σ before the quantiser below :data:`DITHERED` of a step)
 is not tested: its samples sit on one or two codes, and their within-segment shape is the quantiser's and the
@@ -79,7 +84,7 @@ __all__ = ["TESTS", "WithinResult", "within_segment_tests", "segment_statistics"
            "turning_noise_before_quantiser"]
 
 #: the statistics, in the order of every array
-TESTS = ("trend", "step", "periodic", "burst", "scatter")
+TESTS = ("trend", "step", "periodic", "burst", "scatter", "transient")
 #: a quantised channel is tested where the noise before the quantiser is at least this many steps (below it the
 #: samples sit on one or two codes)
 DITHERED = 0.3
@@ -97,6 +102,16 @@ MIN_CYCLES = 4
 STEP_MARGIN = 0.05
 #: how much longer than the segment the flicker is generated (the middle is kept)
 FLICKER_SPAN = 4
+#: the transient test's time constants, as fractions of the segment's duration
+TRANSIENT_FRACTIONS = (0.01, 0.03, 0.1, 0.3)
+
+
+def _transient_shapes(n: int) -> np.ndarray:
+    """(len(TRANSIENT_FRACTIONS), n) the centred decays e^{−k/(f·n)} of the transient test, each of unit norm."""
+    k = np.arange(n)
+    shapes = np.exp(-k[None, :] / (np.asarray(TRANSIENT_FRACTIONS)[:, None] * n))
+    shapes -= shapes.mean(axis=1, keepdims=True)
+    return shapes / np.linalg.norm(shapes, axis=1, keepdims=True)
 
 
 def _step_profile(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -116,7 +131,7 @@ def _block_variances(x: np.ndarray) -> np.ndarray:
 
 
 def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[np.ndarray, np.ndarray]:
-    """The statistics (..., 5) in the order of :data:`TESTS` of samples *x* (..., n), and the periodic test's
+    """The statistics (..., 6) in the order of :data:`TESTS` of samples *x* (..., n), and the periodic test's
     frequency (..., ) in Hz; ``scatter`` is the variance s² itself here. NaN where the samples do not vary (s at
     most :data:`plansim.fit.noise.RELATIVE_FLOOR` of their r.m.s., or of *level* when given — the r.m.s. of the
     samples before anything was removed from them: round-off) or the segment is too short (n < 20)."""
@@ -154,6 +169,7 @@ def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[n
     out[..., 3] = np.where(block_median > 0, block_var.max(axis=-1) / np.where(block_median > 0, block_median, 1.0),
                            np.nan)
     out[..., 4] = s2  # made relative to the channel's other segments by within_segment_tests
+    out[..., 5] = np.max(np.abs(x @ _transient_shapes(n).T), axis=-1) / s
     out[~varies] = np.nan
     return out, np.where(varies, freq, np.nan)
 
@@ -257,7 +273,8 @@ class WithinResult:
 
 def _describe(test: str, x: np.ndarray, sample_rate: float, frequency: float, channel: int) -> dict:
     """What the pattern is: a trend's slope, a step's time and size, a periodic component's frequency and
-    amplitude, a burst's stretch and standard deviation, a segment's standard deviation (SI)."""
+    amplitude, a burst's stretch and standard deviation, a transient's time constant and size at the segment's
+    start, a segment's standard deviation (SI)."""
     unit = UNITS_SI[channel_kind(channel)]["mean"]
     n = x.size
     t = (np.arange(n) - (n - 1) / 2.0) / sample_rate
@@ -271,6 +288,14 @@ def _describe(test: str, x: np.ndarray, sample_rate: float, frequency: float, ch
     if test == "periodic":
         amplitude = 2.0 * abs(np.sum(y * np.exp(-2j * math.pi * frequency * np.arange(n) / sample_rate))) / n
         return {"frequency_hz": float(frequency), "amplitude": float(amplitude), "unit": unit}
+    if test == "transient":
+        shapes = _transient_shapes(n)
+        best = int(np.argmax(np.abs(shapes @ y)))
+        tau = TRANSIENT_FRACTIONS[best] * n
+        decay = np.exp(-np.arange(n) / tau)
+        centred = decay - decay.mean()
+        size = float((centred @ y) / (centred @ centred))  # the decay's size at the segment's start
+        return {"time_constant_s": float(tau / sample_rate), "size": size, "unit": unit}
     if test == "burst":
         width = n // BLOCKS
         block = int(np.argmax(_block_variances(y)))

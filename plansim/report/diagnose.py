@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 from plansim.diagnose.procedure import absorbed, levels
+from plansim.diagnose.within import TESTS
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETERS
 from plansim.report.fit import OUTPUT_UNITS, _g, _kind
@@ -30,10 +31,10 @@ def _within_lines(d) -> list[str]:
     """The within-segment findings, each with its pattern in display units."""
     w = d.within
     if not w.flagged:
-        return [f"Within the {len(w.segments)} segments tested (trend, step, periodic, burst, scatter): nothing "
+        return [f"Within the {len(w.segments)} segments tested ({', '.join(TESTS)}): nothing "
                 f"(smallest adjusted p = {_p(w.smallest_adjusted_p())}, level {w.alpha:g})."]
     lines = [f"UNEXPLAINED within segments (level {w.alpha:g}, family-wise over {len(w.segments)} segments, "
-             "6 channels and 5 tests): not named after any catalogue effect"]
+             f"6 channels and {len(TESTS)} tests): not named after any catalogue effect"]
     for item in w.flagged[:12]:
         unit, factor = _display_unit(item["channel"])
         test = item["test"]
@@ -43,6 +44,9 @@ def _within_lines(d) -> list[str]:
             what = f"step of {item['size'] / factor:+.3g} {unit} at {item['at_s']:.1f} s"
         elif test == "periodic":
             what = f"periodic at {item['frequency_hz']:.4g} Hz, amplitude {item['amplitude'] / factor:.3g} {unit}"
+        elif test == "transient":
+            what = (f"transient from the segment's start: {item['size'] / factor:+.3g} {unit} decaying with a time "
+                    f"constant of {item['time_constant_s']:.3g} s")
         elif test == "burst":
             what = f"burst from {item['from_s']:.1f} to {item['to_s']:.1f} s, sd {item['std'] / factor:.3g} {unit}"
         else:
