@@ -106,12 +106,12 @@ FLICKER_SPAN = 4
 TRANSIENT_FRACTIONS = (0.01, 0.03, 0.1, 0.3)
 
 
-def _transient_shapes(n: int) -> np.ndarray:
-    """(len(TRANSIENT_FRACTIONS), n) the centred decays e^{−k/(f·n)} of the transient test, each of unit norm."""
+def _transient_shapes(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(len(TRANSIENT_FRACTIONS), n) the centred decays e^{−k/(f·n)} of the transient test, and their norms."""
     k = np.arange(n)
     shapes = np.exp(-k[None, :] / (np.asarray(TRANSIENT_FRACTIONS)[:, None] * n))
     shapes -= shapes.mean(axis=1, keepdims=True)
-    return shapes / np.linalg.norm(shapes, axis=1, keepdims=True)
+    return shapes, np.linalg.norm(shapes, axis=1)
 
 
 def _step_profile(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -169,7 +169,8 @@ def segment_statistics(x: np.ndarray, sample_rate: float, level=None) -> tuple[n
     out[..., 3] = np.where(block_median > 0, block_var.max(axis=-1) / np.where(block_median > 0, block_median, 1.0),
                            np.nan)
     out[..., 4] = s2  # made relative to the channel's other segments by within_segment_tests
-    out[..., 5] = np.max(np.abs(x @ _transient_shapes(n).T), axis=-1) / s
+    shapes, norms = _transient_shapes(n)
+    out[..., 5] = np.max(np.abs(x @ shapes.T) / norms, axis=-1) / s
     out[~varies] = np.nan
     return out, np.where(varies, freq, np.nan)
 
@@ -289,13 +290,10 @@ def _describe(test: str, x: np.ndarray, sample_rate: float, frequency: float, ch
         amplitude = 2.0 * abs(np.sum(y * np.exp(-2j * math.pi * frequency * np.arange(n) / sample_rate))) / n
         return {"frequency_hz": float(frequency), "amplitude": float(amplitude), "unit": unit}
     if test == "transient":
-        shapes = _transient_shapes(n)
-        best = int(np.argmax(np.abs(shapes @ y)))
-        tau = TRANSIENT_FRACTIONS[best] * n
-        decay = np.exp(-np.arange(n) / tau)
-        centred = decay - decay.mean()
-        size = float((centred @ y) / (centred @ centred))  # the decay's size at the segment's start
-        return {"time_constant_s": float(tau / sample_rate), "size": size, "unit": unit}
+        shapes, norms = _transient_shapes(n)
+        best = int(np.argmax(np.abs(shapes @ y) / norms))
+        size = float((shapes[best] @ y) / norms[best] ** 2)  # the least-squares size of the decay at the start
+        return {"time_constant_s": float(TRANSIENT_FRACTIONS[best] * n / sample_rate), "size": size, "unit": unit}
     if test == "burst":
         width = n // BLOCKS
         block = int(np.argmax(_block_variances(y)))

@@ -303,7 +303,7 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
         # the steps' mean would carry that over the log's length), each stretch placed on its stamps' mean
         t = np.asarray(time, dtype=np.float64)
         edges = [0, *(int(k) + 1 for k in np.flatnonzero(gap)), samples]
-        stretches = [(a, b) for a, b in zip(edges[:-1], edges[1:])]
+        stretches = list(zip(edges[:-1], edges[1:]))
         centred = [(np.arange(b - a) - (b - a - 1) / 2.0, t[a:b] - np.mean(t[a:b])) for a, b in stretches]
         slope = sum(float(k @ y) for k, y in centred) / sum(float(k @ k) for k, _ in centred)
         if slope > 0:

@@ -388,17 +388,13 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                                  f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
                                  f"of the header (line {header_line}); every row holds one value per column"))
                 continue
-            stamp = None
             if time_column is not None:
                 text = row[index[6]].strip()
-                if clock is None and not lines:
-                    first_clock = None if _is_number(text, delimiter) else _clock_time(text)
-                    clock = False if first_clock is None else first_clock
+                if clock is None:  # the first sample decides
+                    clock = False if _is_number(text, delimiter) else (_clock_time(text) or False)
                 if clock:
                     stamp = _clock_time(text)
-                    if stamp is not None and (stamp[0] is None) != (clock[0] is None):
-                        stamp = None  # a date where the first sample had none, or none where it had one
-                    if stamp is None:
+                    if stamp is None or (stamp[0] is None) != (clock[0] is None):  # a date where the first had none
                         trailing.append((line_number, f"{time_column} is {text!r}",
                                          f"{where}: column {time_column!r} is {text!r} at line {line_number}; "
                                          f"expected a clock time, as the first sample's ({clock[2]!r})"))
@@ -411,7 +407,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                         seconds = (stamp[0] - clock[0]) * 86400.0 + stamp[1]
                     previous_stamp = seconds
                     row = list(row)
-                    row[index[6]] = "0"
+                    row[index[6]] = repr(seconds - clock[1])  # seconds from the first sample, read as any number
             try:
                 numbers = [float(row[k]) for k in index]
             except ValueError:
@@ -431,8 +427,6 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 continue
             if trailing:  # a line that is not a sample, followed by samples: the log is broken there
                 raise ValueError(trailing[0][2])
-            if stamp is not None:
-                numbers[6] = seconds - clock[1]  # seconds from the first sample
             if not all(map(math.isfinite, numbers)):
                 j = next(j for j, v in enumerate(numbers) if not math.isfinite(v))
                 raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
