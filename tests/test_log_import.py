@@ -26,14 +26,8 @@ import pytest
 
 from plansim.cli import main
 from plansim.estimate.segmentation import segment_log
-from plansim.io.log_import import (
-    MAX_PREAMBLE_LINES,
-    MAX_TRAILING_LINES,
-    import_log,
-    parse_offset,
-    parse_scale,
-    parse_units,
-)
+from plansim.io.log_import import import_log
+from plansim.io.log_table import MAX_PREAMBLE_LINES, MAX_TRAILING_LINES, parse_offset, parse_scale, parse_units
 from plansim.io.recording import nominal_time, read_recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.runner import simulate_and_record

@@ -9,20 +9,18 @@ motion between them (:func:`plansim.estimate.segmentation.segment_log`) and retu
 ``static``, ``rotation`` and ``move`` segments (docs/recording.md), with what it found in the
 attributes and the schedule notes. ``plansim import`` writes it (docs/measured-data.md).
 
+The second of the three parts of ``plansim import``: :func:`plansim.io.log_table.read_log` reads the table,
+:func:`plansim.io.log_summary.format_summary` writes what was found as text.
+
 Every problem with the log is a ``ValueError`` naming the file, the line and the column; what the
 log may still be used for despite a flaw (a gap, a saturated stretch, timing jitter) is a named
 :class:`LogWarning`.
 """
-
 from __future__ import annotations
 
-import csv
-import datetime
 import math
 import os
-import re
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -39,58 +37,71 @@ from plansim.estimate.segmentation import (
     analyse_time,
     segment_log,
 )
-from plansim.io.recording_csv import _text_file, _unterminated_last_line
+from plansim.io.log_table import (
+    TIME_UNITS,
+    LogTable,
+    parse_full_scale,
+    parse_offset,
+    parse_scale,
+    parse_units,
+    read_log,
+)
 from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
 from plansim.schedule.segments import Schedule, Segment
 from plansim.units import KINDS, STANDARD_GRAVITY
 
-#: default names of the six channel columns, in the order gx gy gz ax ay az
-DEFAULT_COLUMNS = CHANNELS
-#: units of the time column -> seconds per unit ("samples": a sample counter, needs the sample rate)
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "samples": math.nan}
-#: the delimiters a log may use; the one that splits the header line into the most columns is taken
-DELIMITERS = (",", ";", "\t")
-#: the delimiter of a log whose columns are separated by runs of spaces (imu_tk, MATLAB's ``save -ascii``)
-WHITESPACE = "whitespace"
 #: a static span's mean specific force must be within this fraction of standard gravity (units check)
 GRAVITY_TOLERANCE = 0.3
+
+
 #: timing jitter (RMS) beyond this fraction of the sample period is a warning
 JITTER_WARNING = 0.1
+
+
 #: a given sample rate that differs from the time column's by more than this fraction is a warning
 RATE_MISMATCH_WARNING = 0.01
-#: lines a logger may write before the header (its own metadata, such as "Fs,100"): the header is the first line
-#: that names every column asked for, searched this far; those before it are skipped and reported
-MAX_PREAMBLE_LINES = 50
-#: lines after the last sample that are not samples (a logger's footer, a row it did not finish when stopped):
-#: skipped and reported up to this many; more, or one followed by samples, stops the import
-MAX_TRAILING_LINES = 10
-#: rows converted to numbers at a time while reading
-_BLOCK_ROWS = 65536
+
+
 #: the range of a lab temperature given with --temperature, degC: the widest a MEMS IMU is rated for (automotive
 #: and military grades run from -55 to +125 degC), with a margin
 LAB_TEMPERATURE = (-100.0, 200.0)
+
+
 #: the temperature assumed for each segment when the log has no temperature channel, degC
 DEFAULT_TEMPERATURE = 20.0
+
+
 #: a sample more than this fraction beyond its channel's declared full scale is an error: a sensor cannot read
 #: beyond its rail, so the full scale or the units are wrong (the margin allows a converter whose rail lies a little
 #: beyond its part's nominal range)
 FULL_SCALE_EXCEEDED = 0.02
 
+
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines")
+
+
 #: up to this many glitch rows are listed by line in the warning
 GLITCHES_LISTED = 10
+
+
 #: two saturated stretches of one channel at most this many detector windows apart are one episode (a shake hits
 #: the rail once per swing): one warning for it
 SATURATION_EPISODE_WINDOWS = 1
+
+
 #: a static pose whose gyro output is at least this (rad/s) and points along its own specific force (within
 #: :data:`VERTICAL_TURN_CONE`) is warned of as possibly a steady turn about the vertical: the one turn that leaves
 #: the accelerometers steady, which the detector (step 6) can tell from rest only against a rest elsewhere in the log
 VERTICAL_TURN_RATE = math.radians(1.0)
+
+
 #: half-angle of the cone about the specific force within which such a gyro output counts as along it. A bias of
 #: random direction falls in it by chance 1 − cos 10° = 1.5 % of the time
 VERTICAL_TURN_CONE = math.radians(10.0)
+
+
 #: a sample rate from the time column outside this range (Hz) is a warning: an IMU log is sampled at 1 Hz to 100 kHz,
 #: and a rate outside it is most often a time column in another unit than --time-unit says (ms read as s: 1000 Hz
 #: reads as 1 Hz)
@@ -110,42 +121,6 @@ class LogWarning:
 
 
 @dataclass(frozen=True)
-class LogTable:
-    """The columns read from a plain log, in the file's units.
-
-    ``channels`` (N, 6) in the order gx gy gz ax ay az; ``time`` (N,) in the time column's unit or None;
-    ``temperature`` (N,) degC or None; ``names`` the six channel column names; ``ignored`` the columns
-    not used; ``first_line`` the file line of the first sample (1-based).
-    """
-
-    path: Path
-    channels: np.ndarray
-    names: tuple[str, ...]
-    time: np.ndarray | None
-    time_column: str | None
-    temperature: np.ndarray | None
-    temperature_column: str | None
-    ignored: tuple[str, ...]
-    first_line: int
-    lines: np.ndarray = field(repr=False, default=None)  # the file line of every sample
-    #: lines before the header that are not comments and not the header: a logger's own metadata
-    #: ("Fs,100"), skipped and reported, never read as numbers (:data:`MAX_PREAMBLE_LINES` at most)
-    preamble: tuple[str, ...] = ()
-    header_line: int = 1  # the file line of the header (1-based)
-    decimal_comma: bool = False  # some values were written with a decimal comma (";"- or tab-separated logs)
-    #: False: the log has no header line; its columns are named by their position, "1" for the first
-    has_header: bool = True
-    #: a row of units just under the header ("s,deg/s,…"): its line and the channels' six entries, skipped
-    units_row: tuple[int, tuple[str, ...]] | None = None
-    #: ``(line, why)`` of the lines after the last sample that are not samples (a footer, a row the logger did
-    #: not finish, a last line with no line break): skipped (:data:`MAX_TRAILING_LINES` at most)
-    trailing: tuple[tuple[int, str], ...] = ()
-    #: the first sample's clock time where the time column holds clock times (``time`` is then in seconds from
-    #: it), else None
-    clock_start: str | None = None
-
-
-@dataclass(frozen=True)
 class ImportResult:
     """What :func:`import_log` gives: the recording, the detector's findings and the warnings."""
 
@@ -159,391 +134,6 @@ class ImportResult:
     offset: tuple[float, ...] | None = None  # counts at zero input (--offset), or None
     #: the channels read reversed (a leading '-' in ``columns``: an axis whose sign the log has the other way)
     reversed_channels: tuple[str, ...] = ()
-
-
-def _split_list(text: str, option: str) -> list[str]:
-    items = [item.strip() for item in str(text).split(",")]
-    if not items or any(not item for item in items):
-        raise ValueError(f"{option} {text!r}: expected a comma-separated list without empty entries")
-    return items
-
-
-def parse_units(text: str | None) -> tuple[str, ...]:
-    """The unit of each of the six channels from ``--units``: two entries (gyros, accelerometers) or six.
-
-    Gyro units are those of :data:`plansim.units.KINDS` ``angular_rate`` (rad/s, deg/s, deg/h), accelerometer
-    units those of ``acceleration`` (m/s^2, g, mg, ug). ``None``: SI (rad/s, m/s^2).
-    """
-    if text is None:
-        return ("rad/s",) * 3 + ("m/s^2",) * 3
-    items = _split_list(text, "--units")
-    if len(items) == 2:
-        items = [items[0]] * 3 + [items[1]] * 3
-    if len(items) != 6:
-        raise ValueError(f"--units {text!r}: {len(items)} entries; expected 2 (gyro unit, accelerometer unit) or 6 "
-                         f"(one per channel {', '.join(CHANNELS)})")
-    for k, unit in enumerate(items):
-        kind = "angular_rate" if k < 3 else "acceleration"
-        items[k] = unit = UNIT_SPELLINGS.get(unit, unit)
-        if unit not in KINDS[kind]:
-            hint = f" ({SCALED_UNITS[unit]})" if unit in SCALED_UNITS else ""
-            raise ValueError(f"--units {text!r}: {unit!r} for channel {CHANNELS[k]}{hint}; allowed: "
-                             f"{', '.join(u for u in KINDS[kind] if u)}")
-    return tuple(items)
-
-
-#: other spellings of the units of :data:`plansim.units.KINDS` that logs and data sheets use (``--units``)
-UNIT_SPELLINGS = {"dps": "deg/s", "deg/sec": "deg/s", "°/s": "deg/s", "degree/s": "deg/s", "degrees/s": "deg/s",
-                  "rad/sec": "rad/s", "rps": "rad/s", "°/h": "deg/h", "dph": "deg/h", "m/s2": "m/s^2",
-                  "m/s²": "m/s^2", "m/s/s": "m/s^2", "m/sec^2": "m/s^2", "µg": "ug", "μg": "ug"}
-#: units that are a scaled unit of KINDS: how to read them (``--units``' error)
-SCALED_UNITS = {"mdps": "1e-3 deg/s: give --units deg/s with --scale 1000", "mdeg/s": "give --units deg/s with "
-                "--scale 1000", "mrad/s": "give --units rad/s with --scale 1000", "m/s^2*1000": "give --units m/s^2 "
-                "with --scale 1000", "mm/s^2": "give --units m/s^2 with --scale 1000"}
-
-
-def parse_scale(text: str | None) -> tuple[float, ...] | None:
-    """Counts per unit from ``--scale``: two entries (gyros, accelerometers) or six; ``None``: not counts."""
-    return _per_channel(text, "--scale", "counts per gyro unit, counts per accelerometer unit", positive=True)
-
-
-def parse_offset(text: str | None) -> tuple[float, ...] | None:
-    """The counts read at zero input from ``--offset`` (an unsigned converter's mid-scale, e.g. 32768): two
-    entries (gyros, accelerometers) or six; ``None``: 0. Subtracted before ``--scale`` divides."""
-    return _per_channel(text, "--offset", "counts at zero input of the gyros, of the accelerometers", positive=False)
-
-
-def parse_full_scale(text: str | None) -> tuple[float, ...] | None:
-    """Each channel's full scale from ``--full-scale``, in the channels' ``--units`` (not counts): two entries
-    (gyros, accelerometers) or six; ``None``: not known (the rail is then looked for in the data)."""
-    return _per_channel(text, "--full-scale", "gyro full scale, accelerometer full scale", positive=True,
-                        allowed="a positive full scale in the channel's unit (--units)")
-
-
-def _per_channel(text: str | None, option: str, pair: str, positive: bool,
-                 allowed: str = "a positive number of counts per unit") -> tuple[float, ...] | None:
-    """Two entries (gyros, accelerometers) or six numbers of *option*; ``None`` when not given."""
-    if text is None:
-        return None
-    items = _split_list(text, option)
-    if len(items) == 2:
-        items = [items[0]] * 3 + [items[1]] * 3
-    if len(items) != 6:
-        raise ValueError(f"{option} {text!r}: {len(items)} entries; expected 2 ({pair}) or 6 (one per channel)")
-    values = []
-    for k, item in enumerate(items):
-        try:
-            value = float(item)
-        except ValueError:
-            raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]} is not a number") from None
-        if not math.isfinite(value) or (positive and not value > 0):
-            expected = allowed if positive else "a finite number of counts"
-            raise ValueError(f"{option} {text!r}: {item!r} for channel {CHANNELS[k]}; expected {expected}")
-        values.append(value)
-    return tuple(values)
-
-
-def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, time_column: str | None = None,
-             temperature_column: str | None = None) -> LogTable:
-    """Read the columns of a plain CSV log, checking every row.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The log: UTF-8 text, optional ``#`` comment lines, a header line of column names (a commented one
-        counts, as EuRoC's ``#timestamp [ns],w_RS_S_x [rad s^-1],…``), one row per sample; comma-, semicolon-
-        or tab-separated (with ``;`` or tabs, a decimal comma is read: ``0,123``).
-    columns : tuple of 6 str or None
-        The column names of gx gy gz ax ay az; columns not named (and not the time or temperature column)
-        are ignored. ``None``: the columns must be named ``gx gy gz ax ay az`` and the log may hold no other.
-    time_column, temperature_column : str or None
-        Names of the time and temperature columns, if any. A time column of clock times (ISO 8601 date and time,
-        ``2024-11-27 14:22:31.504`` or with ``T``, ``/`` or unpadded fields, or the time of day alone,
-        ``14:22:31.504``) is read as such, in seconds from its first sample (:func:`_clock_time`); the first
-        sample decides.
-
-    Raises
-    ------
-    ValueError
-        The file is missing or not text; a column is missing, named twice or not expected; a row has more
-        or fewer values than the header; a value is not a finite number. The message names the file, the
-        line and the column.
-    """
-    target = Path(path)
-    where = f"log {str(target)!r}"
-    if not target.is_file():
-        raise ValueError(f"{where} does not exist")
-    names = DEFAULT_COLUMNS if columns is None else tuple(columns)
-    if len(names) != 6:
-        raise ValueError(f"--columns {','.join(names)!r}: {len(names)} names; expected 6, in the order "
-                         f"{', '.join(CHANNELS)}")
-    wanted = list(names) + [c for c in (time_column, temperature_column) if c is not None]
-    repeated = sorted({name for name in wanted if wanted.count(name) > 1})
-    if repeated:
-        raise ValueError(f"{where}: column {repeated[0]!r} is named for two uses (channels, --time, "
-                         "--temperature-column)")
-    with _text_file(target, where) as fh:
-        header_line = 0
-        header = None
-        has_header = True
-        first = None  # the first line that is not a comment: the header, unless a preamble precedes it
-        previous = None  # the last line read that is not a comment
-        preamble: list[str] = []
-        for line in iter(fh.readline, ""):  # readline, not iteration: the look-ahead below may seek back
-            header_line += 1
-            stripped = line.strip()
-            if not stripped:
-                continue
-            if stripped.startswith("#"):
-                # a commented header names the columns too (EuRoC, TUM-VI, Kalibr: "#timestamp [ns],w_RS_S_x …")
-                # read without its '#' ("timestamp [ns]") or as it stands ("#timestamp [ns]", as a user copies it)
-                uncommented = stripped.lstrip("#").strip()
-                if uncommented and set(wanted) <= set(_names(uncommented)):
-                    header = uncommented
-                    break
-                if set(wanted) <= set(_names(stripped)):
-                    header = stripped
-                    break
-                continue
-            if _all_numbers(stripped) and _next_row_alike(fh, stripped):
-                if previous is not None and _width(previous[1]) == _width(stripped):
-                    # the line before names as many columns: the header, though not the columns asked for
-                    header_line, header = previous
-                    preamble = preamble[:-1]
-                    break
-                # no header line: the first sample (a row of numbers followed by another of as many); the
-                # columns are named by their position, 1 for the first
-                has_header = False
-                header_line -= 1
-                header = line
-                break
-            previous = (header_line, line)
-            if first is None:
-                first = (header_line, line)
-            if set(wanted) <= set(_names(line)):
-                header = line
-                break
-            preamble.append(stripped)
-            if len(preamble) > MAX_PREAMBLE_LINES:
-                break
-        if header is None and first is not None:
-            header_line, header = first  # no line names every column: report against the first one
-            preamble = []
-        if header is None:
-            raise ValueError(f"{where}: no header line; expected a line of column names, then one row per sample")
-        if preamble or not has_header:  # lines were read past the header; read again from just after it
-            fh.seek(0)
-            for _ in range(header_line):
-                fh.readline()
-        delimiter = _delimiter(header)
-        header_names = _names(header) if has_header else [str(k + 1) for k in range(len(_split(header, delimiter)))]
-        duplicates = sorted({name for name in header_names if header_names.count(name) > 1})
-        if duplicates:
-            raise ValueError(f"{where}: column {duplicates[0]!r} appears more than once in the header "
-                             f"(line {header_line})")
-        missing = [name for name in wanted if name not in header_names]
-        if missing and not has_header:
-            raise ValueError(f"{where}: column {missing[0]!r} is missing: the log has no header line (line "
-                             f"{header_line + 1} is its first sample, {len(header_names)} columns); name the columns "
-                             "by their position, 1 for the first, e.g. --columns 2,3,4,5,6,7 --time 1")
-        if missing:
-            hint = "" if columns is not None else (" (name the six channel columns with --columns GX,GY,GZ,AX,AY,AZ)")
-            raise ValueError(f"{where}: column {missing[0]!r} is missing; the header (line {header_line}) has "
-                             f"{', '.join(header_names)}{hint}")
-        ignored = tuple(name for name in header_names if name not in wanted)
-        if columns is None and ignored:
-            raise ValueError(f"{where}: column {ignored[0]!r} is not expected: without --columns the log holds "
-                             f"exactly the channels {', '.join(CHANNELS)} (and the --time and --temperature-column "
-                             "columns if given); name the six channel columns with --columns (the other columns "
-                             "are then ignored)")
-        index = [header_names.index(name) for name in wanted]
-        width = len(header_names)
-        decimal_comma = False
-        blocks: list[np.ndarray] = []  # rows converted block by block: floats, not text, are kept
-        block: list[list[float]] = []
-        lines: list[int] = []
-        line_number = header_line
-        cut = _unterminated_last_line(target)  # a logger stopped while writing its last row
-        clock = None  # the time column holds clock times (decided on the first sample): (days, seconds) of it
-        day = 0  # whole days a time of day alone has passed midnight
-        previous_stamp = 0.0
-        units_row = None
-        trailing: list[tuple[int, str, str]] = []  # (line, why, the error it is if a sample follows)
-        for row in _rows(fh, delimiter):
-            line_number += 1
-            if not row or all(not cell.strip() for cell in row):
-                continue
-            if row[0].lstrip().startswith("#"):
-                continue
-            if line_number == cut:
-                trailing.append((line_number, "no line break", ""))
-                continue
-            if has_header and not lines and units_row is None and len(row) == width and all(
-                    row[k].strip() and not _is_number(row[k].strip(), delimiter) for k in index):
-                units_row = (line_number, tuple(row[k].strip() for k in index[:6]))  # "s,deg/s,…" under the header
-                continue
-            if len(row) != width:
-                word = "more" if len(row) > width else "fewer"
-                trailing.append((line_number, f"{len(row)} values, not {width}",
-                                 f"{where}: line {line_number} has {len(row)} values, {word} than the {width} columns "
-                                 f"of the header (line {header_line}); every row holds one value per column"))
-                continue
-            if time_column is not None:
-                text = row[index[6]].strip()
-                if clock is None:  # the first sample decides
-                    clock = False if _is_number(text, delimiter) else (_clock_time(text) or False)
-                if clock:
-                    stamp = _clock_time(text)
-                    if stamp is None or (stamp[0] is None) != (clock[0] is None):  # a date where the first had none
-                        trailing.append((line_number, f"{time_column} is {text!r}",
-                                         f"{where}: column {time_column!r} is {text!r} at line {line_number}; "
-                                         f"expected a clock time, as the first sample's ({clock[2]!r})"))
-                        continue
-                    if stamp[0] is None:  # a time of day: it passes midnight where it falls by more than 12 h
-                        if lines and stamp[1] + day * 86400.0 < previous_stamp - 43200.0:
-                            day += 1
-                        seconds = stamp[1] + day * 86400.0
-                    else:
-                        seconds = (stamp[0] - clock[0]) * 86400.0 + stamp[1]
-                    previous_stamp = seconds
-                    row = list(row)
-                    row[index[6]] = repr(seconds - clock[1])  # seconds from the first sample, read as any number
-            try:
-                numbers = [float(row[k]) for k in index]
-            except ValueError:
-                numbers = None
-                if delimiter != ",":  # a decimal comma (a spreadsheet's export in many locales): 0,123;4,5
-                    try:
-                        numbers = [float(row[k].replace(",", ".", 1)) if row[k].count(",") == 1 else float(row[k])
-                                   for k in index]
-                        decimal_comma = True
-                    except ValueError:
-                        numbers = None
-            if numbers is None:
-                j = next(j for j, k in enumerate(index) if not _is_number(row[k], delimiter))
-                trailing.append((line_number, f"{wanted[j]} is {row[index[j]].strip()!r}",
-                                 f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
-                                 "expected a number"))
-                continue
-            if trailing:  # a line that is not a sample, followed by samples: the log is broken there
-                raise ValueError(trailing[0][2])
-            if not all(map(math.isfinite, numbers)):
-                j = next(j for j, v in enumerate(numbers) if not math.isfinite(v))
-                raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
-                                 "every value must be a finite number (a sample lost by the logger? cut the log before "
-                                 "or after it)")
-            block.append(numbers)
-            lines.append(line_number)
-            if len(block) == _BLOCK_ROWS:
-                blocks.append(np.array(block, dtype=np.float64))
-                block = []
-        if block:
-            blocks.append(np.array(block, dtype=np.float64))
-    if not blocks:
-        if trailing and trailing[0][2]:
-            raise ValueError(trailing[0][2])
-        raise ValueError(f"{where}: no sample after the header (line {header_line})")
-    if len(trailing) > MAX_TRAILING_LINES:
-        raise ValueError(next(error for _, _, error in trailing if error))
-    data = np.concatenate(blocks)
-    time = data[:, 6] if time_column is not None else None
-    temperature = data[:, -1] if temperature_column is not None else None
-    return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
-                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
-                    has_header, units_row, tuple((line, why) for line, why, _ in trailing),
-                    clock[2] if clock else None)
-
-
-def _delimiter(line: str) -> str:
-    """The delimiter of a line: the one of :data:`DELIMITERS` that splits it into the most fields, or
-    :data:`WHITESPACE` when none of them splits it and runs of spaces do."""
-    best = max(DELIMITERS, key=lambda d: len(next(csv.reader([line], delimiter=d))))
-    if len(next(csv.reader([line], delimiter=best))) == 1 and len(line.split()) > 1:
-        return WHITESPACE
-    return best
-
-
-def _split(line: str, delimiter: str) -> list[str]:
-    """The fields of one line at *delimiter* (:data:`WHITESPACE`: runs of spaces and tabs)."""
-    if delimiter == WHITESPACE:
-        return line.split()
-    return next(csv.reader([line], delimiter=delimiter))
-
-
-def _rows(fh, delimiter: str):
-    """The rows of the rest of an open log, each a list of fields."""
-    if delimiter != WHITESPACE:
-        yield from csv.reader(fh, delimiter=delimiter)
-        return
-    for line in fh:
-        yield line.split()
-
-
-def _names(line: str) -> list[str]:
-    """The stripped fields of one line, split at its own delimiter."""
-    return [name.strip() for name in _split(line, _delimiter(line))]
-
-
-def _all_numbers(line: str) -> bool:
-    """Whether a line is a sample, not a header: at least two fields, every one a number."""
-    delimiter = _delimiter(line)
-    fields = _split(line, delimiter)
-    return len(fields) >= 2 and all(_is_number(f.strip(), delimiter) for f in fields)
-
-
-def _width(line: str) -> int:
-    """The number of fields of one line at its own delimiter."""
-    return len(_split(line, _delimiter(line)))
-
-
-def _next_row_alike(fh, line: str) -> bool:
-    """Whether the next line of *fh* that is not blank or a comment is a row of numbers as wide as *line* (or
-    there is none): a lone numeric line of a logger's preamble ("2024,11,27") is not taken for a sample."""
-    width = _width(line)
-    position = fh.tell()
-    try:
-        for following in iter(fh.readline, ""):
-            text = following.strip()
-            if text and not text.startswith("#"):
-                return _all_numbers(text) and _width(text) == width
-        return True
-    finally:
-        fh.seek(position)
-
-
-#: a clock time in a time column: an optional date (year, month, day; '-', '/' or '.' between, unpadded fields too)
-#: and a time of day (hours, minutes, seconds with a fraction after '.' or ','), an optional zone that is ignored
-_CLOCK_TIME = re.compile(r"^(?:(\d{4})[-/.](\d{1,2})[-/.](\d{1,2})[ T])?(\d{1,2}):(\d{2}):(\d{2}(?:[.,]\d+)?)"
-                         r"\s*(?:Z|[+-]\d{2}:?\d{2})?$")
-
-
-def _clock_time(text: str) -> tuple[int | None, float, str] | None:
-    """A clock time's (day number or None for a time of day alone, seconds into the day, the text); None if the
-    text is not one (:data:`_CLOCK_TIME`)."""
-    match = _CLOCK_TIME.match(text.strip())
-    if match is None:
-        return None
-    year, month, day, hours, minutes, seconds = match.groups()
-    try:
-        days = None if year is None else datetime.date(int(year), int(month), int(day)).toordinal()
-    except ValueError:
-        return None
-    if int(hours) > 23 or int(minutes) > 59 or float(seconds.replace(",", ".")) >= 61.0:
-        return None
-    return days, int(hours) * 3600.0 + int(minutes) * 60.0 + float(seconds.replace(",", ".")), text.strip()
-
-
-def _is_number(text: str, delimiter: str = ",") -> bool:
-    try:
-        float(text)
-    except ValueError:
-        if delimiter == "," or text.count(",") != 1:
-            return False
-        try:
-            float(text.replace(",", ".", 1))
-        except ValueError:
-            return False
-    return True
 
 
 def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = None, time_column: str | None = None,
@@ -950,70 +540,3 @@ def _detail(span: Span, table: LogTable) -> dict:
             detail["why_not_a_rotation"] = span.reason
     return detail
 
-
-def format_summary(result: ImportResult) -> str:
-    """The import's findings as text, every number with its unit (what ``plansim import`` prints)."""
-    table, timing, seg = result.table, result.timing, result.segmentation
-    rec = result.recording
-    lines = [f"plansim import {table.path.name}: {rec.samples.shape[0]} samples"]
-    unit_text = ", ".join(dict.fromkeys(result.units))
-    if result.scale is not None:
-        unit_text = "counts: " + ", ".join(f"{c:g}/{u}" for c, u in zip(result.scale, result.units))
-        if result.offset is not None:
-            unit_text += " after subtracting " + ", ".join(f"{c:g}" for c in result.offset) + " counts (--offset)"
-    lines.append("  channels: " + " ".join(f"{c}={'-' if c in result.reversed_channels else ''}{n}"
-                                           for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
-                 + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
-    if not table.has_header:
-        lines.append(f"  no header line: columns named by position, 1 for the first (first sample on line "
-                     f"{table.first_line})")
-    if table.decimal_comma:
-        lines.append("  numbers with a decimal comma (0,123) read as such: the values are separated by ';' or tabs")
-    if table.preamble:
-        shown = "; ".join(table.preamble[:4]) + ("; …" if len(table.preamble) > 4 else "")
-        where = f"the header (line {table.header_line})" if table.has_header else f"line {table.first_line}"
-        lines.append(f"  before {where}: {len(table.preamble)} line(s) skipped, not read as data: {shown}")
-    if table.clock_start is not None:
-        lines.append(f"  time: column {table.time_column!r} holds clock times, read in seconds from the first "
-                     f"({table.clock_start})")
-    if table.time is None:
-        lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (given; no time column: gaps and jitter cannot be "
-                     "seen)")
-    else:
-        lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (from column {table.time_column!r}: "
-                     f"{timing.estimated_rate:.6g} Hz); jitter {timing.jitter_rms:.3g} s RMS, "
-                     f"{timing.jitter_max:.3g} s at most; {len(timing.gaps)} gap(s), {timing.missing_samples} "
-                     "sample(s) missing")
-    noise = seg.noise
-    gyro = " ".join(f"{c} {math.degrees(v):.3g}" for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
-    accel = " ".join(f"{c} {v:.3g}" for c, v in zip(CHANNELS[3:], noise.sigma[3:]))
-    density = " ".join(f"{c} {math.degrees(v) * 60.0 / math.sqrt(timing.sample_rate):.3g}"
-                       for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
-    lines.append(f"  noise per sample (quiet stretch, lines {table.lines[noise.start]}-{table.lines[noise.stop - 1]}): "
-                 f"{gyro} deg/s; {accel} m/s^2 (as white noise: {density} deg/sqrt(h))")
-    rate = " ".join(f"{math.degrees(v):.3g}" for v in seg.rate_threshold)
-    lines.append(f"  at rest: variance ratios <= {seg.variance_threshold[0]:.3g} (accelerometers), "
-                 f"{seg.variance_threshold[1]:.3g} (gyros) over {seg.window} samples "
-                 f"({seg.window / timing.sample_rate:.3g} s), for at least {seg.min_static / timing.sample_rate:.3g} "
-                 f"s; a quiet stretch turning faster than {rate} deg/s (x y z) is a steady turn")
-    counts = {kind: len(seg.of_kind(kind)) for kind in ("static", "rotation", "move")}
-    lines.append(f"  segments: {counts['static']} static, {counts['rotation']} rotation, {counts['move']} move")
-    lines.append(f"  {'#':>3}  {'test':8s}  {'lines':>13s}  {'duration':>9s}  label")
-    for k, (span, segment) in enumerate(zip(seg.spans, rec.schedule.segments)):
-        rows = f"{table.lines[span.start]}-{table.lines[span.stop - 1]}"
-        lines.append(f"  {k:3d}  {segment.test:8s}  {rows:>13s}  {span.samples / timing.sample_rate:7.2f} s  "
-                     f"{segment.label}")
-    lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
-                 "approximate for the static poses")
-    rotations = seg.of_kind("rotation")
-    if any(not math.isfinite(r.steady_rate) for r in rotations):
-        lines.append("  rotations: angle = the whole number of quarter turns nearest the measured integral (bias "
-                     "removed); check it against what was done; rate = nan (not logged)")
-    if any(math.isfinite(r.steady_rate) for r in rotations):
-        lines.append("  steady turns: angle = nan and rate = nan (a table's rate is not in the log): give each one "
-                     "the rate the table held for the fit to use it (in the segment table, rate_deg_s and "
-                     "rate_rad_s, or one of them with the other column deleted); the moves beside them are the "
-                     "table's spin-up and stop")
-    for warning in result.warnings:
-        lines.append(f"  warning [{warning.name}]: {warning.message}")
-    return "\n".join(lines)

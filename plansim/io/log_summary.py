@@ -1,0 +1,80 @@
+"""What ``plansim import`` prints: the import's findings as text, every number with its unit.
+
+The third of the three parts of ``plansim import`` (:mod:`plansim.io.log_table` reads the table,
+:mod:`plansim.io.log_import` cuts it into segments and makes the recording).
+"""
+from __future__ import annotations
+
+import math
+
+from plansim.io.log_import import ImportResult
+from plansim.io.recording_data import CHANNELS
+
+
+def format_summary(result: ImportResult) -> str:
+    """The import's findings as text, every number with its unit (what ``plansim import`` prints)."""
+    table, timing, seg = result.table, result.timing, result.segmentation
+    rec = result.recording
+    lines = [f"plansim import {table.path.name}: {rec.samples.shape[0]} samples"]
+    unit_text = ", ".join(dict.fromkeys(result.units))
+    if result.scale is not None:
+        unit_text = "counts: " + ", ".join(f"{c:g}/{u}" for c, u in zip(result.scale, result.units))
+        if result.offset is not None:
+            unit_text += " after subtracting " + ", ".join(f"{c:g}" for c in result.offset) + " counts (--offset)"
+    lines.append("  channels: " + " ".join(f"{c}={'-' if c in result.reversed_channels else ''}{n}"
+                                           for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
+                 + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
+    if not table.has_header:
+        lines.append(f"  no header line: columns named by position, 1 for the first (first sample on line "
+                     f"{table.first_line})")
+    if table.decimal_comma:
+        lines.append("  numbers with a decimal comma (0,123) read as such: the values are separated by ';' or tabs")
+    if table.preamble:
+        shown = "; ".join(table.preamble[:4]) + ("; …" if len(table.preamble) > 4 else "")
+        where = f"the header (line {table.header_line})" if table.has_header else f"line {table.first_line}"
+        lines.append(f"  before {where}: {len(table.preamble)} line(s) skipped, not read as data: {shown}")
+    if table.clock_start is not None:
+        lines.append(f"  time: column {table.time_column!r} holds clock times, read in seconds from the first "
+                     f"({table.clock_start})")
+    if table.time is None:
+        lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (given; no time column: gaps and jitter cannot be "
+                     "seen)")
+    else:
+        lines.append(f"  sample rate: {timing.sample_rate:.6g} Hz (from column {table.time_column!r}: "
+                     f"{timing.estimated_rate:.6g} Hz); jitter {timing.jitter_rms:.3g} s RMS, "
+                     f"{timing.jitter_max:.3g} s at most; {len(timing.gaps)} gap(s), {timing.missing_samples} "
+                     "sample(s) missing")
+    noise = seg.noise
+    gyro = " ".join(f"{c} {math.degrees(v):.3g}" for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
+    accel = " ".join(f"{c} {v:.3g}" for c, v in zip(CHANNELS[3:], noise.sigma[3:]))
+    density = " ".join(f"{c} {math.degrees(v) * 60.0 / math.sqrt(timing.sample_rate):.3g}"
+                       for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
+    lines.append(f"  noise per sample (quiet stretch, lines {table.lines[noise.start]}-{table.lines[noise.stop - 1]}): "
+                 f"{gyro} deg/s; {accel} m/s^2 (as white noise: {density} deg/sqrt(h))")
+    rate = " ".join(f"{math.degrees(v):.3g}" for v in seg.rate_threshold)
+    lines.append(f"  at rest: variance ratios <= {seg.variance_threshold[0]:.3g} (accelerometers), "
+                 f"{seg.variance_threshold[1]:.3g} (gyros) over {seg.window} samples "
+                 f"({seg.window / timing.sample_rate:.3g} s), for at least {seg.min_static / timing.sample_rate:.3g} "
+                 f"s; a quiet stretch turning faster than {rate} deg/s (x y z) is a steady turn")
+    counts = {kind: len(seg.of_kind(kind)) for kind in ("static", "rotation", "move")}
+    lines.append(f"  segments: {counts['static']} static, {counts['rotation']} rotation, {counts['move']} move")
+    lines.append(f"  {'#':>3}  {'test':8s}  {'lines':>13s}  {'duration':>9s}  label")
+    for k, (span, segment) in enumerate(zip(seg.spans, rec.schedule.segments)):
+        rows = f"{table.lines[span.start]}-{table.lines[span.stop - 1]}"
+        lines.append(f"  {k:3d}  {segment.test:8s}  {rows:>13s}  {span.samples / timing.sample_rate:7.2f} s  "
+                     f"{segment.label}")
+    lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
+                 "approximate for the static poses")
+    rotations = seg.of_kind("rotation")
+    if any(not math.isfinite(r.steady_rate) for r in rotations):
+        lines.append("  rotations: angle = the whole number of quarter turns nearest the measured integral (bias "
+                     "removed); check it against what was done; rate = nan (not logged)")
+    if any(math.isfinite(r.steady_rate) for r in rotations):
+        lines.append("  steady turns: angle = nan and rate = nan (a table's rate is not in the log): give each one "
+                     "the rate the table held for the fit to use it (in the segment table, rate_deg_s and "
+                     "rate_rad_s, or one of them with the other column deleted); the moves beside them are the "
+                     "table's spin-up and stop")
+    for warning in result.warnings:
+        lines.append(f"  warning [{warning.name}]: {warning.message}")
+    return "\n".join(lines)
+
