@@ -873,3 +873,87 @@ def test_a_rate_table_log_is_fitted_once_the_table_rates_are_given(tmp_path, cap
     kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
     assert abs(kgzz["estimate"] - scale) < 3.3 * kgzz["u"], kgzz
     assert kgzz["u"] < 1e-4
+
+
+def _write_sensor_log(path: Path, time_s: np.ndarray, values: np.ndarray, unit: str) -> None:
+    """One sensor's log as phyphox and the phone sensor loggers write it: a time column and three axes, quoted."""
+    header = ",".join(f'"{name}"' for name in ("Time (s)", f"X ({unit})", f"Y ({unit})", f"Z ({unit})"))
+    np.savetxt(path, np.column_stack([time_s, values]), delimiter=",", header=header, comments="", fmt="%.17g")
+
+
+def test_gyros_and_accelerometers_logged_in_two_files_are_paired_by_time(tmp_path, capsys):
+    """A phone app's two files (phyphox: Gyroscope.csv, Accelerometer.csv, 'Time (s)' and 'X (rad/s)' … in each).
+    The accelerometer log runs at twice the rate, 3 ms behind, starts 0.5 s before the gyro log and stops 0.3 s
+    before it: the gyro log is the slower, each of its samples takes the nearest accelerometer sample (the one 3 ms
+    later, not the one 4 ms earlier), and the last 0.3 s of gyro samples, with no accelerometer sample within a
+    period (5 ms) of them, are dropped. What is kept is the recording's own samples, exactly, cut into the
+    segments the one-file log gives. Then the other way round (the gyros faster, the accelerometer log kept),
+    row by row without time columns, and the errors."""
+    recording = simulated_log()
+    t, x = recording.time, recording.samples
+    n = t.size
+    rng = np.random.default_rng(5)
+    columns = ["--columns", "X (rad/s),Y (rad/s),Z (rad/s),X (m/s^2),Y (m/s^2),Z (m/s^2)", "--time", "Time (s)"]
+    cut = n - 30  # the accelerometer log stops 0.3 s before the gyro log
+    one = tmp_path / "one.csv"
+    np.savetxt(one, np.column_stack([t, x])[:cut], delimiter=",", header="time,gx,gy,gz,ax,ay,az", comments="",
+               fmt="%.17g")
+    reference = import_log(one, time_column="time")
+    lead = np.arange(-50, 0) * 0.005  # and starts 0.5 s before it
+    t_acc = np.concatenate([lead, np.column_stack([t + 0.003, t + 0.006])[:cut].ravel()[:-1]])
+    between = x[:, 3:] + rng.normal(scale=0.01, size=(n, 3))  # the samples the gyros never see
+    acc = np.concatenate([np.tile(x[0, 3:], (50, 1)),
+                          np.stack([x[:, 3:], between], axis=1)[:cut].reshape(-1, 3)[:-1]])
+    _write_sensor_log(tmp_path / "Gyroscope.csv", t, x[:, :3], "rad/s")
+    _write_sensor_log(tmp_path / "Accelerometer.csv", t_acc, acc, "m/s^2")
+    out = tmp_path / "rec.nc"
+    assert main(["import", str(tmp_path / "Gyroscope.csv"), "--accel-log", str(tmp_path / "Accelerometer.csv"),
+                 "--out", str(out), *columns]) == 0
+    text = capsys.readouterr().out
+    assert "two logs: gyros from Gyroscope.csv (100 Hz), accelerometers from Accelerometer.csv (200 Hz)" in text
+    assert "each sample of Gyroscope.csv (the slower log" in text and "0.003 s apart at most (0.003 s RMS)" in text
+    assert "30 sample(s) of Gyroscope.csv had no sample of Accelerometer.csv" in text
+    rec = read_recording(out)
+    np.testing.assert_array_equal(rec.samples, x[:cut])
+    np.testing.assert_allclose(rec.time, t[:cut], atol=1e-9)
+    assert rec.attrs["imported_from"] == "Gyroscope.csv (gyros), Accelerometer.csv (accelerometers)"
+    assert [(s.test, s.up) for s in rec.schedule.segments] == [
+        (s.test, s.up) for s in reference.recording.schedule.segments]
+    assert rec.schedule.notes["import"]["accel_log"] == "Accelerometer.csv"
+
+    # the gyros twice as fast: the accelerometer log is kept, its lines are the ones given
+    _write_sensor_log(tmp_path / "g2.csv", np.column_stack([t - 0.003, t + 0.004]).ravel(),
+                      np.stack([x[:, :3], x[:, :3] + 1e-3], axis=1).reshape(-1, 3), "rad/s")
+    _write_sensor_log(tmp_path / "a2.csv", t, x[:, 3:], "m/s^2")
+    both = import_log(tmp_path / "g2.csv", accel_log=tmp_path / "a2.csv", columns=tuple(columns[1].split(",")),
+                      time_column="Time (s)")
+    np.testing.assert_array_equal(both.recording.samples, x)
+    assert both.table.path.name == "a2.csv" and both.table.lines[0] == 2
+    assert "each sample of a2.csv (the slower log" in both.table.pairing[0]
+
+    # no time columns: paired row by row (imu_tk's two files, sampled together), with --sample-rate
+    for name, values in (("g3.csv", x[:, :3]), ("a3.csv", x[:, 3:])):
+        np.savetxt(tmp_path / name, values, fmt="%.17g")
+    rows = import_log(tmp_path / "g3.csv", accel_log=tmp_path / "a3.csv", columns=("1", "2", "3", "1", "2", "3"),
+                      sample_rate=100.0)
+    np.testing.assert_array_equal(rows.recording.samples, x)
+    assert "paired row by row" in rows.table.pairing[0]
+
+    # errors name what is wrong
+    np.savetxt(tmp_path / "a4.csv", x[:-5, 3:], fmt="%.17g")
+    with pytest.raises(ValueError, match="has 7800 samples and the accelerometer log .a4.csv. 7795"):
+        import_log(tmp_path / "g3.csv", accel_log=tmp_path / "a4.csv", columns=("1", "2", "3", "1", "2", "3"),
+                   sample_rate=100.0)
+    _write_sensor_log(tmp_path / "late.csv", t + 1000.0, x[:, 3:], "m/s^2")
+    with pytest.raises(ValueError, match="do not overlap in time"):
+        import_log(tmp_path / "Gyroscope.csv", accel_log=tmp_path / "late.csv", columns=tuple(columns[1].split(",")),
+                   time_column="Time (s)")
+    backwards = t.copy()
+    backwards[400] = backwards[398]
+    _write_sensor_log(tmp_path / "back.csv", backwards, x[:, 3:], "m/s^2")
+    with pytest.raises(ValueError, match="accelerometer log .*back.csv.* goes backwards at line 402"):
+        import_log(tmp_path / "Gyroscope.csv", accel_log=tmp_path / "back.csv", columns=tuple(columns[1].split(",")),
+                   time_column="Time (s)")
+    with pytest.raises(ValueError, match="5 names; expected 6, the gyro log's three"):
+        import_log(tmp_path / "Gyroscope.csv", accel_log=tmp_path / "a2.csv", columns=("a", "b", "c", "d", "e"),
+                   time_column="Time (s)")

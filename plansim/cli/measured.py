@@ -19,14 +19,17 @@ def _cmd_import(args) -> int:
     outputs = [target]
     if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
         outputs.append(check_output_path(segment_table_path(target), "--out's segment table"))
-    if any(os.path.exists(args.log) and os.path.exists(out) and os.path.samefile(args.log, out) for out in outputs):
-        raise ValueError(f"--out {args.out!r} would overwrite the log {args.log!r}; write the recording elsewhere")
+    for log in (args.log, args.accel_log):
+        if log is not None and any(os.path.exists(log) and os.path.exists(out) and os.path.samefile(log, out)
+                                   for out in outputs):
+            raise ValueError(f"--out {args.out!r} would overwrite the log {log!r}; write the recording elsewhere")
     columns = None if args.columns is None else tuple(name.strip() for name in args.columns.split(","))
     options = {name: getattr(args, name) for name in ("window", "min_static") if getattr(args, name) is not None}
     result = import_log(args.log, columns=columns, time_column=args.time, time_unit=args.time_unit,
                         units=args.units, scale=args.scale, offset=args.offset, sample_rate=args.sample_rate,
                         temperature_column=args.temperature_column, temperature=args.temperature,
-                        latitude=args.latitude, height=args.height, full_scale=args.full_scale, **options)
+                        latitude=args.latitude, height=args.height, full_scale=args.full_scale,
+                        accel_log=args.accel_log, **options)
     write_recording(result.recording, args.out)  # whole or not at all
     print(format_summary(result))
     print(f"\nwrote recording: {args.out} (review its segment table: docs/measured-data.md)")
@@ -45,6 +48,11 @@ def _add_import_command(sub) -> None:
                                "skipped and reported), or none, then one row per sample; values separated by "
                                "commas, semicolons, tabs or spaces")
     p.add_argument("--out", required=True, help="recording file (.nc, or .csv plus <stem>.segments.csv)")
+    p.add_argument("--accel-log", default=None, metavar="LOG2",
+                   help="the accelerometers' log, where they were logged in a file of their own (imu_tk, phyphox, "
+                        "phone sensor loggers): LOG then holds the gyros, --columns names LOG's three then LOG2's "
+                        "three, and --time is in both; each sample of the slower log is paired with the other's "
+                        "nearest in time (nothing interpolated)")
     p.add_argument("--time", default=None, metavar="COL",
                    help="the time column (default: none; give --sample-rate); in a log with no header line, its "
                         "position (1 for the first column)")

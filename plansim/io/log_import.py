@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -40,6 +41,7 @@ from plansim.estimate.segmentation import (
 from plansim.io.log_table import (
     TIME_UNITS,
     LogTable,
+    pair_logs,
     parse_full_scale,
     parse_offset,
     parse_scale,
@@ -141,13 +143,13 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                offset: str | None = None, sample_rate: float | None = None, temperature_column: str | None = None,
                temperature: float | None = None, latitude: float | None = None, height: float | None = None,
                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
-               full_scale: str | None = None) -> ImportResult:
+               full_scale: str | None = None, accel_log: str | os.PathLike | None = None) -> ImportResult:
     """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
 
     Parameters
     ----------
     path : str or os.PathLike
-        The CSV log.
+        The CSV log (with ``accel_log``: the gyros' log).
     columns : tuple of 6 str or None
         Channel column names in the order gx gy gz ax ay az (default: those names).
     time_column : str or None
@@ -177,6 +179,11 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         ``--full-scale``: each channel's full scale (the largest magnitude it reads) in ``units``, two or six
         entries; a sample within :data:`plansim.estimate.segmentation.FULL_SCALE_MARGIN` of it is at the rail.
         ``None``: a rail is looked for in the data (step 10 of :mod:`plansim.estimate.segmentation`).
+    accel_log : str or os.PathLike or None
+        ``--accel-log``: where the accelerometers were logged in a file of their own, that file; ``path`` then
+        holds the gyros, the first three ``columns`` are ``path``'s and the last three this file's, the time
+        column (same name and unit) is in both and ``temperature_column`` in ``path``. The two are paired by
+        :func:`plansim.io.log_table.pair_logs`: each sample of the slower, with the other's nearest in time.
 
     Raises
     ------
@@ -228,7 +235,17 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if columns is not None:
         signs = np.array([-1.0 if str(name).startswith("-") and len(str(name)) > 1 else 1.0 for name in columns])
         columns = tuple(str(name)[1:].strip() if sign < 0 else name for name, sign in zip(columns, signs))
-    table = read_log(path, columns, time_column, temperature_column)
+    if accel_log is None:
+        table = read_log(path, columns, time_column, temperature_column)
+    else:
+        if columns is not None and len(columns) != 6:
+            raise ValueError(f"--columns {','.join(columns)!r}: {len(columns)} names; expected 6, the gyro log's "
+                             f"three ({', '.join(CHANNELS[:3])}) then the accelerometer log's "
+                             f"({', '.join(CHANNELS[3:])})")
+        halves = (None, None) if columns is None else (columns[:3], columns[3:])
+        table = pair_logs(read_log(path, halves[0], time_column, temperature_column, channels=CHANNELS[:3]),
+                          read_log(accel_log, halves[1], time_column, None, channels=CHANNELS[3:]),
+                          TIME_UNITS[time_unit] if time_unit != "samples" else 1.0 / sample_rate)
     where = f"log {str(table.path)!r}"
     n = table.channels.shape[0]
     factors = np.array([KINDS["angular_rate" if k < 3 else "acceleration"][u] for k, u in enumerate(unit_names)])
@@ -420,6 +437,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         details.append(_detail(span, table))
     schedule = Schedule(tuple(segments), procedure="imported", notes={"import": {
         "log": table.path.name,
+        "accel_log": None if accel_log is None else Path(accel_log).name,
+        "pairing": list(table.pairing),
         "columns": dict(zip(CHANNELS, [("-" if sign < 0 else "") + name for name, sign in zip(table.names, signs)])),
         "ignored_columns": list(table.ignored),
         "units": dict(zip(CHANNELS, unit_names)),
@@ -449,7 +468,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     }})
     attrs = {
         "source": "measured",
-        "imported_from": table.path.name,
+        "imported_from": (table.path.name if accel_log is None
+                          else f"{Path(path).name} (gyros), {Path(accel_log).name} (accelerometers)"),
         "plansim_version": plansim_version(),
         "units": UNITS_DESCRIPTION,
         **site,

@@ -24,6 +24,8 @@ def format_summary(result: ImportResult) -> str:
     lines.append("  channels: " + " ".join(f"{c}={'-' if c in result.reversed_channels else ''}{n}"
                                            for c, n in zip(CHANNELS, table.names)) + f" ({unit_text})"
                  + (f"; ignored: {', '.join(table.ignored)}" if table.ignored else ""))
+    for note in table.pairing:
+        lines.append(f"  two logs: {note}")
     if not table.has_header:
         lines.append(f"  no header line: columns named by position, 1 for the first (first sample on line "
                      f"{table.first_line})")

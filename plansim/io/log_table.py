@@ -12,6 +12,7 @@ Every problem with the table is a ``ValueError`` naming the file, the line and t
 from __future__ import annotations
 
 import csv
+import dataclasses
 import datetime
 import math
 import os
@@ -24,10 +25,6 @@ import numpy as np
 from plansim.io.recording_csv import _text_file, _unterminated_last_line
 from plansim.io.recording_data import CHANNELS
 from plansim.units import KINDS
-
-#: default names of the six channel columns, in the order gx gy gz ax ay az
-DEFAULT_COLUMNS = CHANNELS
-
 
 #: units of the time column -> seconds per unit ("samples": a sample counter, needs the sample rate)
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "samples": math.nan}
@@ -89,6 +86,13 @@ class LogTable:
     #: the first sample's clock time where the time column holds clock times (``time`` is then in seconds from
     #: it), else None
     clock_start: str | None = None
+    #: that first sample's clock time in seconds (from the start of its day, plus its date's day number times
+    #: 86400 s where it has a date): where two logs are paired (:func:`pair_logs`), their clocks line up on it
+    clock_zero_s: float | None = None
+    #: where the gyros and the accelerometers were logged in two files and paired (:func:`pair_logs`): what was
+    #: done, in words, for the summary and the recording's attributes; ``path``, ``lines`` and the time are the
+    #: file on whose samples the other's were paired
+    pairing: tuple[str, ...] = ()
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -176,7 +180,7 @@ def _per_channel(text: str | None, option: str, pair: str, positive: bool,
 
 
 def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, time_column: str | None = None,
-             temperature_column: str | None = None) -> LogTable:
+             temperature_column: str | None = None, channels: tuple[str, ...] = CHANNELS) -> LogTable:
     """Read the columns of a plain CSV log, checking every row.
 
     Parameters
@@ -185,14 +189,17 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         The log: UTF-8 text, optional ``#`` comment lines, a header line of column names (a commented one
         counts, as EuRoC's ``#timestamp [ns],w_RS_S_x [rad s^-1],…``), one row per sample; comma-, semicolon-
         or tab-separated (with ``;`` or tabs, a decimal comma is read: ``0,123``).
-    columns : tuple of 6 str or None
-        The column names of gx gy gz ax ay az; columns not named (and not the time or temperature column)
-        are ignored. ``None``: the columns must be named ``gx gy gz ax ay az`` and the log may hold no other.
+    columns : tuple of str or None
+        The column names of ``channels`` (gx gy gz ax ay az); columns not named (and not the time or temperature
+        column) are ignored. ``None``: the columns must be named as the channels and the log may hold no other.
     time_column, temperature_column : str or None
         Names of the time and temperature columns, if any. A time column of clock times (ISO 8601 date and time,
         ``2024-11-27 14:22:31.504`` or with ``T``, ``/`` or unpadded fields, or the time of day alone,
         ``14:22:31.504``) is read as such, in seconds from its first sample (:func:`_clock_time`); the first
         sample decides.
+    channels : tuple of str
+        The channels the log holds, in the order of ``columns``: all six, or the gyros' or the accelerometers'
+        three where the two are logged in two files (:func:`pair_logs`).
 
     Raises
     ------
@@ -205,10 +212,11 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     where = f"log {str(target)!r}"
     if not target.is_file():
         raise ValueError(f"{where} does not exist")
-    names = DEFAULT_COLUMNS if columns is None else tuple(columns)
-    if len(names) != 6:
-        raise ValueError(f"--columns {','.join(names)!r}: {len(names)} names; expected 6, in the order "
-                         f"{', '.join(CHANNELS)}")
+    names = tuple(channels) if columns is None else tuple(columns)
+    n_channels = len(channels)
+    if len(names) != n_channels:
+        raise ValueError(f"--columns {','.join(names)!r}: {len(names)} names for {where}; expected {n_channels}, "
+                         f"in the order {', '.join(channels)}")
     wanted = list(names) + [c for c in (time_column, temperature_column) if c is not None]
     repeated = sorted({name for name in wanted if wanted.count(name) > 1})
     if repeated:
@@ -285,7 +293,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         ignored = tuple(name for name in header_names if name not in wanted)
         if columns is None and ignored:
             raise ValueError(f"{where}: column {ignored[0]!r} is not expected: without --columns the log holds "
-                             f"exactly the channels {', '.join(CHANNELS)} (and the --time and --temperature-column "
+                             f"exactly the channels {', '.join(channels)} (and the --time and --temperature-column "
                              "columns if given); name the six channel columns with --columns (the other columns "
                              "are then ignored)")
         index = [header_names.index(name) for name in wanted]
@@ -312,7 +320,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 continue
             if has_header and not lines and units_row is None and len(row) == width and all(
                     row[k].strip() and not _is_number(row[k].strip(), delimiter) for k in index):
-                units_row = (line_number, tuple(row[k].strip() for k in index[:6]))  # "s,deg/s,…" under the header
+                # "s,deg/s,…" under the header
+                units_row = (line_number, tuple(row[k].strip() for k in index[:n_channels]))
                 continue
             if len(row) != width:
                 word = "more" if len(row) > width else "fewer"
@@ -321,7 +330,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                                  f"of the header (line {header_line}); every row holds one value per column"))
                 continue
             if time_column is not None:
-                text = row[index[6]].strip()
+                text = row[index[n_channels]].strip()
                 if clock is None:  # the first sample decides
                     clock = False if _is_number(text, delimiter) else (_clock_time(text) or False)
                 if clock:
@@ -339,7 +348,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                         seconds = (stamp[0] - clock[0]) * 86400.0 + stamp[1]
                     previous_stamp = seconds
                     row = list(row)
-                    row[index[6]] = repr(seconds - clock[1])  # seconds from the first sample, read as any number
+                    # seconds from the first sample, read as any number
+                    row[index[n_channels]] = repr(seconds - clock[1])
             try:
                 numbers = [float(row[k]) for k in index]
             except ValueError:
@@ -378,12 +388,12 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     if len(trailing) > MAX_TRAILING_LINES:
         raise ValueError(next(error for _, _, error in trailing if error))
     data = np.concatenate(blocks)
-    time = data[:, 6] if time_column is not None else None
+    time = data[:, n_channels] if time_column is not None else None
     temperature = data[:, -1] if temperature_column is not None else None
-    return LogTable(target, data[:, :6], names, time, time_column, temperature, temperature_column, ignored,
-                    lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
+    return LogTable(target, data[:, :n_channels], names, time, time_column, temperature, temperature_column,
+                    ignored, lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
                     has_header, units_row, tuple((line, why) for line, why, _ in trailing),
-                    clock[2] if clock else None)
+                    clock[2] if clock else None, ((clock[0] or 0) * 86400.0 + clock[1]) if clock else None)
 
 
 def _delimiter(line: str) -> str:
@@ -477,3 +487,137 @@ def _is_number(text: str, delimiter: str = ",") -> bool:
             return False
     return True
 
+
+
+#: a sample of the log the pairing keeps takes the other log's nearest sample where that lies within this many of
+#: the other log's usual periods; farther (the other log has a gap there, or has not started or has stopped), the
+#: sample is dropped, and the import reports the gap this leaves in the time column
+PAIRING_REACH = 1.0
+
+
+def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) -> LogTable:
+    """One table of the six channels from a gyro log and an accelerometer log written as two files.
+
+    Loggers that write each sensor to its own file (imu_tk's two files; phone apps such as phyphox and the Android
+    and iOS sensor loggers) stamp both with one clock, but the two sensors are not sampled together, and often not
+    at the same rate. The samples of the log with the lower rate are kept (the gyro log's at equal rates), each
+    with the other log's sample **nearest in time**, where that lies within :data:`PAIRING_REACH` of the other
+    log's usual period; samples beyond it (the other log not yet started, stopped, or in a gap) are dropped.
+    Nothing is averaged or interpolated: where the other log runs at least as fast, each of its samples is used
+    at most once (up to the clocks' jitter), so its white noise stays white with its variance per sample, which
+    the noise fit reads (an interpolation between neighbours would lower that variance by up to half, and the
+    uncertainties with it). The time between the paired samples (at most half a period of the faster log, at
+    equal rates) is reported; it does not move a static pose's means, and during a turn it delays one sensor by
+    less than a sample.
+
+    Logs without a time column are paired row by row, and must then have as many rows (imu_tk's files, sampled
+    together).
+
+    Parameters
+    ----------
+    gyro, accel : LogTable
+        The two logs as :func:`read_log` reads them, ``channels`` ``gx gy gz`` and ``ax ay az``, their time
+        columns in one unit (or both clock times).
+    seconds_per_unit : float
+        The time columns' unit in seconds (1 for clock times), for the rates and times the pairing reports.
+
+    Returns
+    -------
+    LogTable
+        The six channels on the kept samples; ``path``, ``lines``, ``time`` and the header's details are the kept
+        log's, and ``pairing`` says what was done.
+
+    Raises
+    ------
+    ValueError
+        One log has a time column and the other not, or clock times and the other numbers; a time column goes
+        backwards; logs without time columns differ in length; the logs do not overlap in time.
+    """
+    names = {id(gyro): "gyro log", id(accel): "accelerometer log"}
+    if (gyro.time is None) != (accel.time is None) or (gyro.clock_zero_s is None) != (accel.clock_zero_s is None):
+        raise ValueError(f"the gyro log {gyro.path.name!r} and the accelerometer log {accel.path.name!r} must both "
+                         "have a time column of one kind (numbers in one unit, or clock times), or neither")
+    if gyro.time is None:
+        if gyro.channels.shape[0] != accel.channels.shape[0]:
+            raise ValueError(f"the gyro log {gyro.path.name!r} has {gyro.channels.shape[0]} samples and the "
+                             f"accelerometer log {accel.path.name!r} {accel.channels.shape[0]}: without time columns "
+                             "the two are paired row by row and must be as long (give each a time column, --time)")
+        return dataclasses.replace(
+            gyro, channels=np.hstack([gyro.channels, accel.channels]), names=gyro.names + accel.names,
+            ignored=gyro.ignored + accel.ignored, decimal_comma=gyro.decimal_comma or accel.decimal_comma,
+            units_row=_paired_units_row(gyro, accel),
+            pairing=(f"gyros from {gyro.path.name}, accelerometers from {accel.path.name}: paired row by row "
+                     f"({gyro.channels.shape[0]} samples each, no time columns); lines are {gyro.path.name}'s",
+                     *_skipped_lines(accel)))
+    times = {}
+    for table in (gyro, accel):
+        t = table.time + (table.clock_zero_s or 0.0)
+        back = np.flatnonzero(np.diff(t) < 0)
+        if back.size:
+            k = int(back[0]) + 1
+            raise ValueError(f"{names[id(table)]} {str(table.path)!r}: column {table.time_column!r} goes backwards at "
+                             f"line {table.lines[k]} ({float(table.time[k - 1])!r} then {float(table.time[k])!r}); "
+                             "the two logs are paired by time, which must not go backwards")
+        steps = np.diff(t)
+        steps = steps[steps > 0]
+        if t.size < 2 or steps.size == 0:
+            raise ValueError(f"{names[id(table)]} {str(table.path)!r}: {t.size} sample(s) with distinct times; "
+                             "expected a recording")
+        times[id(table)] = (t, float(np.median(steps)))
+    period_gyro, period_accel = times[id(gyro)][1], times[id(accel)][1]
+    kept, other = (accel, gyro) if period_accel > period_gyro * (1.0 + 1e-3) else (gyro, accel)
+    t_kept, period_kept = times[id(kept)]
+    t_other, period_other = times[id(other)]
+    j = np.clip(np.searchsorted(t_other, t_kept), 1, t_other.size - 1)
+    j = np.where(np.abs(t_other[j - 1] - t_kept) <= np.abs(t_other[j] - t_kept), j - 1, j)
+    offset = t_other[j] - t_kept
+    keep = np.abs(offset) <= PAIRING_REACH * period_other
+    if np.count_nonzero(keep) < 2:
+        raise ValueError(f"the gyro log {gyro.path.name!r} ({times[id(gyro)][0][0]:.6g} to "
+                         f"{times[id(gyro)][0][-1]:.6g}) and the accelerometer log {accel.path.name!r} "
+                         f"({times[id(accel)][0][0]:.6g} to {times[id(accel)][0][-1]:.6g}, in the time column's "
+                         "unit) do not overlap in time: they must be stamped by one clock")
+    j, offset = j[keep], offset[keep]
+    reused = int(j.size - np.unique(j).size)
+    parts = {id(kept): kept.channels[keep], id(other): other.channels[j]}
+    temperature = None
+    if gyro.temperature is not None:
+        temperature = gyro.temperature[keep] if kept is gyro else gyro.temperature[j]
+    dropped = int(keep.size - np.count_nonzero(keep))
+    rates = [1.0 / (period * seconds_per_unit) for period in (period_gyro, period_accel)]
+    kind = "equal-rate" if abs(period_gyro - period_accel) <= 1e-3 * period_gyro else "slower"
+    apart = np.abs(offset) * seconds_per_unit
+    note = (f"gyros from {gyro.path.name} ({rates[0]:.6g} Hz), accelerometers from {accel.path.name} "
+            f"({rates[1]:.6g} Hz): each sample of {kept.path.name} (the {kind} log, whose lines are given) paired "
+            f"with the nearest of {other.path.name}, {np.max(apart):.3g} s apart at most "
+            f"({np.sqrt(np.mean(apart ** 2)):.3g} s RMS)")
+    extra = []
+    if dropped:
+        extra.append(f"{dropped} sample(s) of {kept.path.name} had no sample of {other.path.name} within "
+                     f"{PAIRING_REACH:g} of its periods (before it started, after it stopped or in a gap): dropped")
+    if reused:
+        extra.append(f"{reused} sample(s) of {other.path.name} paired twice (it runs slower than {kept.path.name} "
+                     "there, or the clocks jitter)")
+    return dataclasses.replace(
+        kept, channels=np.hstack([parts[id(gyro)], parts[id(accel)]]), names=gyro.names + accel.names,
+        time=kept.time[keep], temperature=temperature, temperature_column=gyro.temperature_column,
+        ignored=gyro.ignored + accel.ignored, first_line=int(kept.lines[keep][0]), lines=kept.lines[keep],
+        decimal_comma=gyro.decimal_comma or accel.decimal_comma, units_row=_paired_units_row(gyro, accel),
+        pairing=(note, *extra, *_skipped_lines(other)))
+
+
+def _paired_units_row(gyro: LogTable, accel: LogTable) -> tuple[int, tuple[str, ...]] | None:
+    """The two logs' units rows as one (the gyro log's line), where both have one."""
+    if gyro.units_row is None or accel.units_row is None:
+        return None
+    return gyro.units_row[0], gyro.units_row[1] + accel.units_row[1]
+
+
+def _skipped_lines(table: LogTable) -> tuple[str, ...]:
+    """What was skipped in the log whose lines are not given (its preamble and trailing lines), in words."""
+    notes = []
+    if table.preamble:
+        notes.append(f"{table.path.name}: {len(table.preamble)} line(s) before its header skipped")
+    if table.trailing:
+        notes.append(f"{table.path.name}: {len(table.trailing)} line(s) after its last sample skipped (not samples)")
+    return tuple(notes)
