@@ -883,12 +883,14 @@ def _write_sensor_log(path: Path, time_s: np.ndarray, values: np.ndarray, unit: 
 
 def test_gyros_and_accelerometers_logged_in_two_files_are_paired_by_time(tmp_path, capsys):
     """A phone app's two files (phyphox: Gyroscope.csv, Accelerometer.csv, 'Time (s)' and 'X (rad/s)' … in each).
-    The accelerometer log runs at twice the rate, 3 ms behind, starts 0.5 s before the gyro log and stops 0.3 s
-    before it: the gyro log is the slower, each of its samples takes the nearest accelerometer sample (the one 3 ms
-    later, not the one 4 ms earlier), and the last 0.3 s of gyro samples, with no accelerometer sample within a
-    period (5 ms) of them, are dropped. What is kept is the recording's own samples, exactly, cut into the
-    segments the one-file log gives. Then the other way round (the gyros faster, the accelerometer log kept),
-    row by row without time columns, and the errors."""
+    The accelerometer log runs at twice the rate, its samples 2.5 ms either side of the gyro's, reading the
+    accelerometers' true output plus and minus a random d; it starts 0.5 s before the gyro log and stops 0.3 s
+    before it. The gyro log is the slower: each of its samples takes the mean of the two accelerometer samples in its
+    interval (half-way to its neighbours), which is the recording's own output (d cancels: every sample of the
+    faster log is used once, none picked over another), and the last 0.3 s of gyro samples, with no accelerometer
+    sample within a period (5 ms), are dropped. The result is cut into the segments the one-file log gives. Then
+    the other way round (the gyros faster, the accelerometer log kept), row by row without time columns, and the
+    errors."""
     recording = simulated_log()
     t, x = recording.time, recording.samples
     n = t.size
@@ -899,11 +901,11 @@ def test_gyros_and_accelerometers_logged_in_two_files_are_paired_by_time(tmp_pat
     np.savetxt(one, np.column_stack([t, x])[:cut], delimiter=",", header="time,gx,gy,gz,ax,ay,az", comments="",
                fmt="%.17g")
     reference = import_log(one, time_column="time")
-    lead = np.arange(-50, 0) * 0.005  # and starts 0.5 s before it
-    t_acc = np.concatenate([lead, np.column_stack([t + 0.003, t + 0.006])[:cut].ravel()[:-1]])
-    between = x[:, 3:] + rng.normal(scale=0.01, size=(n, 3))  # the samples the gyros never see
-    acc = np.concatenate([np.tile(x[0, 3:], (50, 1)),
-                          np.stack([x[:, 3:], between], axis=1)[:cut].reshape(-1, 3)[:-1]])
+    lead = np.arange(-50, 0) * 0.005 - 0.0075  # and starts 0.5 s before it
+    d = rng.normal(scale=0.01, size=(n, 3))
+    t_acc = np.concatenate([lead, np.column_stack([t - 0.0025, t + 0.0025])[:cut].ravel()])
+    acc = np.concatenate([np.tile(x[0, 3:], (50, 1)), np.stack([x[:, 3:] + d, x[:, 3:] - d], axis=1)[:cut]
+                          .reshape(-1, 3)])
     _write_sensor_log(tmp_path / "Gyroscope.csv", t, x[:, :3], "rad/s")
     _write_sensor_log(tmp_path / "Accelerometer.csv", t_acc, acc, "m/s^2")
     out = tmp_path / "rec.nc"
@@ -911,23 +913,26 @@ def test_gyros_and_accelerometers_logged_in_two_files_are_paired_by_time(tmp_pat
                  "--out", str(out), *columns]) == 0
     text = capsys.readouterr().out
     assert "two logs: gyros from Gyroscope.csv (100 Hz), accelerometers from Accelerometer.csv (200 Hz)" in text
-    assert "each sample of Gyroscope.csv (the slower log" in text and "0.003 s apart at most (0.003 s RMS)" in text
+    assert ("each sample of Gyroscope.csv (the slower log, whose lines are given) takes the mean of the samples of "
+            "Accelerometer.csv in its interval (2 to 2, 2 on average)") in text
     assert "30 sample(s) of Gyroscope.csv had no sample of Accelerometer.csv" in text
     rec = read_recording(out)
-    np.testing.assert_array_equal(rec.samples, x[:cut])
+    np.testing.assert_array_equal(rec.samples[:, :3], x[:cut, :3])
+    np.testing.assert_allclose(rec.samples[:, 3:], x[:cut, 3:], rtol=0, atol=1e-14)
     np.testing.assert_allclose(rec.time, t[:cut], atol=1e-9)
     assert rec.attrs["imported_from"] == "Gyroscope.csv (gyros), Accelerometer.csv (accelerometers)"
     assert [(s.test, s.up) for s in rec.schedule.segments] == [
         (s.test, s.up) for s in reference.recording.schedule.segments]
     assert rec.schedule.notes["import"]["accel_log"] == "Accelerometer.csv"
 
-    # the gyros twice as fast: the accelerometer log is kept, its lines are the ones given
-    _write_sensor_log(tmp_path / "g2.csv", np.column_stack([t - 0.003, t + 0.004]).ravel(),
-                      np.stack([x[:, :3], x[:, :3] + 1e-3], axis=1).reshape(-1, 3), "rad/s")
+    # the gyros twice as fast: the accelerometer log is kept (its lines are the ones given), and each of its samples
+    # takes the mean of two gyro samples, so the angle the gyros integrate over a turn is kept whole
+    _write_sensor_log(tmp_path / "g2.csv", np.column_stack([t - 0.0025, t + 0.0025]).ravel(),
+                      np.stack([x[:, :3] + 1e-3, x[:, :3] - 1e-3], axis=1).reshape(-1, 3), "rad/s")
     _write_sensor_log(tmp_path / "a2.csv", t, x[:, 3:], "m/s^2")
     both = import_log(tmp_path / "g2.csv", accel_log=tmp_path / "a2.csv", columns=tuple(columns[1].split(",")),
                       time_column="Time (s)")
-    np.testing.assert_array_equal(both.recording.samples, x)
+    np.testing.assert_allclose(both.recording.samples, x, rtol=0, atol=1e-14)
     assert both.table.path.name == "a2.csv" and both.table.lines[0] == 2
     assert "each sample of a2.csv (the slower log" in both.table.pairing[0]
 

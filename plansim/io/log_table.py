@@ -489,9 +489,11 @@ def _is_number(text: str, delimiter: str = ",") -> bool:
 
 
 
-#: a sample of the log the pairing keeps takes the other log's nearest sample where that lies within this many of
-#: the other log's usual periods; farther (the other log has a gap there, or has not started or has stopped), the
-#: sample is dropped, and the import reports the gap this leaves in the time column
+#: a sample of the log the pairing keeps takes the mean of the other log's samples within half its own period on
+#: each side (half-way to its neighbours, at most :data:`PAIRING_REACH` of its usual period away where the kept log
+#: has a gap); where none falls there, the other log's nearest sample within this many of the other log's usual
+#: periods; farther (the other log has a gap there, or has not started or has stopped), the sample is dropped, and the
+#: import reports the gap this leaves in the time column
 PAIRING_REACH = 1.0
 
 
@@ -501,14 +503,19 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
     Loggers that write each sensor to its own file (imu_tk's two files; phone apps such as phyphox and the Android
     and iOS sensor loggers) stamp both with one clock, but the two sensors are not sampled together, and often not
     at the same rate. The samples of the log with the lower rate are kept (the gyro log's at equal rates), each
-    with the other log's sample **nearest in time**, where that lies within :data:`PAIRING_REACH` of the other
-    log's usual period; samples beyond it (the other log not yet started, stopped, or in a gap) are dropped.
-    Nothing is averaged or interpolated: where the other log runs at least as fast, each of its samples is used
-    at most once (up to the clocks' jitter), so its white noise stays white with its variance per sample, which
-    the noise fit reads (an interpolation between neighbours would lower that variance by up to half, and the
-    uncertainties with it). The time between the paired samples (at most half a period of the faster log, at
-    equal rates) is reported; it does not move a static pose's means, and during a turn it delays one sensor by
-    less than a sample.
+    with the **mean of the other log's samples in its interval**, half-way to its neighbours (at most
+    :data:`PAIRING_REACH` of its usual period on each side); where none falls in it, the other log's nearest sample
+    within :data:`PAIRING_REACH` of the other's usual period; where none is so near (the other log not yet started,
+    stopped, or in a gap), the sample is dropped.
+
+    Every sample of the faster log is used once, in one mean: the angle a gyro integrates over a turn or a move is
+    kept whole (picking one sample in m instead aliases the hand's faster motion into it: the Ferraris session's
+    gyros, so decimated to half their rate, turned the moves' fit over to a mirror solution with two scale factors
+    near −1, where the mean of each pair fits as the full rate does), and its white noise stays white, its density
+    (variance per sample × period) unchanged. An interpolation between neighbours would correlate them and lower the
+    variance the noise fit reads, with every uncertainty. The time between a kept sample and the middle of its mean
+    (at most half a period of the faster log, at equal rates) does not move a static pose's means; in a turn it
+    delays one sensor by less than a sample.
 
     Logs without a time column are paired row by row, and must then have as many rows (imu_tk's files, sampled
     together).
@@ -568,36 +575,57 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
     kept, other = (accel, gyro) if period_accel > period_gyro * (1.0 + 1e-3) else (gyro, accel)
     t_kept, period_kept = times[id(kept)]
     t_other, period_other = times[id(other)]
+    # each kept sample's interval: half-way to its neighbours, at most PAIRING_REACH of its period on each side
+    half = np.minimum(np.diff(t_kept) / 2.0, PAIRING_REACH * period_kept)
+    left = t_kept - np.r_[min(period_kept / 2.0, PAIRING_REACH * period_kept), half]
+    right = t_kept + np.r_[half, min(period_kept / 2.0, PAIRING_REACH * period_kept)]
+    first, stop = np.searchsorted(t_other, left, side="left"), np.searchsorted(t_other, right, side="left")
+    counts = stop - first
+    means, offset = np.empty((t_kept.size, 3)), np.empty(t_kept.size)
+    filled = np.flatnonzero(counts > 0)
+    if filled.size:  # sums over [first, stop) of each filled interval (disjoint and in order): add.reduceat
+        bounds = np.empty(2 * filled.size, dtype=np.intp)
+        bounds[0::2], bounds[1::2] = first[filled], stop[filled]
+        sums = np.add.reduceat(np.vstack([other.channels, np.zeros((1, 3))]), bounds, axis=0)[0::2]
+        means[filled] = sums / counts[filled, None]
+        middle = np.add.reduceat(np.r_[t_other - t_kept[0], 0.0], bounds)[0::2] / counts[filled]
+        offset[filled] = middle - (t_kept[filled] - t_kept[0])
+    # an interval no sample of the other log falls in: its nearest sample, if within PAIRING_REACH of its period
     j = np.clip(np.searchsorted(t_other, t_kept), 1, t_other.size - 1)
     j = np.where(np.abs(t_other[j - 1] - t_kept) <= np.abs(t_other[j] - t_kept), j - 1, j)
-    offset = t_other[j] - t_kept
-    keep = np.abs(offset) <= PAIRING_REACH * period_other
+    empty = counts == 0
+    means[empty] = other.channels[j[empty]]
+    offset[empty] = t_other[j[empty]] - t_kept[empty]
+    keep = ~empty | (np.abs(offset) <= PAIRING_REACH * period_other)
     if np.count_nonzero(keep) < 2:
         raise ValueError(f"the gyro log {gyro.path.name!r} ({times[id(gyro)][0][0]:.6g} to "
                          f"{times[id(gyro)][0][-1]:.6g}) and the accelerometer log {accel.path.name!r} "
                          f"({times[id(accel)][0][0]:.6g} to {times[id(accel)][0][-1]:.6g}, in the time column's "
                          "unit) do not overlap in time: they must be stamped by one clock")
-    j, offset = j[keep], offset[keep]
-    reused = int(j.size - np.unique(j).size)
-    parts = {id(kept): kept.channels[keep], id(other): other.channels[j]}
+    parts = {id(kept): kept.channels[keep], id(other): means[keep]}
     temperature = None
     if gyro.temperature is not None:
-        temperature = gyro.temperature[keep] if kept is gyro else gyro.temperature[j]
-    dropped = int(keep.size - np.count_nonzero(keep))
+        if kept is gyro:
+            temperature = gyro.temperature[keep]
+        else:
+            temperature = gyro.temperature[j]  # the nearest gyro sample's: a temperature changes slowly
     rates = [1.0 / (period * seconds_per_unit) for period in (period_gyro, period_accel)]
     kind = "equal-rate" if abs(period_gyro - period_accel) <= 1e-3 * period_gyro else "slower"
-    apart = np.abs(offset) * seconds_per_unit
+    apart = np.abs(offset[keep]) * seconds_per_unit
+    used = counts[keep & ~empty]
     note = (f"gyros from {gyro.path.name} ({rates[0]:.6g} Hz), accelerometers from {accel.path.name} "
-            f"({rates[1]:.6g} Hz): each sample of {kept.path.name} (the {kind} log, whose lines are given) paired "
-            f"with the nearest of {other.path.name}, {np.max(apart):.3g} s apart at most "
-            f"({np.sqrt(np.mean(apart ** 2)):.3g} s RMS)")
+            f"({rates[1]:.6g} Hz): each sample of {kept.path.name} (the {kind} log, whose lines are given) takes the "
+            f"mean of the samples of {other.path.name} in its interval ({int(used.min()) if used.size else 0} to "
+            f"{int(used.max()) if used.size else 0}, {np.mean(used) if used.size else 0:.3g} on average), their "
+            f"middle {np.max(apart):.3g} s from it at most ({np.sqrt(np.mean(apart ** 2)):.3g} s RMS)")
     extra = []
+    dropped = int(keep.size - np.count_nonzero(keep))
+    if np.any(empty & keep):
+        extra.append(f"{int(np.count_nonzero(empty & keep))} sample(s) of {kept.path.name} with no sample of "
+                     f"{other.path.name} in their interval took its nearest")
     if dropped:
         extra.append(f"{dropped} sample(s) of {kept.path.name} had no sample of {other.path.name} within "
                      f"{PAIRING_REACH:g} of its periods (before it started, after it stopped or in a gap): dropped")
-    if reused:
-        extra.append(f"{reused} sample(s) of {other.path.name} paired twice (it runs slower than {kept.path.name} "
-                     "there, or the clocks jitter)")
     return dataclasses.replace(
         kept, channels=np.hstack([parts[id(gyro)], parts[id(accel)]]), names=gyro.names + accel.names,
         time=kept.time[keep], temperature=temperature, temperature_column=gyro.temperature_column,
