@@ -962,3 +962,47 @@ def test_gyros_and_accelerometers_logged_in_two_files_are_paired_by_time(tmp_pat
     with pytest.raises(ValueError, match="5 names; expected 6, the gyro log's three"):
         import_log(tmp_path / "Gyroscope.csv", accel_log=tmp_path / "a2.csv", columns=("a", "b", "c", "d", "e"),
                    time_column="Time (s)")
+
+
+def test_two_sensors_sampled_apart_in_rows_of_their_own_in_one_file(tmp_path, capsys):
+    """One file, each sensor's samples in rows of their own as they came, the other sensor's three columns left
+    empty (a logger that writes every sample the moment it arrives): the rows are split by sensor and paired as two
+    files are (test above). The gyros at 100 Hz, the accelerometers at 200 Hz 2.5 ms either side reading the output
+    plus and minus d: the recording's own samples come back. A row with one channel of a triad empty is not such a
+    row, and is refused naming its line; without a time column the rows cannot be paired."""
+    recording = simulated_log()
+    t, x = recording.time, recording.samples
+    n = t.size
+    d = np.random.default_rng(6).normal(scale=0.01, size=(n, 3))
+    def text(values):
+        return ",".join("" if math.isnan(v) else repr(float(v)) for v in values)
+
+    blank = np.full(3, math.nan)
+    rows = [(float(tk), text([tk, *g, *blank])) for tk, g in zip(t, x[:, :3])]
+    for sign, offset in ((1.0, -0.0025), (-1.0, 0.0025)):
+        rows += [(float(tk + offset), text([tk + offset, *blank, *a])) for tk, a in zip(t, x[:, 3:] + sign * d)]
+    rows.sort()
+    log = tmp_path / "interleaved.csv"
+    log.write_text("time,gx,gy,gz,ax,ay,az\n" + "\n".join(text for _, text in rows) + "\n")
+    out = tmp_path / "rec.nc"
+    assert main(["import", str(log), "--time", "time", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert ("two logs: gyros from interleaved.csv (100 Hz), accelerometers from interleaved.csv (200 Hz): each sample "
+            "of interleaved.csv (the slower log") in printed and "(2 to 2, 2 on average)" in printed
+    rec = read_recording(out)
+    np.testing.assert_array_equal(rec.samples[:, :3], x[:, :3])
+    np.testing.assert_allclose(rec.samples[:, 3:], x[:, 3:], rtol=0, atol=1e-14)
+    # the gyro rows' lines are the ones given: the first is line 3 (line 2 is an accelerometer's, 2.5 ms before it)
+    lines = log.read_text().splitlines()
+    assert ",,,," in lines[1] and lines[2].endswith(",,,")
+    assert import_log(log, time_column="time").table.lines[:3].tolist() == [3, 6, 9]
+
+    broken = lines[:40] + [lines[40].rsplit(",", 1)[0] + ","] + lines[41:]
+    assert broken[40].endswith(",") and not broken[40].endswith(",,,")  # az left empty, ax and ay not
+    (tmp_path / "broken.csv").write_text("\n".join(broken) + "\n")
+    with pytest.raises(ValueError, match="column '(ax|ay|az|gx|gy|gz)' is '' at line 41"):
+        import_log(tmp_path / "broken.csv", time_column="time")
+    (tmp_path / "no_time.csv").write_text("gx,gy,gz,ax,ay,az\n" + "\n".join(line.split(",", 1)[1] for line in
+                                                                          lines[1:]) + "\n")
+    with pytest.raises(ValueError, match="paired by time, so the log needs its time column"):
+        import_log(tmp_path / "no_time.csv", sample_rate=300.0)

@@ -47,6 +47,7 @@ from plansim.io.log_table import (
     parse_scale,
     parse_units,
     read_log,
+    split_interleaved,
 )
 from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
 from plansim.schedule.segments import Schedule, Segment
@@ -235,8 +236,11 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if columns is not None:
         signs = np.array([-1.0 if str(name).startswith("-") and len(str(name)) > 1 else 1.0 for name in columns])
         columns = tuple(str(name)[1:].strip() if sign < 0 else name for name, sign in zip(columns, signs))
+    seconds_per_unit = TIME_UNITS[time_unit] if time_unit != "samples" else 1.0 / sample_rate
     if accel_log is None:
         table = read_log(path, columns, time_column, temperature_column)
+        if table.interleaved:  # the gyros' and the accelerometers' samples in rows of their own: paired by time
+            table = pair_logs(*split_interleaved(table), seconds_per_unit)
     else:
         if columns is not None and len(columns) != 6:
             raise ValueError(f"--columns {','.join(columns)!r}: {len(columns)} names; expected 6, the gyro log's "
@@ -245,7 +249,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         halves = (None, None) if columns is None else (columns[:3], columns[3:])
         table = pair_logs(read_log(path, halves[0], time_column, temperature_column, channels=CHANNELS[:3]),
                           read_log(accel_log, halves[1], time_column, None, channels=CHANNELS[3:]),
-                          TIME_UNITS[time_unit] if time_unit != "samples" else 1.0 / sample_rate)
+                          seconds_per_unit)
     where = f"log {str(table.path)!r}"
     n = table.channels.shape[0]
     factors = np.array([KINDS["angular_rate" if k < 3 else "acceleration"][u] for k, u in enumerate(unit_names)])

@@ -93,6 +93,9 @@ class LogTable:
     #: done, in words, for the summary and the recording's attributes; ``path``, ``lines`` and the time are the
     #: file on whose samples the other's were paired
     pairing: tuple[str, ...] = ()
+    #: some rows hold only the gyros' three channels or only the accelerometers' (the other three empty, NaN in
+    #: ``channels``): two sensors sampled apart, logged in one file (:func:`split_interleaved`)
+    interleaved: bool = False
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -308,6 +311,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         day = 0  # whole days a time of day alone has passed midnight
         previous_stamp = 0.0
         units_row = None
+        interleaved = False
         trailing: list[tuple[int, str, str]] = []  # (line, why, the error it is if a sample follows)
         for row in _rows(fh, delimiter):
             line_number += 1
@@ -350,6 +354,16 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                     row = list(row)
                     # seconds from the first sample, read as any number
                     row[index[n_channels]] = repr(seconds - clock[1])
+            # a row holding one sensor's three channels, the other's left empty: a log of two sensors sampled apart
+            # in one file (every sample in a row of its own, as it came); read as NaN, paired by split_interleaved
+            blank = tuple(j for j in range(n_channels) if not row[index[j]].strip())
+            if blank and n_channels == 6 and blank in ((0, 1, 2), (3, 4, 5)):
+                row = list(row)
+                for j in blank:
+                    row[index[j]] = "nan"
+                interleaved = True
+            else:
+                blank = ()
             try:
                 numbers = [float(row[k]) for k in index]
             except ValueError:
@@ -369,8 +383,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 continue
             if trailing:  # a line that is not a sample, followed by samples: the log is broken there
                 raise ValueError(trailing[0][2])
-            if not all(map(math.isfinite, numbers)):
-                j = next(j for j, v in enumerate(numbers) if not math.isfinite(v))
+            if not all(math.isfinite(v) or j in blank for j, v in enumerate(numbers)):
+                j = next(j for j, v in enumerate(numbers) if not math.isfinite(v) and j not in blank)
                 raise ValueError(f"{where}: column {wanted[j]!r} is {row[index[j]].strip()!r} at line {line_number}; "
                                  "every value must be a finite number (a sample lost by the logger? cut the log before "
                                  "or after it)")
@@ -393,7 +407,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     return LogTable(target, data[:, :n_channels], names, time, time_column, temperature, temperature_column,
                     ignored, lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
                     has_header, units_row, tuple((line, why) for line, why, _ in trailing),
-                    clock[2] if clock else None, ((clock[0] or 0) * 86400.0 + clock[1]) if clock else None)
+                    clock[2] if clock else None, ((clock[0] or 0) * 86400.0 + clock[1]) if clock else None,
+                    interleaved=interleaved)
 
 
 def _delimiter(line: str) -> str:
@@ -632,6 +647,34 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
         ignored=gyro.ignored + accel.ignored, first_line=int(kept.lines[keep][0]), lines=kept.lines[keep],
         decimal_comma=gyro.decimal_comma or accel.decimal_comma, units_row=_paired_units_row(gyro, accel),
         pairing=(note, *extra, *_skipped_lines(other)))
+
+
+def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
+    """The gyro and the accelerometer rows of a log that writes each sensor's samples in rows of their own, the
+    other sensor's three columns left empty (``table.interleaved``), as two tables for :func:`pair_logs`. A row
+    holding both is in both.
+
+    Raises
+    ------
+    ValueError
+        The log has no time column (the rows cannot be paired without one), or one sensor has fewer than two rows.
+    """
+    where = f"log {str(table.path)!r}"
+    if table.time is None:
+        raise ValueError(f"{where}: some rows hold only the gyros or only the accelerometers (the other three columns "
+                         "empty): the two are paired by time, so the log needs its time column (--time)")
+    halves = []
+    for part, sensor in ((slice(0, 3), "gyro"), (slice(3, 6), "accelerometer")):
+        rows = np.flatnonzero(np.all(np.isfinite(table.channels[:, part]), axis=1))
+        if rows.size < 2:
+            raise ValueError(f"{where}: {rows.size} row(s) hold the {sensor}s' values; some rows hold only one "
+                             "sensor's (the other three columns empty), and each sensor needs its samples")
+        halves.append(dataclasses.replace(
+            table, channels=table.channels[rows, part], names=table.names[part], time=table.time[rows],
+            temperature=None if table.temperature is None else table.temperature[rows], lines=table.lines[rows],
+            first_line=int(table.lines[rows[0]]), interleaved=False))
+    # one file: what was skipped in it is reported once, with the kept half
+    return halves[0], dataclasses.replace(halves[1], preamble=(), trailing=())
 
 
 def _paired_units_row(gyro: LogTable, accel: LogTable) -> tuple[int, tuple[str, ...]] | None:
