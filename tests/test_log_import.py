@@ -32,6 +32,7 @@ from plansim.io.recording import nominal_time, read_recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.runner import simulate_and_record
 from plansim.schedule import Schedule, Segment
+from plansim.units import STANDARD_GRAVITY
 
 REAL = Path(__file__).resolve().parents[2] / "shared/data/real/imucal-ferraris"
 CHANNEL_COLUMNS = "gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z"
@@ -1006,3 +1007,40 @@ def test_two_sensors_sampled_apart_in_rows_of_their_own_in_one_file(tmp_path, ca
                                                                           lines[1:]) + "\n")
     with pytest.raises(ValueError, match="paired by time, so the log needs its time column"):
         import_log(tmp_path / "no_time.csv", sample_rate=300.0)
+
+
+def test_units_the_log_writes_are_read_and_checked(tmp_path, capsys):
+    """WitMotion writes 'AsX(°/s)' and 'AccX(g)', phyphox 'X (rad/s)', EuRoC 'w_RS_S_x [rad s^-1]': without --units
+    those units are taken (the log in deg/s and g imports as the SI log does), and with --units that differ the
+    channels are read in --units under a named warning, naming each channel. A row of units is read the same way;
+    a partial declaration (one channel without a unit) is not guessed from."""
+    t, x = synthetic_log()
+    write_synthetic(tmp_path / "si.csv", t, x)
+    reference = import_log(tmp_path / "si.csv", time_column="time")
+    wit = np.column_stack([np.degrees(x[:, :3]), x[:, 3:] / STANDARD_GRAVITY])
+    names = ("AsX(°/s)", "AsY(°/s)", "AsZ(°/s)", "AccX(g)", "AccY(g)", "AccZ(g)")
+    write_synthetic(tmp_path / "wit.csv", t, wit, names=names)
+    columns = ["--columns", ",".join(names), "--time", "time"]
+    assert main(["import", str(tmp_path / "wit.csv"), "--out", str(tmp_path / "wit.nc"), *columns]) == 0
+    printed = capsys.readouterr().out
+    assert "(deg/s, g, as the log's header writes them)" in printed
+    rec = read_recording(tmp_path / "wit.nc")
+    np.testing.assert_allclose(rec.samples, reference.recording.samples, rtol=1e-10, atol=1e-15)  # printed to 12 digits
+    assert rec.schedule.notes["import"]["units_source"] == "the log's header"
+    # --units that differ: read in --units, and each differing channel named
+    result = import_log(tmp_path / "wit.csv", columns=names, time_column="time", units="rad/s,g")
+    warning = next(w for w in result.warnings if w.name == "units_disagree")
+    assert "header writes gx in deg/s, gy in deg/s, gz in deg/s; --units says rad/s, rad/s, rad/s" in warning.message
+    np.testing.assert_allclose(result.recording.samples[:, :3], wit[:, :3], rtol=1e-10)
+    # a row of units under a plain header: read as the units
+    text = (tmp_path / "wit.csv").read_text().splitlines()
+    plain = ["time,gx,gy,gz,ax,ay,az", "s,deg/s,deg/s,deg/s,g,g,g", *text[1:]]
+    (tmp_path / "row.csv").write_text("\n".join(plain) + "\n")
+    result = import_log(tmp_path / "row.csv", time_column="time")
+    np.testing.assert_allclose(result.recording.samples, reference.recording.samples, rtol=1e-10, atol=1e-15)
+    assert "read as the channels' units" in next(w.message for w in result.warnings if w.name == "units_row")
+    # one name without a unit: nothing is taken (the SI default), and the 1 g check refuses the log in g
+    partial = ("AsX(°/s)", "AsY(°/s)", "AsZ", "AccX(g)", "AccY(g)", "AccZ(g)")
+    write_synthetic(tmp_path / "partial.csv", t, wit, names=partial)
+    with pytest.raises(ValueError, match="1 g"):
+        import_log(tmp_path / "partial.csv", columns=partial, time_column="time")

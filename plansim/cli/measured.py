@@ -65,7 +65,8 @@ def _add_import_command(sub) -> None:
                         "whose sign the log has the other way (gyr_x,-gyr_y,…)")
     p.add_argument("--units", default=None,
                    help="the channels' units: gyro,accelerometer (e.g. deg/s,m/s^2) or one per channel; with "
-                        "--scale, the unit the counts are per; default rad/s,m/s^2")
+                        "--scale, the unit the counts are per; default: the units the log writes for every channel "
+                        "(a row of units, or its names' ends: 'X (rad/s)'), else rad/s,m/s^2")
     p.add_argument("--scale", default=None,
                    help="counts per unit, gyro,accelerometer or one per channel (e.g. 16.4,2048 with --units deg/s,g)")
     p.add_argument("--offset", default=None,

@@ -41,6 +41,7 @@ from plansim.estimate.segmentation import (
 from plansim.io.log_table import (
     TIME_UNITS,
     LogTable,
+    header_units,
     pair_logs,
     parse_full_scale,
     parse_offset,
@@ -82,7 +83,8 @@ FULL_SCALE_EXCEEDED = 0.02
 
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
-                 "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines")
+                 "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
+                 "units_disagree")
 
 
 #: up to this many glitch rows are listed by line in the warning
@@ -252,6 +254,19 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                           seconds_per_unit)
     where = f"log {str(table.path)!r}"
     n = table.channels.shape[0]
+    warnings: list[LogWarning] = []
+    # the units the log writes for its channels (a row of units, or each name's end: "X (rad/s)"): taken where
+    # --units is not given, compared with it where it is; a log in counts (--scale) is read in --units
+    declared = header_units(table.names, table.units_row) if counts_per_unit is None else None
+    units_source = "--units" if units is not None else "default (rad/s, m/s^2)"
+    if declared is not None and units is None:
+        unit_names, units_source = declared[0], f"the log's {declared[1]}"
+    elif declared is not None and declared[0] != unit_names:
+        differ = [c for c in range(6) if declared[0][c] != unit_names[c]]
+        warnings.append(LogWarning("units_disagree", "the log's " + declared[1] + " writes " + ", ".join(
+            f"{CHANNELS[c]} in {declared[0][c]}" for c in differ) + "; --units says " + ", ".join(
+            f"{unit_names[c]}" for c in differ) + ": the channels are read in --units; check which is right (a gyro "
+            "read in deg/s as rad/s turns 57 times too far)"))
     factors = np.array([KINDS["angular_rate" if k < 3 else "acceleration"][u] for k, u in enumerate(unit_names)])
     divisors = (np.ones(6) if counts_per_unit is None else np.array(counts_per_unit)) * signs
     offsets = np.zeros(6) if zero_counts is None else np.array(zero_counts)
@@ -266,13 +281,14 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                  f"its full scale of {rails[c]:g} {unit_names[c]}; expected the range the sensor "
                                  "reads (in --units), e.g. 2000,16 with --units deg/s,g")
 
-    warnings: list[LogWarning] = []
     if table.units_row is not None:
         line, entries = table.units_row
+        read = ("read as the channels' units" if units_source == "the log's row of units"
+                else "they agree with --units" if declared is not None and declared[0] == unit_names
+                else f"the channels are read in {', '.join(dict.fromkeys(unit_names))} ({units_source}): check that "
+                     "they agree")
         warnings.append(LogWarning("units_row", f"line {line}, under the header, reads {', '.join(entries)} for "
-                                                f"{', '.join(CHANNELS)}: a row of units, skipped, not read; the "
-                                                f"channels are read in {', '.join(dict.fromkeys(unit_names))} "
-                                                "(--units): check that they agree"))
+                                                f"{', '.join(CHANNELS)}: a row of units, skipped as a sample; {read}"))
     if table.trailing:
         shown = "; ".join(f"line {line}: {why}" for line, why in table.trailing[:4])
         warnings.append(LogWarning("trailing_lines", f"{len(table.trailing)} line(s) after the last sample (line "
@@ -446,6 +462,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "columns": dict(zip(CHANNELS, [("-" if sign < 0 else "") + name for name, sign in zip(table.names, signs)])),
         "ignored_columns": list(table.ignored),
         "units": dict(zip(CHANNELS, unit_names)),
+        "units_source": units_source,
         "counts_per_unit": None if counts_per_unit is None else dict(zip(CHANNELS, counts_per_unit)),
         "zero_offset_counts": None if zero_counts is None else dict(zip(CHANNELS, zero_counts)),
         "full_scale": None if rails is None else dict(zip(CHANNELS, rails)),

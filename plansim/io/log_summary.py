@@ -17,6 +17,9 @@ def format_summary(result: ImportResult) -> str:
     rec = result.recording
     lines = [f"plansim import {table.path.name}: {rec.samples.shape[0]} samples"]
     unit_text = ", ".join(dict.fromkeys(result.units))
+    source = rec.schedule.notes.get("import", {}).get("units_source", "")
+    if source.startswith("the log's"):
+        unit_text += f", as {source} writes them"
     if result.scale is not None:
         unit_text = "counts: " + ", ".join(f"{c:g}/{u}" for c, u in zip(result.scale, result.units))
         if result.offset is not None:

@@ -130,9 +130,45 @@ def parse_units(text: str | None) -> tuple[str, ...]:
 
 
 #: other spellings of the units of :data:`plansim.units.KINDS` that logs and data sheets use (``--units``)
+#: (not "rps": revolutions per second to some, radians per second to others)
 UNIT_SPELLINGS = {"dps": "deg/s", "deg/sec": "deg/s", "°/s": "deg/s", "degree/s": "deg/s", "degrees/s": "deg/s",
-                  "rad/sec": "rad/s", "rps": "rad/s", "°/h": "deg/h", "dph": "deg/h", "m/s2": "m/s^2",
-                  "m/s²": "m/s^2", "m/s/s": "m/s^2", "m/sec^2": "m/s^2", "µg": "ug", "μg": "ug"}
+                  "rad/sec": "rad/s", "°/h": "deg/h", "dph": "deg/h", "m/s2": "m/s^2",
+                  "m/s²": "m/s^2", "m/s/s": "m/s^2", "m/sec^2": "m/s^2", "µg": "ug", "μg": "ug",
+                  # as headers write them: EuRoC and Kalibr's "rad s^-1", "m s^-2"
+                  "rad s^-1": "rad/s", "rad s-1": "rad/s", "rad·s⁻¹": "rad/s", "deg s^-1": "deg/s",
+                  "m s^-2": "m/s^2", "m s-2": "m/s^2", "m·s⁻²": "m/s^2"}
+
+
+#: a unit written at the end of a column's name, in brackets or parentheses: "X (rad/s)" (phyphox),
+#: "w_RS_S_x [rad s^-1]" (EuRoC), "AsX(°/s)" and "AccX(g)" (WitMotion)
+_UNIT_IN_NAME = re.compile(r"[(\[]\s*([^()\[\]]+?)\s*[)\]]\s*$")
+
+
+def header_units(names: tuple[str, ...], units_row: tuple[int, tuple[str, ...]] | None = None
+                 ) -> tuple[tuple[str, ...], str] | None:
+    """The six channels' units as the log writes them, and where: ``(units, "row of units")`` from a row of units
+    under the header, else ``(units, "header")`` from the end of each channel column's name in brackets or
+    parentheses (``X (rad/s)``, ``w_RS_S_x [rad s^-1]``, ``AsX(°/s)``), in the spellings :data:`UNIT_SPELLINGS`
+    and :data:`plansim.units.KINDS` know. None where any channel's is missing or is not a unit of its kind (a gyro's
+    angular rate, an accelerometer's acceleration): a partial or unknown declaration is not guessed from.
+    """
+    sources = []
+    if units_row is not None:
+        sources.append(([entry.strip().strip("[]()").strip() for entry in units_row[1]], "row of units"))
+    found = [_UNIT_IN_NAME.search(name) for name in names]
+    if all(found):
+        sources.append(([match.group(1) for match in found], "header"))
+    for entries, where in sources:
+        units = []
+        for k, entry in enumerate(entries):
+            unit = UNIT_SPELLINGS.get(entry, UNIT_SPELLINGS.get(entry.lower(), entry))
+            if unit not in KINDS["angular_rate" if k < 3 else "acceleration"]:
+                break
+            units.append(unit)
+        else:
+            if len(units) == 6:
+                return tuple(units), where
+    return None
 
 
 #: units that are a scaled unit of KINDS: how to read them (``--units``' error)
