@@ -3,7 +3,8 @@
 The examples are run in this process (``runpy``, with their command-line arguments), small: the hand-held coverage
 over 2 sessions, the bandwidth without its optional Monte Carlo but for 5 trials. What they print is checked
 against what each claims, not against stored output: the hidden effect is named; the headerless log's poses
-and moves are found and its gyro scale factors land within 5 u of the truth; the data sheet the data contradict
+and moves are found and its gyro scale factors land within 5 u of the truth, and so do the phone logs' gyro and
+accelerometer scale factors once paired; the data sheet the data contradict
 is Ba's, and restated it holds, with Bax where the data alone had put it; the fitted curve reads the bandwidth to
 1e-9 Hz where the chord is off by more than 0.5 Hz.
 """
@@ -47,6 +48,16 @@ def test_headerless_log_to_gyro_scale_factors(capsys):
     assert "found: 24 poses, 23 moves, 0 turns" in out
     rows = re.findall(r"(Kg\w\w): ([\d.]+) ± ([\d.]+) \(truth ([\d.]+)\)", out)
     assert len(rows) == 3
+    for _name, estimate, u, truth in rows:
+        assert abs(float(estimate) - float(truth)) <= 5 * float(u)
+
+
+def test_phone_logs_are_paired_and_calibrated(capsys):
+    out = run_example("phone_logs.py", capsys=capsys)
+    assert "each sample of Gyroscope.csv (the slower log, whose lines are given) takes the mean of the samples" in out
+    assert "found: 24 poses, 23 moves, 0 turns; units rad/s, m/s^2 from the header" in out
+    rows = re.findall(r"(K[ga]\w\w): ([\d.]+) ± ([\d.]+) \(truth ([\d.]+)\)", out)
+    assert len(rows) == 6
     for _name, estimate, u, truth in rows:
         assert abs(float(estimate) - float(truth)) <= 5 * float(u)
 
