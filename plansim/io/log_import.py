@@ -38,17 +38,16 @@ from plansim.estimate.segmentation import (
     analyse_time,
     segment_log,
 )
+from plansim.io.log_pairing import pair_logs, split_interleaved
 from plansim.io.log_table import (
     TIME_UNITS,
     LogTable,
     header_units,
-    pair_logs,
     parse_full_scale,
     parse_offset,
     parse_scale,
     parse_units,
     read_log,
-    split_interleaved,
 )
 from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
 from plansim.schedule.segments import Schedule, Segment
@@ -186,7 +185,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         ``--accel-log``: where the accelerometers were logged in a file of their own, that file; ``path`` then
         holds the gyros, the first three ``columns`` are ``path``'s and the last three this file's, the time
         column (same name and unit) is in both and ``temperature_column`` in ``path``. The two are paired by
-        :func:`plansim.io.log_table.pair_logs`: each sample of the slower, with the other's nearest in time.
+        :func:`plansim.io.log_pairing.pair_logs`: each sample of the slower, with the mean of the other's samples in
+        its interval.
 
     Raises
     ------

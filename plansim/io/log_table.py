@@ -12,7 +12,6 @@ Every problem with the table is a ``ValueError`` naming the file, the line and t
 from __future__ import annotations
 
 import csv
-import dataclasses
 import datetime
 import math
 import os
@@ -87,14 +86,15 @@ class LogTable:
     #: it), else None
     clock_start: str | None = None
     #: that first sample's clock time in seconds (from the start of its day, plus its date's day number times
-    #: 86400 s where it has a date): where two logs are paired (:func:`pair_logs`), their clocks line up on it
+    #: 86400 s where it has a date): where two logs are paired (:func:`plansim.io.log_pairing.pair_logs`), their
+    #: clocks line up on it
     clock_zero_s: float | None = None
-    #: where the gyros and the accelerometers were logged in two files and paired (:func:`pair_logs`): what was
-    #: done, in words, for the summary and the recording's attributes; ``path``, ``lines`` and the time are the
-    #: file on whose samples the other's were paired
+    #: where the gyros and the accelerometers were logged in two files and paired
+    #: (:func:`plansim.io.log_pairing.pair_logs`): what was done, in words, for the summary and the recording's
+    #: attributes; ``path``, ``lines`` and the time are the file on whose samples the other's were paired
     pairing: tuple[str, ...] = ()
     #: some rows hold only the gyros' three channels or only the accelerometers' (the other three empty, NaN in
-    #: ``channels``): two sensors sampled apart, logged in one file (:func:`split_interleaved`)
+    #: ``channels``): two sensors sampled apart, logged in one file (:func:`plansim.io.log_pairing.split_interleaved`)
     interleaved: bool = False
 
 
@@ -238,7 +238,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         sample decides.
     channels : tuple of str
         The channels the log holds, in the order of ``columns``: all six, or the gyros' or the accelerometers'
-        three where the two are logged in two files (:func:`pair_logs`).
+        three where the two are logged in two files (:func:`plansim.io.log_pairing.pair_logs`).
 
     Raises
     ------
@@ -537,194 +537,3 @@ def _is_number(text: str, delimiter: str = ",") -> bool:
         except ValueError:
             return False
     return True
-
-
-
-#: a sample of the log the pairing keeps takes the mean of the other log's samples within half its own period on
-#: each side (half-way to its neighbours, at most :data:`PAIRING_REACH` of its usual period away where the kept log
-#: has a gap); where none falls there, the other log's nearest sample within this many of the other log's usual
-#: periods; farther (the other log has a gap there, or has not started or has stopped), the sample is dropped, and the
-#: import reports the gap this leaves in the time column
-PAIRING_REACH = 1.0
-
-
-def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) -> LogTable:
-    """One table of the six channels from a gyro log and an accelerometer log written as two files.
-
-    Loggers that write each sensor to its own file (imu_tk's two files; phone apps such as phyphox and the Android
-    and iOS sensor loggers) stamp both with one clock, but the two sensors are not sampled together, and often not
-    at the same rate. The samples of the log with the lower rate are kept (the gyro log's at equal rates), each
-    with the **mean of the other log's samples in its interval**, half-way to its neighbours (at most
-    :data:`PAIRING_REACH` of its usual period on each side); where none falls in it, the other log's nearest sample
-    within :data:`PAIRING_REACH` of the other's usual period; where none is so near (the other log not yet started,
-    stopped, or in a gap), the sample is dropped.
-
-    Every sample of the faster log is used once, in one mean: the angle a gyro integrates over a turn or a move is
-    kept whole (picking one sample in m instead aliases the hand's faster motion into it: the Ferraris session's
-    gyros, so decimated to half their rate, turned the moves' fit over to a mirror solution with two scale factors
-    near −1, where the mean of each pair fits as the full rate does), and its white noise stays white, its density
-    (variance per sample × period) unchanged. An interpolation between neighbours would correlate them and lower the
-    variance the noise fit reads, with every uncertainty. The time between a kept sample and the middle of its mean
-    (at most half a period of the faster log, at equal rates) does not move a static pose's means; in a turn it
-    delays one sensor by less than a sample.
-
-    Logs without a time column are paired row by row, and must then have as many rows (imu_tk's files, sampled
-    together).
-
-    Parameters
-    ----------
-    gyro, accel : LogTable
-        The two logs as :func:`read_log` reads them, ``channels`` ``gx gy gz`` and ``ax ay az``, their time
-        columns in one unit (or both clock times).
-    seconds_per_unit : float
-        The time columns' unit in seconds (1 for clock times), for the rates and times the pairing reports.
-
-    Returns
-    -------
-    LogTable
-        The six channels on the kept samples; ``path``, ``lines``, ``time`` and the header's details are the kept
-        log's, and ``pairing`` says what was done.
-
-    Raises
-    ------
-    ValueError
-        One log has a time column and the other not, or clock times and the other numbers; a time column goes
-        backwards; logs without time columns differ in length; the logs do not overlap in time.
-    """
-    names = {id(gyro): "gyro log", id(accel): "accelerometer log"}
-    if (gyro.time is None) != (accel.time is None) or (gyro.clock_zero_s is None) != (accel.clock_zero_s is None):
-        raise ValueError(f"the gyro log {gyro.path.name!r} and the accelerometer log {accel.path.name!r} must both "
-                         "have a time column of one kind (numbers in one unit, or clock times), or neither")
-    if gyro.time is None:
-        if gyro.channels.shape[0] != accel.channels.shape[0]:
-            raise ValueError(f"the gyro log {gyro.path.name!r} has {gyro.channels.shape[0]} samples and the "
-                             f"accelerometer log {accel.path.name!r} {accel.channels.shape[0]}: without time columns "
-                             "the two are paired row by row and must be as long (give each a time column, --time)")
-        return dataclasses.replace(
-            gyro, channels=np.hstack([gyro.channels, accel.channels]), names=gyro.names + accel.names,
-            ignored=gyro.ignored + accel.ignored, decimal_comma=gyro.decimal_comma or accel.decimal_comma,
-            units_row=_paired_units_row(gyro, accel),
-            pairing=(f"gyros from {gyro.path.name}, accelerometers from {accel.path.name}: paired row by row "
-                     f"({gyro.channels.shape[0]} samples each, no time columns); lines are {gyro.path.name}'s",
-                     *_skipped_lines(accel)))
-    times = {}
-    for table in (gyro, accel):
-        t = table.time + (table.clock_zero_s or 0.0)
-        back = np.flatnonzero(np.diff(t) < 0)
-        if back.size:
-            k = int(back[0]) + 1
-            raise ValueError(f"{names[id(table)]} {str(table.path)!r}: column {table.time_column!r} goes backwards at "
-                             f"line {table.lines[k]} ({float(table.time[k - 1])!r} then {float(table.time[k])!r}); "
-                             "the two logs are paired by time, which must not go backwards")
-        steps = np.diff(t)
-        steps = steps[steps > 0]
-        if t.size < 2 or steps.size == 0:
-            raise ValueError(f"{names[id(table)]} {str(table.path)!r}: {t.size} sample(s) with distinct times; "
-                             "expected a recording")
-        times[id(table)] = (t, float(np.median(steps)))
-    period_gyro, period_accel = times[id(gyro)][1], times[id(accel)][1]
-    kept, other = (accel, gyro) if period_accel > period_gyro * (1.0 + 1e-3) else (gyro, accel)
-    t_kept, period_kept = times[id(kept)]
-    t_other, period_other = times[id(other)]
-    # each kept sample's interval: half-way to its neighbours, at most PAIRING_REACH of its period on each side
-    half = np.minimum(np.diff(t_kept) / 2.0, PAIRING_REACH * period_kept)
-    left = t_kept - np.r_[min(period_kept / 2.0, PAIRING_REACH * period_kept), half]
-    right = t_kept + np.r_[half, min(period_kept / 2.0, PAIRING_REACH * period_kept)]
-    first, stop = np.searchsorted(t_other, left, side="left"), np.searchsorted(t_other, right, side="left")
-    counts = stop - first
-    means, offset = np.empty((t_kept.size, 3)), np.empty(t_kept.size)
-    filled = np.flatnonzero(counts > 0)
-    if filled.size:  # sums over [first, stop) of each filled interval (disjoint and in order): add.reduceat
-        bounds = np.empty(2 * filled.size, dtype=np.intp)
-        bounds[0::2], bounds[1::2] = first[filled], stop[filled]
-        sums = np.add.reduceat(np.vstack([other.channels, np.zeros((1, 3))]), bounds, axis=0)[0::2]
-        means[filled] = sums / counts[filled, None]
-        middle = np.add.reduceat(np.r_[t_other - t_kept[0], 0.0], bounds)[0::2] / counts[filled]
-        offset[filled] = middle - (t_kept[filled] - t_kept[0])
-    # an interval no sample of the other log falls in: its nearest sample, if within PAIRING_REACH of its period
-    j = np.clip(np.searchsorted(t_other, t_kept), 1, t_other.size - 1)
-    j = np.where(np.abs(t_other[j - 1] - t_kept) <= np.abs(t_other[j] - t_kept), j - 1, j)
-    empty = counts == 0
-    means[empty] = other.channels[j[empty]]
-    offset[empty] = t_other[j[empty]] - t_kept[empty]
-    keep = ~empty | (np.abs(offset) <= PAIRING_REACH * period_other)
-    if np.count_nonzero(keep) < 2:
-        raise ValueError(f"the gyro log {gyro.path.name!r} ({times[id(gyro)][0][0]:.6g} to "
-                         f"{times[id(gyro)][0][-1]:.6g}) and the accelerometer log {accel.path.name!r} "
-                         f"({times[id(accel)][0][0]:.6g} to {times[id(accel)][0][-1]:.6g}, in the time column's "
-                         "unit) do not overlap in time: they must be stamped by one clock")
-    parts = {id(kept): kept.channels[keep], id(other): means[keep]}
-    temperature = None
-    if gyro.temperature is not None:
-        if kept is gyro:
-            temperature = gyro.temperature[keep]
-        else:
-            temperature = gyro.temperature[j]  # the nearest gyro sample's: a temperature changes slowly
-    rates = [1.0 / (period * seconds_per_unit) for period in (period_gyro, period_accel)]
-    kind = "equal-rate" if abs(period_gyro - period_accel) <= 1e-3 * period_gyro else "slower"
-    apart = np.abs(offset[keep]) * seconds_per_unit
-    used = counts[keep & ~empty]
-    note = (f"gyros from {gyro.path.name} ({rates[0]:.6g} Hz), accelerometers from {accel.path.name} "
-            f"({rates[1]:.6g} Hz): each sample of {kept.path.name} (the {kind} log, whose lines are given) takes the "
-            f"mean of the samples of {other.path.name} in its interval ({int(used.min()) if used.size else 0} to "
-            f"{int(used.max()) if used.size else 0}, {np.mean(used) if used.size else 0:.3g} on average), their "
-            f"middle {np.max(apart):.3g} s from it at most ({np.sqrt(np.mean(apart ** 2)):.3g} s RMS)")
-    extra = []
-    dropped = int(keep.size - np.count_nonzero(keep))
-    if np.any(empty & keep):
-        extra.append(f"{int(np.count_nonzero(empty & keep))} sample(s) of {kept.path.name} with no sample of "
-                     f"{other.path.name} in their interval took its nearest")
-    if dropped:
-        extra.append(f"{dropped} sample(s) of {kept.path.name} had no sample of {other.path.name} within "
-                     f"{PAIRING_REACH:g} of its periods (before it started, after it stopped or in a gap): dropped")
-    return dataclasses.replace(
-        kept, channels=np.hstack([parts[id(gyro)], parts[id(accel)]]), names=gyro.names + accel.names,
-        time=kept.time[keep], temperature=temperature, temperature_column=gyro.temperature_column,
-        ignored=gyro.ignored + accel.ignored, first_line=int(kept.lines[keep][0]), lines=kept.lines[keep],
-        decimal_comma=gyro.decimal_comma or accel.decimal_comma, units_row=_paired_units_row(gyro, accel),
-        pairing=(note, *extra, *_skipped_lines(other)))
-
-
-def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
-    """The gyro and the accelerometer rows of a log that writes each sensor's samples in rows of their own, the
-    other sensor's three columns left empty (``table.interleaved``), as two tables for :func:`pair_logs`. A row
-    holding both is in both.
-
-    Raises
-    ------
-    ValueError
-        The log has no time column (the rows cannot be paired without one), or one sensor has fewer than two rows.
-    """
-    where = f"log {str(table.path)!r}"
-    if table.time is None:
-        raise ValueError(f"{where}: some rows hold only the gyros or only the accelerometers (the other three columns "
-                         "empty): the two are paired by time, so the log needs its time column (--time)")
-    halves = []
-    for part, sensor in ((slice(0, 3), "gyro"), (slice(3, 6), "accelerometer")):
-        rows = np.flatnonzero(np.all(np.isfinite(table.channels[:, part]), axis=1))
-        if rows.size < 2:
-            raise ValueError(f"{where}: {rows.size} row(s) hold the {sensor}s' values; some rows hold only one "
-                             "sensor's (the other three columns empty), and each sensor needs its samples")
-        halves.append(dataclasses.replace(
-            table, channels=table.channels[rows, part], names=table.names[part], time=table.time[rows],
-            temperature=None if table.temperature is None else table.temperature[rows], lines=table.lines[rows],
-            first_line=int(table.lines[rows[0]]), interleaved=False))
-    # one file: what was skipped in it is reported once, with the kept half
-    return halves[0], dataclasses.replace(halves[1], preamble=(), trailing=())
-
-
-def _paired_units_row(gyro: LogTable, accel: LogTable) -> tuple[int, tuple[str, ...]] | None:
-    """The two logs' units rows as one (the gyro log's line), where both have one."""
-    if gyro.units_row is None or accel.units_row is None:
-        return None
-    return gyro.units_row[0], gyro.units_row[1] + accel.units_row[1]
-
-
-def _skipped_lines(table: LogTable) -> tuple[str, ...]:
-    """What was skipped in the log whose lines are not given (its preamble and trailing lines), in words."""
-    notes = []
-    if table.preamble:
-        notes.append(f"{table.path.name}: {len(table.preamble)} line(s) before its header skipped")
-    if table.trailing:
-        notes.append(f"{table.path.name}: {len(table.trailing)} line(s) after its last sample skipped (not samples)")
-    return tuple(notes)
