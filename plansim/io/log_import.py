@@ -9,13 +9,15 @@ motion between them (:func:`plansim.estimate.segmentation.segment_log`) and retu
 ``static``, ``rotation`` and ``move`` segments (docs/recording.md), with what it found in the
 attributes and the schedule notes. ``plansim import`` writes it (docs/measured-data.md).
 
-The second of the three parts of ``plansim import``: :func:`plansim.io.log_table.read_log` reads the table,
-:func:`plansim.io.log_summary.format_summary` writes what was found as text.
+The middle of ``plansim import``: :func:`plansim.io.log_table.read_log` reads the table,
+:mod:`plansim.io.log_pairing` pairs two sensors sampled apart, :func:`plansim.io.log_summary.format_summary` writes
+what was found as text.
 
 Every problem with the log is a ``ValueError`` naming the file, the line and the column; what the
 log may still be used for despite a flaw (a gap, a saturated stretch, timing jitter) is a named
 :class:`LogWarning`.
 """
+
 from __future__ import annotations
 
 import math
@@ -55,63 +57,39 @@ from plansim.units import KINDS, STANDARD_GRAVITY
 
 #: a static span's mean specific force must be within this fraction of standard gravity (units check)
 GRAVITY_TOLERANCE = 0.3
-
-
 #: timing jitter (RMS) beyond this fraction of the sample period is a warning
 JITTER_WARNING = 0.1
-
-
 #: a given sample rate that differs from the time column's by more than this fraction is a warning
 RATE_MISMATCH_WARNING = 0.01
-
-
 #: the range of a lab temperature given with --temperature, degC: the widest a MEMS IMU is rated for (automotive
 #: and military grades run from -55 to +125 degC), with a margin
 LAB_TEMPERATURE = (-100.0, 200.0)
-
-
 #: the temperature assumed for each segment when the log has no temperature channel, degC
 DEFAULT_TEMPERATURE = 20.0
-
-
 #: a sample more than this fraction beyond its channel's declared full scale is an error: a sensor cannot read
 #: beyond its rail, so the full scale or the units are wrong (the margin allows a converter whose rail lies a little
 #: beyond its part's nominal range)
 FULL_SCALE_EXCEEDED = 0.02
-
-
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree")
-
-
 #: up to this many glitch rows are listed by line in the warning
 GLITCHES_LISTED = 10
-
-
 #: two saturated stretches of one channel at most this many detector windows apart are one episode (a shake hits
 #: the rail once per swing): one warning for it
 SATURATION_EPISODE_WINDOWS = 1
-
-
 #: a static pose whose gyro output is at least this (rad/s) and points along its own specific force (within
 #: :data:`VERTICAL_TURN_CONE`) is warned of as possibly a steady turn about the vertical: the one turn that leaves
 #: the accelerometers steady, which the detector (step 6) can tell from rest only against a rest elsewhere in the log
 VERTICAL_TURN_RATE = math.radians(1.0)
-
-
 #: half-angle of the cone about the specific force within which such a gyro output counts as along it. A bias of
 #: random direction falls in it by chance 1 − cos 10° = 1.5 % of the time
 VERTICAL_TURN_CONE = math.radians(10.0)
-
-
 #: a sample rate from the time column outside this range (Hz) is a warning: an IMU log is sampled at 1 Hz to 100 kHz,
 #: and a rate outside it is most often a time column in another unit than --time-unit says (ms read as s: 1000 Hz
 #: reads as 1 Hz)
 PLAUSIBLE_SAMPLE_RATE = (1.0, 1e5)
-
-
 #: up to this many tilted poses are warned of one by one; more, in one warning that lists them
 TILTED_LISTED_APART = 3
 

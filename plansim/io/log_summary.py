@@ -1,8 +1,9 @@
 """What ``plansim import`` prints: the import's findings as text, every number with its unit.
 
-The third of the three parts of ``plansim import`` (:mod:`plansim.io.log_table` reads the table,
-:mod:`plansim.io.log_import` cuts it into segments and makes the recording).
+The last part of ``plansim import`` (:mod:`plansim.io.log_table` reads the table, :mod:`plansim.io.log_pairing`
+pairs two sensors sampled apart, :mod:`plansim.io.log_import` cuts it into segments and makes the recording).
 """
+
 from __future__ import annotations
 
 import math

@@ -1,7 +1,8 @@
 """Reading a plain IMU log's table: its columns, in the file's units, every row checked.
 
-The first of the three parts of ``plansim import`` (:mod:`plansim.io.log_import` cuts the table into
-segments and makes the recording, :mod:`plansim.io.log_summary` writes what it found as text). A plain log is
+The first part of ``plansim import`` (:mod:`plansim.io.log_pairing` pairs two sensors sampled apart,
+:mod:`plansim.io.log_import` cuts the table into segments and makes the recording, :mod:`plansim.io.log_summary`
+writes what it found as text). A plain log is
 one CSV table: a header line of column names (or none: columns named by position), then one row per sample
 with six channels (three gyros, three accelerometers) in counts or in physical units, and perhaps a time
 column, a sample counter, a temperature and labels. :func:`read_log` reads it; ``parse_*`` read the command
@@ -9,6 +10,7 @@ line's per-channel options (``--units``, ``--scale``, ``--offset``, ``--full-sca
 
 Every problem with the table is a ``ValueError`` naming the file, the line and the column.
 """
+
 from __future__ import annotations
 
 import csv
@@ -27,26 +29,16 @@ from plansim.units import KINDS
 
 #: units of the time column -> seconds per unit ("samples": a sample counter, needs the sample rate)
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "samples": math.nan}
-
-
 #: the delimiters a log may use; the one that splits the header line into the most columns is taken
 DELIMITERS = (",", ";", "\t")
-
-
 #: the delimiter of a log whose columns are separated by runs of spaces (imu_tk, MATLAB's ``save -ascii``)
 WHITESPACE = "whitespace"
-
-
 #: lines a logger may write before the header (its own metadata, such as "Fs,100"): the header is the first line
 #: that names every column asked for, searched this far; those before it are skipped and reported
 MAX_PREAMBLE_LINES = 50
-
-
 #: lines after the last sample that are not samples (a logger's footer, a row it did not finish when stopped):
 #: skipped and reported up to this many; more, or one followed by samples, stops the import
 MAX_TRAILING_LINES = 10
-
-
 #: rows converted to numbers at a time while reading
 _BLOCK_ROWS = 65536
 
@@ -55,8 +47,9 @@ _BLOCK_ROWS = 65536
 class LogTable:
     """The columns read from a plain log, in the file's units.
 
-    ``channels`` (N, 6) in the order gx gy gz ax ay az; ``time`` (N,) in the time column's unit or None;
-    ``temperature`` (N,) degC or None; ``names`` the six channel column names; ``ignored`` the columns
+    ``channels`` (N, 6) in the order gx gy gz ax ay az (or the three of a log of one sensor; NaN where a row
+    holds the other sensor's alone, ``interleaved``); ``time`` (N,) in the time column's unit or None;
+    ``temperature`` (N,) degC or None; ``names`` the channel column names; ``ignored`` the columns
     not used; ``first_line`` the file line of the first sample (1-based).
     """
 
