@@ -191,6 +191,24 @@ def test_the_noise_before_the_quantiser_of_a_turning_segment_is_recovered():
     assert turning_noise_before_quantiser(x - residual, q, 1e-3 * q, 1.0, FS) == 0.0  # less scatter than the sweep
 
 
+def test_a_turning_channel_that_sits_on_its_codes_is_not_dithered():
+    """An accelerometer at rest on one code through a rate test (jjf2003's 12-bit accelerometers), its level a
+    hair above half-way between two codes and the fit's smooth signal rippling by round-off: its scatter about the
+    fit, 2.4e-15 of a 0.077 m/s^2 step, is round-off. Any σ of that order pushes samples across the half-code, so
+    the scatter jumps: Brent's method, asked for 1 % of 2.4e-15, did not converge on such a channel and stopped a
+    121-recording diagnose-check at its 13th (``plansim diagnose-check jjf2003 --null 1 --per-effect 30 --sizes 5
+    --effects clock_fast,noise_burst,scale_change,segment_offset --seed 701``). Here, 1e-12 above the half-code, it
+    returned σ = 2.2e-13, a 'noise' of round-off; a scatter within ROUND_OFF of a step now reads as none (σ = 0:
+    not dithered, not tested, as a channel on one code at rest)."""
+    q, rate = 0.07661445312499993, -math.radians(100.0)
+    n = 3000
+    smooth = 128.5 * q + 1e-12 + 4e-15 * np.sin(rate * np.arange(n) / FS)
+    assert turning_noise_before_quantiser(smooth, q, 2.4e-15, rate, FS) == 0.0
+    # a scatter above round-off is still matched: at the half-code a noise of 0.3 % of a step already splits the
+    # samples between two codes and gives a scatter of 0.3 q
+    assert 0.0 < turning_noise_before_quantiser(smooth, q, 0.3 * q, rate, FS) < 0.01 * q
+
+
 def test_coarsely_quantised_turning_segments_are_tested_through_the_quantiser():
     """A turning segment whose signal sweeps the codes of a quantiser at 0.5 step of noise (jjf2003's 12-bit gyros):
     its null goes through the quantiser about the segment's own smooth signal. 40 recordings at α = 0.2: flagged

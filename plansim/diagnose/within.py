@@ -92,6 +92,9 @@ DITHERED = 0.3
 TAIL_QUANTILE = 0.9
 #: common draws with which :func:`turning_noise_before_quantiser` matches the scatter
 MATCH_DRAWS = 8
+#: a turning channel's scatter about its fit no more than this fraction of its quantiser's step is round-off: the
+#: samples sit on their codes (:func:`turning_noise_before_quantiser` gives 0, and the channel is not tested)
+ROUND_OFF = 1e-9
 #: blocks of the burst statistic
 BLOCKS = 10
 #: null draws per segment (p resolves to 1/(B + 1))
@@ -220,7 +223,10 @@ def turning_noise_before_quantiser(smooth: np.ndarray, q: float, sd: float, rate
     (n,) (its mean and the table's harmonics of the angle): E[s(σ)] = sd, s(σ) the scatter of
     ``turning_residuals(round((smooth + σ z)/q)·q)``, averaged over :data:`MATCH_DRAWS` fixed draws z (common random
     numbers, so s is monotone in σ), solved by Brent's method to 1 % of *sd*. 0 where even σ = 0 gives at least
-    *sd* (the signal sweeping the codes makes all the scatter).
+    *sd* (the signal sweeping the codes makes all the scatter), and where *sd* is no more than
+    :data:`ROUND_OFF` of a step (the samples sit on their codes and the fit leaves round-off: a channel at rest on
+    one code through a rate test scattered 2·10⁻¹⁵ about its fit, and Brent's method, asked for 1 % of that, did
+    not converge).
 
     Below about two steps of scatter the quantiser's error follows the signal's level along the turn and is not
     white, so white noise at the observed scatter is not the null there (the burst test ran at 0.18–0.24 for 0.05
@@ -236,8 +242,9 @@ def turning_noise_before_quantiser(smooth: np.ndarray, q: float, sd: float, rate
         r = turning_residuals(y.T, rate, sample_rate)
         return float(np.mean(np.std(r, axis=0, ddof=1 + 2 * TURNING_HARMONICS))) - sd
 
-    if scatter(0.0) >= 0.0:
-        return 0.0
+    if not sd > ROUND_OFF * q or scatter(0.0) >= 0.0:
+        return 0.0  # no scatter beyond round-off (samples on their codes, the smooth signal fitted exactly), or
+        # the signal sweeping the codes makes all of it
     high = max(sd, q)
     while scatter(high) < 0.0:
         high *= 2.0
