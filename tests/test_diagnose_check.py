@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -89,6 +90,33 @@ def test_the_effects_outside_the_catalogue_are_what_they_say():
         _add_out_of_catalogue("segment_offset", np.zeros((10, 6)), 0.5, 0)
 
 
+def test_a_recording_whose_diagnosis_fails_is_listed_and_the_check_goes_on(tmp_path, capsys, monkeypatch):
+    """A diagnosis that raises no longer stops the check (one did, at the 13th of 121 recordings, 2026-11-30): it is
+    listed with its case and seed, the figures count the recordings that ran, the JSON is written, and the exit
+    code is 1."""
+    from plansim.checks import diagnose_check
+
+    real = diagnose_check.diagnose
+    calls = []
+
+    def first_fails(recording, site, **options):
+        calls.append(1)
+        if len(calls) == 1:
+            raise RuntimeError("Failed to converge after 100 iterations.")
+        return real(recording, site, **options)
+
+    monkeypatch.setattr(diagnose_check, "diagnose", first_fails)
+    out = tmp_path / "check.json"
+    assert main(["diagnose-check", "linear_gaussian", "--null", "2", "--per-effect", "0", "--null-draws", "100",
+                 "--out", str(out), "--quiet", "--seed", "3"]) == 1
+    captured = capsys.readouterr()
+    seed = diagnose_check.case_seed(3, "null", 0)
+    assert f"FAILED: null recording 0 (seed {seed}): RuntimeError: Failed to converge" in captured.out
+    assert "1 recording(s) failed" in captured.err
+    data = json.loads(out.read_text())
+    assert data["null"]["recordings"] == 1 and len(data["failures"]) == 1 and data["failures"][0]["seed"] == seed
+
+
 def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(monkeypatch):
     """--effects names only the check's cases; each recording is diagnosed with the options plansim diagnose
     --scenario gives (plansim.fit.scenario_fit_options: the stated noise included), from the scenario as the lab
@@ -108,8 +136,10 @@ def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(m
         raise RuntimeError("stop")
 
     monkeypatch.setattr(diagnose_check, "diagnose", fake)
-    with pytest.raises(RuntimeError, match="stop"):
-        run_diagnose_check(scenario, null=1, per_effect=0)
+    report = run_diagnose_check(scenario, null=1, per_effect=0)  # the failure is kept, with its seed
+    assert report.failures == [{"case": "null", "index": 0, "seed": diagnose_check.case_seed(0, "null", 0),
+                                "error": "RuntimeError: stop"}]
+    assert report.null["recordings"] == 0 and math.isnan(report.null["rate"]) and report.null["by_group"] == {}
     expected = scenario_fit_options(scenario)
     assert "stated_white" in expected and np.all(np.isfinite(expected["stated_white"]))
     got = seen[0]

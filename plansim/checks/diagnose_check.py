@@ -113,6 +113,19 @@ class CheckReport:
     null: dict = field(default_factory=dict)
     effects: list = field(default_factory=list)
     out_of_catalogue: list = field(default_factory=list)
+    #: recordings whose diagnosis raised: ``{case, index, seed, error}``; the check goes on without them, and the
+    #: figures of each case count the recordings that ran (``recordings``)
+    failures: list = field(default_factory=list)
+
+
+def _attempt(report: CheckReport, case: str, index: int, scenario, recording, truth, alpha, null_draws, seed):
+    """:func:`_run`, or None where it raises, the failure kept in ``report.failures``: a long check loses nothing to
+    one recording, and says which one failed (its case and seed, to run it again) instead of stopping."""
+    try:
+        return _run(scenario, recording, truth, alpha, null_draws, seed)
+    except Exception as exc:  # any failure of one diagnosis is reported with its seed, not fatal to the check
+        report.failures.append({"case": case, "index": index, "seed": seed, "error": f"{type(exc).__name__}: {exc}"})
+        return None
 
 
 def _alarm(d) -> bool:
@@ -170,10 +183,22 @@ def _run(scenario, recording, truth, alpha, null_draws, seed):
     return d, z
 
 
+def _share(count: int, of: int) -> float:
+    """count / of, NaN where nothing ran."""
+    return count / of if of else math.nan
+
+
+def _mean(values: list) -> float:
+    """The mean, NaN where nothing ran."""
+    return float(np.mean(values)) if values else math.nan
+
+
 def _by_group(each: list) -> dict:
     """The parameters' errors pooled over recordings, per group of eq. (1)/(2) (Kg, Bg, G, Ka, Ba, P): r.m.s. of
     z = (estimate − truth)/u, the fraction within the 95 % coverage interval, and the number of values (a group's
     values within one recording are correlated, so its binomial tolerance is wider than the count suggests)."""
+    if not each:
+        return {}
     each = np.asarray(each, dtype=float)  # (recordings, parameters, 2)
     out = {}
     for group in dict.fromkeys(PARAMETER_GROUP):
@@ -220,11 +245,17 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
     by_family = {"selection": 0, "lack_of_fit": 0, "unexplained_segment_level": 0, "within_segment": 0}
     falsely_selected: dict[str, int] = {}
     reference = None
+    ran = 0
     for i in range(null):
         s = case_seed(seed, "null", i)
         recording = simulate_and_record(scenario, seed=s, trial=0)
         _, _, truth = simulate_recording(scenario, s, 0)
-        d, z = _run(scenario, recording, truth, alpha, null_draws, s)
+        result = _attempt(report, "null", i, scenario, recording, truth, alpha, null_draws, s)
+        if result is None:
+            tick()
+            continue
+        d, z = result
+        ran += 1
         reference = reference or d
         sample_rate = recording.schedule.segments[0].sample_rate
         selections += bool(d.selected)
@@ -236,12 +267,12 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         z_before.append(z["before"])
         each_before.append(z["before_each"])
         tick()
-    report.null = {"recordings": null, "false_alarms": alarms, "rate": alarms / null,
-                   "selections": selections, "selection_rate": selections / null,
-                   "binomial_99_upper_count": int(binom.ppf(0.99, null, alpha)),
+    report.null = {"recordings": ran, "false_alarms": alarms, "rate": alarms / ran if ran else math.nan,
+                   "selections": selections, "selection_rate": selections / ran if ran else math.nan,
+                   "binomial_99_upper_count": int(binom.ppf(0.99, ran, alpha)),
                    "by_family": by_family, "falsely_selected": falsely_selected,
-                   "rms_z": float(np.mean([v[0] for v in z_before])),
-                   "coverage_95": float(np.mean([v[1] for v in z_before])),
+                   "rms_z": float(np.mean([v[0] for v in z_before])) if ran else math.nan,
+                   "coverage_95": float(np.mean([v[1] for v in z_before])) if ran else math.nan,
                    "by_group": _by_group(each_before)}
     if reference is None or per_effect == 0:
         return report
@@ -256,8 +287,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
             component, base = candidate.components[usable[0]], float(candidate.noise_equivalent_size[usable[0]])
         for k in (sizes if effect != "lever_arm" else (1.0,)):
             size = base * k if effect != "lever_arm" else base
-            counts = {"detected": 0, "attributed": 0, "selected": {}, "rms_z_before": [], "rms_z_after": [],
-                      "coverage_after": []}
+            counts = {"ran": 0, "detected": 0, "attributed": 0, "selected": {}, "rms_z_before": [],
+                      "rms_z_after": [], "coverage_after": []}
             for i in range(per_effect):
                 s = case_seed(seed, f"{effect}/{k}", i)
                 injected = _inject(scenario, effect, component, size) if effect != "bias_drift" else scenario
@@ -273,7 +304,12 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 else:
                     recording = simulate_and_record(injected, seed=s, trial=0)
                 _, _, truth = simulate_recording(injected, s, 0)
-                d, z = _run(scenario, recording, truth, alpha, null_draws, s)
+                result = _attempt(report, f"{effect} x{k:g}", i, scenario, recording, truth, alpha, null_draws, s)
+                if result is None:
+                    tick()
+                    continue
+                d, z = result
+                counts["ran"] += 1
                 counts["detected"] += _alarm(d)
                 counts["attributed"] += d.selected == (effect,)
                 key = "+".join(d.selected) or "(none)"
@@ -284,11 +320,11 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 tick()
             report.effects.append({
                 "effect": effect, "component": component, "times_noise_equivalent": k if effect != "lever_arm"
-                else None, "size": size, "identifiable": candidate.identifiable, "recordings": per_effect,
-                "detection": counts["detected"] / per_effect, "attribution": counts["attributed"] / per_effect,
-                "confusion": counts["selected"], "rms_z_before": float(np.mean(counts["rms_z_before"])),
-                "rms_z_after": float(np.mean(counts["rms_z_after"])),
-                "coverage_after": float(np.mean(counts["coverage_after"]))})
+                else None, "size": size, "identifiable": candidate.identifiable, "recordings": counts["ran"],
+                "detection": _share(counts["detected"], counts["ran"]),
+                "attribution": _share(counts["attributed"], counts["ran"]),
+                "confusion": counts["selected"], "rms_z_before": _mean(counts["rms_z_before"]),
+                "rms_z_after": _mean(counts["rms_z_after"]), "coverage_after": _mean(counts["coverage_after"])})
     # outside the catalogue, each added to the simulated samples of the null scenario (module docstring)
     u_mean = float(np.median(np.sqrt(np.diag(reference.before.covariance)).reshape(-1, 6)[:, 0]))
     white = reference.before.noise.channels[0].white
@@ -313,7 +349,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
             else:
                 size, scale = k * equivalent, "its noise-equivalent size"
             at = _noncentrality(effect, size, reference.before, clean, clean_bias)
-            flagged, named = 0, 0
+            flagged, named, ran = 0, 0, 0
             for i in range(per_effect):
                 s = case_seed(seed, f"{effect}/{k}", i)
                 # the effect acts on the sensor, before the acquisition: added to the samples of the same trial
@@ -324,16 +360,19 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                                                 bias=float(truth[PARAMETER_INDEX["Bgx"]]),
                                                 span=_middle_segment(recording.schedule))
                 recording = type(recording)(_acquire(scenario, samples), recording.schedule, dict(recording.attrs))
-                d, _ = _run(scenario, recording, truth, alpha, null_draws, s)
+                result = _attempt(report, f"{effect} x{k:g}", i, scenario, recording, truth, alpha, null_draws, s)
+                tick()
+                if result is None:
+                    continue
+                d, _ = result
+                ran += 1
                 flagged += _alarm(d)
                 named += bool(d.selected)
-                tick()
             report.out_of_catalogue.append({"effect": effect, "times": k, "scale": scale, "size": size,
                                             "unit": unit, "noncentrality": at,
                                             "in_natural_units": size / natural, "natural_unit": natural_scale,
-                                            "recordings": per_effect,
-                                            "flagged_unexplained": flagged / per_effect,
-                                            "named_after_a_candidate": named / per_effect})
+                                            "recordings": ran, "flagged_unexplained": _share(flagged, ran),
+                                            "named_after_a_candidate": _share(named, ran)})
     return report
 
 
@@ -415,4 +454,4 @@ def _add_out_of_catalogue(effect: str, samples: np.ndarray, size: float, seed: i
 
 def check_json(report: CheckReport) -> dict:
     return {"scenario": report.scenario, "alpha": report.alpha, "null": report.null, "effects": report.effects,
-            "out_of_catalogue": report.out_of_catalogue}
+            "out_of_catalogue": report.out_of_catalogue, "failures": report.failures}

@@ -60,8 +60,15 @@ def _cmd_diagnose_check(args) -> int:
                 f", non-centrality {e['noncentrality']:.3g}; {e['in_natural_units']:.3g}x {e['natural_unit']}")
             print(f"{e['effect']} x{e['times']:g} ({e['scale']}{nes}): flagged {e['flagged_unexplained']:.2f}, named "
                   f"after a candidate {e['named_after_a_candidate']:.2f}")
+        for f in data["failures"]:
+            print(f"FAILED: {f['case']} recording {f['index']} (seed {f['seed']}): {f['error']}")
         if args.out:
             print(f"\nwrote: {args.out}")
+    if data["failures"]:
+        # the figures above count the recordings that ran; a failure is a fault to fix, so the exit code says so
+        print(f"plansim diagnose-check: {len(data['failures'])} recording(s) failed (listed with their seeds); the "
+              "figures count the others", file=sys.stderr)
+        return 1
     return 0
 
 
