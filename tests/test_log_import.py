@@ -936,6 +936,15 @@ def test_gyros_and_accelerometers_logged_in_two_files_are_paired_by_time(tmp_pat
     np.testing.assert_allclose(both.recording.samples, x, rtol=0, atol=1e-14)
     assert both.table.path.name == "a2.csv" and both.table.lines[0] == 2
     assert "each sample of a2.csv (the slower log" in both.table.pairing[0]
+    # a temperature column in the gyro log follows the kept (accelerometer) samples: the mean over the gyro samples
+    # paired with each, as their outputs are
+    g2 = (tmp_path / "g2.csv").read_text().splitlines()
+    g2t = [g2[0] + ',"Temp (C)"'] + [f"{line},{25.0 + 0.001 * k!r}" for k, line in enumerate(g2[1:])]
+    (tmp_path / "g2t.csv").write_text("\n".join(g2t) + "\n")
+    warm = import_log(tmp_path / "g2t.csv", accel_log=tmp_path / "a2.csv", columns=tuple(columns[1].split(",")),
+                      time_column="Time (s)", temperature_column="Temp (C)")
+    assert warm.table.temperature.shape == (n,)
+    np.testing.assert_allclose(warm.table.temperature, 25.0 + 0.001 * (np.arange(0, 2 * n, 2) + 0.5), atol=1e-12)
 
     # no time columns: paired row by row (imu_tk's two files, sampled together), with --sample-rate
     for name, values in (("g3.csv", x[:, :3]), ("a3.csv", x[:, 3:])):

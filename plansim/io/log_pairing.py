@@ -106,21 +106,26 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
     right = t_kept + np.r_[half, min(period_kept / 2.0, PAIRING_REACH * period_kept)]
     first, stop = np.searchsorted(t_other, left, side="left"), np.searchsorted(t_other, right, side="left")
     counts = stop - first
-    means, offset = np.empty((t_kept.size, 3)), np.empty(t_kept.size)
     filled = np.flatnonzero(counts > 0)
-    if filled.size:  # sums over [first, stop) of each filled interval (disjoint and in order): add.reduceat
-        bounds = np.empty(2 * filled.size, dtype=np.intp)
-        bounds[0::2], bounds[1::2] = first[filled], stop[filled]
-        sums = np.add.reduceat(np.vstack([other.channels, np.zeros((1, 3))]), bounds, axis=0)[0::2]
-        means[filled] = sums / counts[filled, None]
-        middle = np.add.reduceat(np.r_[t_other - t_kept[0], 0.0], bounds)[0::2] / counts[filled]
-        offset[filled] = middle - (t_kept[filled] - t_kept[0])
+    empty = counts == 0
+    bounds = np.empty(2 * filled.size, dtype=np.intp)  # [first, stop) of each filled interval, disjoint and in order
+    bounds[0::2], bounds[1::2] = first[filled], stop[filled]
     # an interval no sample of the other log falls in: its nearest sample, if within PAIRING_REACH of its period
     j = np.clip(np.searchsorted(t_other, t_kept), 1, t_other.size - 1)
     j = np.where(np.abs(t_other[j - 1] - t_kept) <= np.abs(t_other[j] - t_kept), j - 1, j)
-    empty = counts == 0
-    means[empty] = other.channels[j[empty]]
-    offset[empty] = t_other[j[empty]] - t_kept[empty]
+
+    def interval_means(values: np.ndarray) -> np.ndarray:
+        """Each kept sample's mean of *values* (the other log's, (N,) or (N, k)) over its interval, or the nearest."""
+        out = np.empty((t_kept.size,) + values.shape[1:])
+        if filled.size:
+            padded = np.concatenate([values, np.zeros((1,) + values.shape[1:])])
+            sums = np.add.reduceat(padded, bounds, axis=0)[0::2]
+            out[filled] = sums / counts[filled].reshape((-1,) + (1,) * (values.ndim - 1))
+        out[empty] = values[j[empty]]
+        return out
+
+    means = interval_means(other.channels)
+    offset = interval_means(t_other - t_kept[0]) - (t_kept - t_kept[0])
     keep = ~empty | (np.abs(offset) <= PAIRING_REACH * period_other)
     if np.count_nonzero(keep) < 2:
         raise ValueError(f"the gyro log {gyro.path.name!r} ({times[id(gyro)][0][0]:.6g} to "
@@ -133,7 +138,7 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
         if kept is gyro:
             temperature = gyro.temperature[keep]
         else:
-            temperature = gyro.temperature[j]  # the nearest gyro sample's: a temperature changes slowly
+            temperature = interval_means(gyro.temperature)[keep]  # over the gyro samples paired, as their outputs
     rates = [1.0 / (period * seconds_per_unit) for period in (period_gyro, period_accel)]
     kind = "equal-rate" if abs(period_gyro - period_accel) <= 1e-3 * period_gyro else "slower"
     apart = np.abs(offset[keep]) * seconds_per_unit
