@@ -251,8 +251,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
         recording = simulate_and_record(scenario, seed=s, trial=0)
         _, _, truth = simulate_recording(scenario, s, 0)
         result = _attempt(report, "null", i, scenario, recording, truth, alpha, null_draws, s)
+        tick()
         if result is None:
-            tick()
             continue
         d, z = result
         ran += 1
@@ -266,13 +266,12 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
             falsely_selected[effect] = falsely_selected.get(effect, 0) + 1
         z_before.append(z["before"])
         each_before.append(z["before_each"])
-        tick()
-    report.null = {"recordings": ran, "false_alarms": alarms, "rate": alarms / ran if ran else math.nan,
-                   "selections": selections, "selection_rate": selections / ran if ran else math.nan,
+    report.null = {"recordings": ran, "false_alarms": alarms, "rate": _share(alarms, ran),
+                   "selections": selections, "selection_rate": _share(selections, ran),
                    "binomial_99_upper_count": int(binom.ppf(0.99, ran, alpha)),
                    "by_family": by_family, "falsely_selected": falsely_selected,
-                   "rms_z": float(np.mean([v[0] for v in z_before])) if ran else math.nan,
-                   "coverage_95": float(np.mean([v[1] for v in z_before])) if ran else math.nan,
+                   "rms_z": _mean([v[0] for v in z_before]),
+                   "coverage_95": _mean([v[1] for v in z_before]),
                    "by_group": _by_group(each_before)}
     if reference is None or per_effect == 0:
         return report
@@ -305,8 +304,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                     recording = simulate_and_record(injected, seed=s, trial=0)
                 _, _, truth = simulate_recording(injected, s, 0)
                 result = _attempt(report, f"{effect} x{k:g}", i, scenario, recording, truth, alpha, null_draws, s)
+                tick()
                 if result is None:
-                    tick()
                     continue
                 d, z = result
                 counts["ran"] += 1
@@ -317,7 +316,6 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
                 counts["rms_z_before"].append(z["before"][0])
                 counts["rms_z_after"].append(z["after"][0])
                 counts["coverage_after"].append(z["after"][1])
-                tick()
             report.effects.append({
                 "effect": effect, "component": component, "times_noise_equivalent": k if effect != "lever_arm"
                 else None, "size": size, "identifiable": candidate.identifiable, "recordings": counts["ran"],

@@ -51,8 +51,8 @@ def _add_import_command(sub) -> None:
     p.add_argument("--accel-log", default=None, metavar="LOG2",
                    help="the accelerometers' log, where they were logged in a file of their own (imu_tk, phyphox, "
                         "phone sensor loggers): LOG then holds the gyros, --columns names LOG's three then LOG2's "
-                        "three, and --time is in both; each sample of the slower log is paired with the other's "
-                        "nearest in time (nothing interpolated)")
+                        "three, and --time is in both; each sample of the slower log is paired with the mean of the "
+                        "other's samples in its interval (nothing interpolated)")
     p.add_argument("--time", default=None, metavar="COL",
                    help="the time column (default: none; give --sample-rate); in a log with no header line, its "
                         "position (1 for the first column)")

@@ -65,7 +65,6 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
         One log has a time column and the other not, or clock times and the other numbers; a time column goes
         backwards; logs without time columns differ in length; the logs do not overlap in time.
     """
-    names = {id(gyro): "gyro log", id(accel): "accelerometer log"}
     if (gyro.time is None) != (accel.time is None) or (gyro.clock_zero_s is None) != (accel.clock_zero_s is None):
         raise ValueError(f"the gyro log {gyro.path.name!r} and the accelerometer log {accel.path.name!r} must both "
                          "have a time column of one kind (numbers in one unit, or clock times), or neither")
@@ -81,25 +80,14 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
             pairing=(f"gyros from {gyro.path.name}, accelerometers from {accel.path.name}: paired row by row "
                      f"({gyro.channels.shape[0]} samples each, no time columns); lines are {gyro.path.name}'s",
                      *_skipped_lines(accel)))
-    times = {}
-    for table in (gyro, accel):
-        t = table.time + (table.clock_zero_s or 0.0)
-        back = np.flatnonzero(np.diff(t) < 0)
-        if back.size:
-            k = int(back[0]) + 1
-            raise ValueError(f"{names[id(table)]} {str(table.path)!r}: column {table.time_column!r} goes backwards at "
-                             f"line {table.lines[k]} ({float(table.time[k - 1])!r} then {float(table.time[k])!r}); "
-                             "the two logs are paired by time, which must not go backwards")
-        steps = np.diff(t)
-        steps = steps[steps > 0]
-        if t.size < 2 or steps.size == 0:
-            raise ValueError(f"{names[id(table)]} {str(table.path)!r}: {t.size} sample(s) with distinct times; "
-                             "expected a recording")
-        times[id(table)] = (t, float(np.median(steps)))
-    period_gyro, period_accel = times[id(gyro)][1], times[id(accel)][1]
-    kept, other = (accel, gyro) if period_accel > period_gyro * (1.0 + 1e-3) else (gyro, accel)
-    t_kept, period_kept = times[id(kept)]
-    t_other, period_other = times[id(other)]
+    t_gyro, period_gyro = _clock(gyro, "gyro log")
+    t_accel, period_accel = _clock(accel, "accelerometer log")
+    if period_accel > period_gyro * (1.0 + 1e-3):
+        (kept, t_kept, period_kept), (other, t_other, period_other) = ((accel, t_accel, period_accel),
+                                                                        (gyro, t_gyro, period_gyro))
+    else:
+        (kept, t_kept, period_kept), (other, t_other, period_other) = ((gyro, t_gyro, period_gyro),
+                                                                        (accel, t_accel, period_accel))
     # each kept sample's interval: half-way to its neighbours, at most PAIRING_REACH of its period on each side
     half = np.minimum(np.diff(t_kept) / 2.0, PAIRING_REACH * period_kept)
     left = t_kept - np.r_[min(period_kept / 2.0, PAIRING_REACH * period_kept), half]
@@ -128,11 +116,11 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
     offset = interval_means(t_other - t_kept[0]) - (t_kept - t_kept[0])
     keep = ~empty | (np.abs(offset) <= PAIRING_REACH * period_other)
     if np.count_nonzero(keep) < 2:
-        raise ValueError(f"the gyro log {gyro.path.name!r} ({times[id(gyro)][0][0]:.6g} to "
-                         f"{times[id(gyro)][0][-1]:.6g}) and the accelerometer log {accel.path.name!r} "
-                         f"({times[id(accel)][0][0]:.6g} to {times[id(accel)][0][-1]:.6g}, in the time column's "
-                         "unit) do not overlap in time: they must be stamped by one clock")
-    parts = {id(kept): kept.channels[keep], id(other): means[keep]}
+        raise ValueError(f"the gyro log {gyro.path.name!r} ({t_gyro[0]:.6g} to {t_gyro[-1]:.6g}) and the "
+                         f"accelerometer log {accel.path.name!r} ({t_accel[0]:.6g} to {t_accel[-1]:.6g}, in the time "
+                         "column's unit) do not overlap in time: they must be stamped by one clock")
+    gyro_part, accel_part = ((kept.channels[keep], means[keep]) if kept is gyro
+                             else (means[keep], kept.channels[keep]))
     temperature = None
     if gyro.temperature is not None:
         if kept is gyro:
@@ -157,11 +145,28 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
         extra.append(f"{dropped} sample(s) of {kept.path.name} had no sample of {other.path.name} within "
                      f"{PAIRING_REACH:g} of its periods (before it started, after it stopped or in a gap): dropped")
     return dataclasses.replace(
-        kept, channels=np.hstack([parts[id(gyro)], parts[id(accel)]]), names=gyro.names + accel.names,
+        kept, channels=np.hstack([gyro_part, accel_part]), names=gyro.names + accel.names,
         time=kept.time[keep], temperature=temperature, temperature_column=gyro.temperature_column,
         ignored=gyro.ignored + accel.ignored, first_line=int(kept.lines[keep][0]), lines=kept.lines[keep],
         decimal_comma=gyro.decimal_comma or accel.decimal_comma, units_row=_paired_units_row(gyro, accel),
         pairing=(note, *extra, *_skipped_lines(other)))
+
+
+def _clock(table: LogTable, what: str) -> tuple[np.ndarray, float]:
+    """A log's times on the clock both logs share (its clock time added where it has one) and its usual period
+    (the median of its steps), checked: never going backwards, at least two distinct times."""
+    t = table.time + (table.clock_zero_s or 0.0)
+    back = np.flatnonzero(np.diff(t) < 0)
+    if back.size:
+        k = int(back[0]) + 1
+        raise ValueError(f"{what} {str(table.path)!r}: column {table.time_column!r} goes backwards at line "
+                         f"{table.lines[k]} ({float(table.time[k - 1])!r} then {float(table.time[k])!r}); the two "
+                         "logs are paired by time, which must not go backwards")
+    steps = np.diff(t)
+    steps = steps[steps > 0]
+    if steps.size == 0:
+        raise ValueError(f"{what} {str(table.path)!r}: {t.size} sample(s) with distinct times; expected a recording")
+    return t, float(np.median(steps))
 
 
 def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
