@@ -11,9 +11,9 @@ from plansim.io.files import OutputSet, check_output_path
 
 def _cmd_import(args) -> int:
     from plansim.io.log_import import import_log
-    from plansim.io.log_summary import format_summary
     from plansim.io.recording import write_recording
     from plansim.io.recording_csv import segment_table_path
+    from plansim.report.import_summary import format_summary
 
     target = check_output_path(args.out, "--out", (".nc", ".csv"))
     outputs = [target]

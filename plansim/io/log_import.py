@@ -10,8 +10,8 @@ motion between them (:func:`plansim.estimate.segmentation.segment_log`) and retu
 attributes and the schedule notes. ``plansim import`` writes it (docs/measured-data.md).
 
 The middle of ``plansim import``: :func:`plansim.io.log_table.read_log` reads the table,
-:mod:`plansim.io.log_pairing` pairs two sensors sampled apart, :func:`plansim.io.log_summary.format_summary` writes
-what was found as text.
+:mod:`plansim.io.log_pairing` pairs two sensors sampled apart, and
+:func:`plansim.report.import_summary.format_summary` writes what was found as text.
 
 Every problem with the log is a ``ValueError`` naming the file, the line and the column; what the
 log may still be used for despite a flaw (a gap, a saturated stretch, timing jitter) is a named

@@ -1,7 +1,7 @@
 """Reading a plain IMU log's table: its columns, in the file's units, every row checked.
 
 The first part of ``plansim import`` (:mod:`plansim.io.log_pairing` pairs two sensors sampled apart,
-:mod:`plansim.io.log_import` cuts the table into segments and makes the recording, :mod:`plansim.io.log_summary`
+:mod:`plansim.io.log_import` cuts the table into segments and makes the recording, :mod:`plansim.report.import_summary`
 writes what it found as text). A plain log is
 one CSV table: a header line of column names (or none: columns named by position), then one row per sample
 with six channels (three gyros, three accelerometers) in counts or in physical units, and perhaps a time
