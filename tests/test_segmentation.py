@@ -54,6 +54,7 @@ def test_a_log_at_rest_is_one_static_span(kind):
         x = static_noise(kind, 200.0, rng)
         result = segment_log(x, None, FS)
         assert [(s.kind, s.start, s.stop) for s in result.spans] == [("static", 0, x.shape[0])], kind
+        assert result.frozen == (), kind  # step 4c: no chance repeat taken for a frozen channel
         assert result.spans[0].up == "+z" and result.spans[0].orientation == "approximate"
 
 

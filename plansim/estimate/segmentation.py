@@ -28,6 +28,10 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    ``GLITCH_RATIO`` × the neighbours' own variation, those neighbours quiet). The detector and a turn's integral
    take such a row as the mean of its neighbours; no static span holds one (a pose is cut at it, a piece shorter
    than a window trimmed off), and ``Segmentation.glitches`` lists them.
+4c. **Frozen stretches** (:func:`plansim.estimate.frozen.frozen_runs`, once the static spans are known): a channel
+   that repeats one value for longer than its own noise at rest allows (a sensor that stopped updating, a logger
+   repeating its last value). No static span holds one (cut as a glitch row is), and a motion across a frozen
+   gyro is a move (its integral is not known); ``Segmentation.frozen`` lists them.
 5. **Quiet samples.** A sample is quiet when, over its window, Σ_accel var/σ² and Σ_gyro var/σ² are each
    at most the larger of ``VARIANCE_FACTOR`` × 3 (3 is the expected sum at rest) and the median of that
    sum in ``Q`` plus ``SPREAD_FACTOR`` robust standard deviations of it (wider for correlated or
@@ -97,6 +101,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from plansim.estimate.frozen import Frozen, frozen_mask, frozen_runs
 from plansim.model.environment import EARTH_RATE
 
 #: default window of the moving statistics, s
@@ -413,7 +418,8 @@ class Segmentation:
     (accelerometers, gyros) and
     ``rate_threshold`` (3,) the gyro offset, rad/s, beyond which a quiet run is a steady turn;
     ``saturation`` lists the stuck stretches; ``steady_turns`` the quiet runs that were steady turns;
-    ``glitches`` the isolated glitch rows (step 4b), in no static span.
+    ``glitches`` the isolated glitch rows (step 4b), in no static span; ``frozen`` the stretches where a channel
+    repeats one value for longer than its noise allows (step 4c, :mod:`plansim.estimate.frozen`), in no static span.
     """
 
     spans: tuple[Span, ...]
@@ -425,6 +431,7 @@ class Segmentation:
     saturation: tuple[Saturation, ...]
     steady_turns: tuple[tuple[int, int], ...]
     glitches: tuple[int, ...] = ()
+    frozen: tuple[Frozen, ...] = ()
 
     def of_kind(self, kind: str) -> list[Span]:
         return [span for span in self.spans if span.kind == kind]
@@ -673,13 +680,19 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
                          f"{variance_threshold[1]:.3g} (gyros) over windows of {w} samples "
                          "and the gyro output within the rest threshold (docs/measured-data.md)")
 
-    # 4b. no static span holds a glitch row: a pose is cut at each, and a piece shorter than a window is left to
-    # the motion beside it (a pose trimmed)
+    # 4c. frozen stretches: one value repeated for longer than the channel's noise at rest allows
+    frozen = frozen_runs(logged, static_runs, step)
+    frozen_rows = frozen_mask(n, frozen)
+    gyro_frozen = frozen_mask(n, frozen, channels=range(3))
+
+    # 4b-c. no static span holds a glitch row or a frozen sample: a pose is cut at each, and a piece shorter than a
+    # window is left to the motion beside it (a pose trimmed)
+    cut = glitch | frozen_rows
     held_pieces = set()
-    if glitch.any():
+    if cut.any():
         pieces = []
         for a, b in static_runs:
-            cuts = np.flatnonzero(glitch[a:b]) + a
+            cuts = np.flatnonzero(cut[a:b]) + a
             for lo, hi in zip(np.concatenate(([a], cuts + 1)).tolist(), np.concatenate((cuts, [b])).tolist()):
                 if hi - lo >= w:
                     pieces.append((lo, hi))
@@ -689,8 +702,8 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     else:
         held_pieces = set(held)
     if not static_runs:
-        raise ValueError(f"too few static samples: every span at rest is cut by isolated glitch rows into pieces "
-                         f"shorter than a window of {w} samples")
+        raise ValueError(f"too few static samples: every span at rest is cut by isolated glitch rows or frozen "
+                         f"samples into pieces shorter than a window of {w} samples")
 
     # 7-10. poses, motion, steady rates, saturation
     statics = []
@@ -707,16 +720,23 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     for span in statics + [None]:
         lo = 0 if previous is None else previous.stop
         hi = n if span is None else span.start
-        if hi > lo and _cut_at_glitch(glitch[lo:hi], w, previous, span):
+        if hi > lo and _cut_at_glitch(cut[lo:hi], w, previous, span):
+            what = ("a frozen channel (one value repeated, step 4c)" if frozen_rows[lo:hi].any() else
+                    "isolated glitch row(s) (step 4b)")
             spans.append(Span("move", lo, hi, logged[lo:hi].mean(axis=0), up=(previous or span).up,
-                              reason="isolated glitch row(s) cut out of the pose around them (step 4b)"))
+                              reason=f"{what} cut out of the pose around them"))
+        elif hi > lo and gyro_frozen[lo:hi].any():
+            spans.append(Span("move", lo, hi, x[lo:hi].mean(axis=0), up=(previous or span).up,
+                              integrated=np.full(3, np.nan),
+                              reason="a gyro frozen inside (one value repeated, step 4c): the turn cannot be "
+                                     "integrated"))
         elif hi > lo:
             spans.extend(_motion_pieces(x, times, lo, hi, previous, span, gap_starts, saturation, steady))
         if span is not None:
             spans.append(span)
         previous = span
     return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
-                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()))
+                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()), tuple(frozen))
 
 
 def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span | None) -> bool:

@@ -73,9 +73,11 @@ FULL_SCALE_EXCEEDED = 0.02
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
-                 "units_disagree")
+                 "units_disagree", "frozen")
 #: up to this many glitch rows are listed by line in the warning
 GLITCHES_LISTED = 10
+#: up to this many frozen stretches are listed in the warning
+FROZEN_LISTED = 6
 #: two saturated stretches of one channel at most this many detector windows apart are one episode (a shake hits
 #: the rail once per swing): one warning for it
 SATURATION_EPISODE_WINDOWS = 1
@@ -364,6 +366,18 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                              "in the recording as logged, but in no static pose (a pose is cut or "
                                              "trimmed around each); the detector and a turn's integral take each as "
                                              "the mean of its neighbours"))
+    if segmentation.frozen:
+        frozen = segmentation.frozen
+        listed = "; ".join(
+            f"{CHANNELS[f.channel]} ({table.names[f.channel]}) at "
+            f"{_as_logged(f.value, f.channel, factors, divisors, offsets, unit_names, counts_per_unit is not None)} "
+            f"on lines {table.lines[f.start]}-{table.lines[f.stop - 1]} ({f.stop - f.start} samples)"
+            for f in frozen[:FROZEN_LISTED]) + ("; …" if len(frozen) > FROZEN_LISTED else "")
+        warnings.append(LogWarning("frozen", f"{len(frozen)} stretch(es) where a channel repeats one value for longer "
+                                             "than its noise at rest allows (a sensor that stopped updating, or a "
+                                             f"logger repeating its last value): {listed}. Kept in the recording as "
+                                             "logged, but in no static pose (a pose is cut around each), and a turn "
+                                             "across a frozen gyro is a move"))
     for episode in _saturation_episodes(segmentation.saturation, SATURATION_EPISODE_WINDOWS * segmentation.window):
         c, start, stop = episode[0].channel, episode[0].start, max(s.stop for s in episode)
         first, last = table.lines[start], table.lines[stop - 1]
