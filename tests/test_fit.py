@@ -1145,6 +1145,41 @@ def test_a_gyro_reversed_in_the_log_is_named_and_reading_it_reversed_gives_the_f
     np.testing.assert_array_equal(again.moves.method.estimate, original.moves.method.estimate)
 
 
+def test_gyro_columns_in_another_order_are_named_with_the_order_to_read_them_in(tmp_path):
+    """The Ferraris log with gyr_x and gyr_y exchanged (a logger's or a user's --columns mapping the gyros in another
+    order than the accelerometers): before, every sign start of the moves ran away (Kg diagonal −1e6) and the note
+    said only to check the units, columns and signs. The signed permutations, tried where the sign and unit starts
+    end far from ±1, find gx reading the rotation about y and gy about x: the moves are left out with the order to
+    read the columns in, and the caution that the accelerometers' columns may be the exchanged ones. Read in that
+    order, the log is the original to the bit (the fit of the original is checked in the test above)."""
+    log = FERRARIS / "example_ferraris_session.csv"
+    if not log.exists():
+        pytest.skip(f"the shared real data is not beside the repository ({FERRARIS})")
+    from plansim.fit.moves import axes_permuted
+    from plansim.io.log_import import import_log
+
+    columns = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
+    swapped = import_log(log, columns=("gyr_y", "gyr_x", *columns[2:]), units="deg/s,m/s^2", sample_rate=102.4)
+    result = fit_recording(swapped.recording)
+    (note,) = [n for n in result.notes if "another order" in n]
+    assert note.startswith("the moves between poses were left out: they fit best with the gyros reading the "
+                           "accelerometers' axes in another order: gx the rotation about y, gy the rotation about x (")
+    assert "gx ← the column now read as gy, gy ← the column now read as gx, gz ← the column now read as gz" in note
+    assert "An exchange of two axes mirrors a triad" in note
+    assert result.moves is None  # no scale factor from the moves: nothing wrong-mapped is given as a Kg
+    again = import_log(log, columns=columns, units="deg/s,m/s^2", sample_rate=102.4)
+    reread = swapped.recording.samples[:, [1, 0, 2, 3, 4, 5]]
+    np.testing.assert_array_equal(reread, again.recording.samples)
+    # the rule alone: a cyclic order (no mirror) and the cases that are not an order
+    cyclic = np.array([[0.01, 0.99, 0.0], [0.0, 0.02, -1.01], [1.02, 0.0, 0.01]])
+    text = axes_permuted(cyclic)
+    assert "gx the rotation about y, gy the rotation about z, gz the rotation about x" in text
+    assert "gx ← the column now read as gz, gy ← the column now read as gx, gz ← the column now read as gy" in text
+    assert "mirrors" not in text
+    assert axes_permuted(np.diag([1.02, -0.99, 1.0])) == ""  # a reversed axis: reversed_axis_notes' case
+    assert axes_permuted(np.array([[0.5, 0.5, 0.0], [0.5, 0.5, 0.0], [0.0, 0.0, 1.0]])) == ""
+
+
 def test_a_negative_scale_factor_is_named_whichever_method_finds_it():
     from plansim.fit.identify import reversed_axis_notes
 

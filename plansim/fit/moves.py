@@ -70,6 +70,7 @@ the frame where the accelerometer triad's matrix is symmetric.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -103,6 +104,14 @@ SIGN_STARTS = tuple((a, b, c) for a in (1.0, -1.0) for b in (1.0, -1.0) for c in
 #: … and from each pattern times these: the gyros' units mistaken, deg/s read as rad/s (a log in deg/s imported
 #: without --units), where a start at ±1 stops in a local minimum
 UNIT_STARTS = (1.0, math.degrees(1.0))
+#: … and, last, from every signed permutation that is not diagonal: the gyro columns in another order than the
+#: accelerometers' (a logger or a --columns that maps one sensor's axes differently)
+PERMUTED_GROUP = len(UNIT_STARTS)
+PERMUTED_STARTS = tuple(np.diag(signs)[list(order)] for order in itertools.permutations(range(3))
+                        if list(order) != [0, 1, 2] for signs in SIGN_STARTS)
+#: a best fit this close to a signed permutation that is not diagonal (each entry) is read as the axes in another
+#: order (axes_permuted): a MEMS gyro's scale factor is within a few per cent of 1, its cross-couplings within 1 %
+PERMUTATION_TOLERANCE = 0.2
 #: … tried only where the starts before them end with a gyro scale factor K far from ±1, |K² − 1| above this
 #: (|K| outside 0.71–1.22; the test's log in deg/s read as rad/s ended at −0.056 and +0.44 from ±1; a MEMS gyro's
 #: scale factor is within a few per cent of 1)
@@ -126,6 +135,37 @@ WEAK_DIRECTION_U = UNINFORMATIVE_U["Kg"]
 #: this (the 99 % point of χ² with 1 degree of freedom): with poses near the six axes a half turn of the gyro
 #: triad about one axis maps every pose's gravity onto itself, and the moves cannot tell it from none
 SIGN_EVIDENCE = 6.63
+
+
+def axes_permuted(Kg: np.ndarray) -> str:
+    """Where the gyro scale-factor matrix *Kg* that fits the moves best is a signed permutation that is not diagonal
+    (every entry within :data:`PERMUTATION_TOLERANCE` of it), what that says of the log; else ``""``.
+
+    Row a of Kg is what gyro a reads of the rotation about each accelerometer axis: Kg ≈ [[0, 1, 0], [1, 0, 0],
+    [0, 0, 1]] is gx reading the rotation about y and gy about x, the gyros' x and y columns exchanged against the
+    accelerometers' (or the accelerometers' against the gyros': the poses, fitted by the norm of their specific
+    force, cannot tell a mirrored accelerometer triad from the true one). The order is what the search tells; the
+    signs it does not tell reliably (it steps only in the directions the moves identify at Kg = I, so a start at a
+    permutation is projected onto them: the Ferraris session with its gyro columns in cyclic order came out with two
+    signs reversed, while the re-import in that order with no sign changed fits with χ² 1551 against 2826), so the
+    advice is the order alone, and the refit's own notes (:func:`plansim.fit.identify.reversed_axis_notes`) name any
+    axis still reversed."""
+    P = np.round(Kg)
+    if not (np.all(np.abs(Kg - P) <= PERMUTATION_TOLERANCE) and np.all(np.abs(P).sum(axis=0) == 1)
+            and np.all(np.abs(P).sum(axis=1) == 1)) or np.all(P == np.diag(np.diag(P))):
+        return ""
+    order = [int(np.argmax(np.abs(P[a]))) for a in range(3)]  # gyro a reads the rotation about axis order[a]
+    reads = ", ".join(f"g{'xyz'[a]} the rotation about {'xyz'[order[a]]}" for a in range(3) if order[a] != a)
+    fix = ", ".join(f"g{'xyz'[b]} ← the column now read as g{'xyz'[order.index(b)]}" for b in range(3))
+    matrix = "[" + ", ".join("[" + ", ".join(f"{v:+.3f}" for v in row) + "]" for row in Kg) + "]"
+    odd = sum(order[a] != a for a in range(3)) == 2  # one exchange of two axes: a mirror
+    return ("they fit best with the gyros reading the accelerometers' axes in another order: " + reads
+            + f" (Kg = {matrix}; the signs this search finds are not reliable). The log's gyro columns are in another "
+            "order than --columns takes them, or its accelerometer columns are. Re-import with the gyro columns as "
+            + fix + ", and fit again: its notes name any axis that is still reversed."
+            + (" An exchange of two axes mirrors a triad: if it is the accelerometers' columns that are exchanged, "
+               "exchange those instead (the fit cannot tell which: the poses are fitted by the norm of their specific "
+               "force, the same in a mirror)" if odd else ""))
 
 
 class MovesNotFitted(Exception):
@@ -574,10 +614,13 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
         best, plain = None, None
         groups = Kg_start if isinstance(Kg_start, list) else [Kg_start]
         poor = chi2_distribution.isf(POOR_FIT, max(2 * n_moves - basis.shape[1], 1))
-        for group in groups:  # a later group only where the earlier ones ended with a scale factor far from ±1,
-            # or with misses no noise explains (2·cost = χ² against the predicted noise beyond its POOR_FIT point)
-            if best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF) and \
-                    2.0 * best.cost <= poor:
+        for index, group in enumerate(groups):  # a later group only where the earlier ones ended with a scale
+            # factor far from ±1, or with misses no noise explains (2·cost = χ² against the predicted noise beyond its
+            # POOR_FIT point); the permutations (the last of three groups) only where they ended far from ±1: a real
+            # hand session's moves all miss the POOR_FIT point, and the 40 permutations would cost each such fit
+            # 9 s (the Ferraris session's, 15 s before) to find the gyros as wired
+            near_one = best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF)
+            if near_one and (2.0 * best.cost <= poor or index == PERMUTED_GROUP):
                 break
             for start in np.atleast_3d(group).transpose(2, 0, 1) if np.ndim(group) == 3 else [group]:
                 z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
@@ -620,7 +663,11 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
                 # accelerometers (or an accelerometer against the gyros) sits near Kg_ii = −1, where a start at +1
                 # stops in a local minimum (every move's miss of the order of its angle)
                 starts = [np.stack([unit * np.diag(signs) for signs in SIGN_STARTS], axis=2) for unit in UNIT_STARTS]
+                starts.append(np.stack(PERMUTED_STARTS, axis=2))  # starts[PERMUTED_GROUP]
                 Kg, W = solve(V, starts)
+                permuted = axes_permuted(Kg)
+                if permuted:
+                    raise MovesNotFitted("the moves between poses were left out: " + permuted)
                 continue
             if iteration == 1:
                 V_predicted = V
