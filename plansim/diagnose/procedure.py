@@ -125,9 +125,19 @@ def holdout(fit) -> dict:
     For generalised least squares with covariance V the prediction error of a held-out block s, predicted from the
     fit of all the others (their estimate of z and, through V, their correlated noise), has the closed form
     e_s = (P_ss)⁻¹ (P r)_s with P = V⁻¹ − V⁻¹D (DᵀV⁻¹D)⁺ DᵀV⁻¹ (D the fit's design, r its residuals; the
-    cross-validation residuals of kriging and mixed models, Rao 1973), on the fitted rows. A block whose P_ss is
-    singular (the segment alone identifies a combination) and a pose placed by hand (its tilt is fitted from it
-    alone) cannot be held out; they are counted.
+    cross-validation residuals of kriging and mixed models, Rao 1973), on the fitted rows.
+
+    Where P_ss is singular, the segment is the only one to inform some combination: a pose placed by hand (its two
+    tilts are fitted from it alone), or the only segment to identify a combination of parameters. Such a segment is
+    predicted with that combination refitted to it: with L_s the segment's rows of it, P_ss = P⁰_ss (I − H), H the
+    hat matrix of L_s under Cov = (P⁰_ss)⁻¹ (P⁰ from the design without it), so the prediction error solves
+    P_ss e = (P r)_s up to a multiple of L_s, which spans P_ss's null space. The channels that L_s takes up (their
+    leverage, the squared norm of their row of P_ss's null-space basis, above :data:`HOLDOUT_LEVERAGE`: a pose's
+    two tilts take up the two accelerometers across gravity) are not held out; on the others (the accelerometer
+    along gravity, the norm of the specific force, and the gyros) e is taken orthogonal to that null space, which
+    differs from the deletion's (orthogonal in the metric P⁰_ss) only by the L_s share of those channels, at most
+    their leverage. A segment with no channel left, or with P_ss not positive semi-definite to round-off, is counted
+    as not held out.
     """
     S = fit.observed.shape[0]
     rows = np.asarray(fit.rows, dtype=bool)
@@ -144,21 +154,45 @@ def holdout(fit) -> dict:
     Pr = P @ r
     segment_of = index // 6
     errors = np.full((S, 6), np.nan)
-    skipped = 0
-    placed = set(getattr(fit, "placed", ()) or ())
+    skipped = partial = 0
     for s in range(S):
         block = np.flatnonzero(segment_of == s)
         if block.size == 0:
             continue
-        Pss = P[np.ix_(block, block)]
-        values = np.linalg.eigvalsh(Pss)
-        if int(fit.used[s]) in placed or values.min() <= 1e-9 * max(values.max(), 1e-300):
+        values, vectors = np.linalg.eigh(0.5 * (P[np.ix_(block, block)] + P[np.ix_(block, block)].T))
+        top = max(float(values.max()), 1e-300)
+        # 1 − h along each direction: its prediction's variance from the others is the noise's / (1 − h)
+        own = np.einsum("ik,ij,jk->k", vectors, V[np.ix_(block, block)], vectors)
+        null = values * own <= HOLDOUT_PREDICTED
+        if values.min() < -HOLDOUT_NULL * top * 1e3 or null.all():
             skipped += 1
             continue
-        errors[s, index[block] % 6] = np.linalg.solve(Pss, Pr[block])
+        range_ = ~null
+        error = vectors[:, range_] @ ((vectors[:, range_].T @ Pr[block]) / values[range_])
+        held = np.sum(vectors[:, null] ** 2, axis=1) <= HOLDOUT_LEVERAGE
+        if not held.any():
+            skipped += 1
+            continue
+        partial += int(null.any())
+        errors[s, index[block[held]] % 6] = error[held]
     rms = {name: (float(np.sqrt(np.nanmean(errors[:, c] ** 2))) if np.any(np.isfinite(errors[:, c])) else math.nan)
            for c, name in enumerate(CHANNELS)}
-    return {"rms": rms, "skipped": skipped, "scheme": "leave one segment out (GLS cross-validation residuals)"}
+    return {"rms": rms, "skipped": skipped, "partial": partial,
+            "scheme": "leave one segment out (GLS cross-validation residuals; where a segment alone informs a "
+                      "combination, such as a hand-placed pose's tilt, that is refitted to it and the channels it "
+                      "takes up are not held out)"}
+
+
+#: a channel of a segment that the combinations only that segment informs take up by more than this share (its
+#: leverage) is not held out
+HOLDOUT_LEVERAGE = 0.5
+#: a negative eigenvalue of P_ss beyond 1000 times this fraction of its largest: P_ss is not positive semi-definite
+#: to round-off, and the segment is not held out
+HOLDOUT_NULL = 1e-9
+#: a direction of a segment whose prediction from the others has more than 1/this times the variance of the segment's
+#: own noise along it (1 − h below this: the leverage of ordinary least squares above 0.9) is taken as informed by
+#: that segment alone, refitted to it, not predicted
+HOLDOUT_PREDICTED = 0.1
 
 
 #: the between-segment noise a fit takes up is reported as excess scatter (``unexplained["excess_scatter"]``) where its

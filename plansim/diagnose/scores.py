@@ -566,8 +566,8 @@ def outlier_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     """The columns (6S, m) of one segment's mean off the model in one channel: for channel c and segment s, 1 on
     c's fitted row of s alone; and each column's (channel, segment, segment) (indices into the fit's segments).
     A channel left out of the step test (its means' noise an undithered quantiser's, :data:`UNDITHERED_SHARE`) is
-    left out here too. A segment the base model needs to identify a combination (one that cannot be held out) has
-    a column the base model spans, and :meth:`_Geometry.surviving` drops it."""
+    left out here too. A segment the base model needs to identify a combination (what the held-out check does not
+    hold out) has a column the base model spans, and :meth:`_Geometry.surviving` drops it."""
     rows = np.asarray(fit.fitted_rows, dtype=bool)
     S = rows.shape[0]
     excluded = undithered_channels(fit)

@@ -184,10 +184,11 @@ def diagnose_report(d) -> str:
         info = d.information[label]
         lines.append(f"chi2/dof {label}: {_g(ratio, 4)} (AIC {_g(info['aic'], 5)}, BIC {_g(info['bic'], 5)}: "
                      "information only)")
-    skipped = d.holdout["before"]["skipped"]
+    skipped, partial = d.holdout["before"]["skipped"], d.holdout["before"].get("partial", 0)
     lines.append(f"held out: {d.holdout['after']['scheme']}" + (
-        f"; {skipped} of {d.before.observed.shape[0]} segments cannot be held out (a pose placed by hand, or the "
-        "only segment to identify a combination)" if skipped else ""))
+        f"; {partial} of {d.before.observed.shape[0]} segments held out in part (a pose placed by hand, or the only "
+        "segment to identify a combination)" if partial else "") + (
+        f"; {skipped} of {d.before.observed.shape[0]} segments cannot be held out at all" if skipped else ""))
     moved = absorbed(d)
     if d.selected:
         lines += ["", "Parameters that absorbed the effect (moved by more than their u): "
