@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from plansim.estimate.frozen import FROZEN_PRIOR_RATE, equal_runs, frozen_runs, run_rate
+from plansim.estimate.frozen import FROZEN_PRIOR_RATE, equal_runs, frozen_runs, repeated_rows, run_rate
 from plansim.estimate.segmentation import resolution, segment_log
 from plansim.io.log_import import import_log
 
@@ -117,7 +117,9 @@ def test_no_frozen_stretch_in_quantised_hand_sessions(ratio):
         s = hand_session(consumer_unit(seed), spread_poses(24, seed=seed), sample_rate=FS, seed=seed,
                          gyro_noise=1.2e-3, accel_noise=1.4e-2, gyro_step=1.2e-3 / ratio, accel_step=1.4e-2 / ratio,
                          tremor=(1e-2, 5.0) if seed % 2 else (0.0, 0.0))
-        assert segment_log(s.samples, s.time, FS).frozen == (), (ratio, seed)
+        result = segment_log(s.samples, s.time, FS)
+        assert result.frozen == (), (ratio, seed)
+        assert repeated_rows(s.samples, [(p.start, p.stop) for p in result.of_kind("static")]) is None, (ratio, seed)
 
 
 def test_a_channel_that_sits_on_one_code_at_rest_is_not_tested():
@@ -153,3 +155,37 @@ def test_the_real_session_has_none_and_a_frozen_accelerometer_in_it_is_named_by_
             assert start + segment.samples <= 599 or start >= 800, segment.label
         start += segment.samples
     assert len(result.segmentation.of_kind("static")) == len(clean.segmentation.of_kind("static")) + 1
+
+
+def test_rows_that_repeat_the_row_before_are_counted_against_chance(tmp_path):
+    """The Ferraris session: no row repeats the one before in all six channels (chance gives 0.7 over its 10 376
+    rows). With 30 rows copied from the row before (a link repeating its last packet), or written at twice its rate
+    (every row twice), the import warns `repeated_rows`, with the count and what chance gives; a few copies
+    (chance's Poisson tail above 1e-6) are not reported."""
+    log = REAL / "example_ferraris_session.csv"
+    if not log.is_file():
+        pytest.skip(f"the shared real data example_ferraris_session.csv is not beside the repository ({REAL})")
+    columns = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
+    lines = log.read_text().splitlines()
+    rows = lines[1:]
+    rng = np.random.default_rng(2)
+    copied = sorted(rng.choice(np.arange(1, len(rows)), 30, replace=False).tolist())
+    bad = list(rows)
+    for k in copied:
+        bad[k] = ",".join([rows[k].split(",")[0]] + rows[k - 1].split(",")[1:])
+    path = tmp_path / "copies.csv"
+    path.write_text("\n".join([lines[0]] + bad) + "\n")
+    result = import_log(path, columns=columns, units="deg/s,m/s^2", sample_rate=102.4)
+    (warning,) = [w for w in result.warnings if w.name == "repeated_rows"]
+    assert warning.message.startswith("30 row(s) (0.29 % of the log) repeat the row before in all six channels, "
+                                      "where chance gives 0.")
+    assert f"on line(s) {copied[0] + 2}, " in warning.message
+    twice = tmp_path / "twice.csv"
+    doubled = [",".join([str(i)] + row.split(",")[1:]) for i, row in enumerate(r for r in rows for _ in range(2))]
+    twice.write_text("\n".join([lines[0]] + doubled) + "\n")
+    result = import_log(twice, columns=columns, units="deg/s,m/s^2", sample_rate=204.8)
+    assert [w.message.split(" row(s)")[0] for w in result.warnings if w.name == "repeated_rows"] == ["10376"]
+    x = np.loadtxt(log, delimiter=",", skiprows=1)[:, 1:]
+    few = x.copy()
+    few[[1000, 4000, 7000]] = few[[999, 3999, 6999]]
+    assert repeated_rows(few, [(0, few.shape[0])]) is None

@@ -1,4 +1,5 @@
-"""Frozen channels: one value repeated for longer than the channel's noise allows (step 4c of segmentation).
+"""Frozen channels: one value repeated for longer than the channel's noise allows (step 4c of segmentation); and
+rows that repeat the row before in every channel more often than chance gives (:func:`repeated_rows`).
 
 A sensor that stops updating, or a logger that repeats its last value while the sensor's data do not arrive,
 writes one value over and over. Not at a rail (that is saturation, step 10), the stretch looks like the
@@ -130,3 +131,48 @@ def frozen_mask(n: int, frozen: list[Frozen], channels=range(6)) -> np.ndarray:
         if f.channel in channels:
             mask[f.start:f.stop] = True
     return mask
+
+
+#: a log's rows that repeat the row before in every channel are reported where so many or more would come by chance
+#: with at most this probability (Poisson, at the rate the static poses' channels repeat a value independently)
+REPEATED_ROWS_PROBABILITY = 1e-6
+
+
+@dataclass(frozen=True)
+class RepeatedRows:
+    """Rows (indices) that repeat the row before in every channel, and how many chance would give."""
+
+    rows: tuple[int, ...]
+    expected: float
+
+
+def repeated_rows(x: np.ndarray, rests: list[tuple[int, int]]) -> RepeatedRows | None:
+    """The rows of *x* equal to the row before in every channel, where more of them are found than chance allows.
+
+    A logger that writes a row when its sensors have no new sample repeats the last one (a wireless link, a host
+    polling faster than the sensor, a log written at twice its sensor's rate). One such row is not a frozen stretch
+    (:func:`frozen_runs`: a channel held for longer than its noise allows), but many are: the noise's samples are
+    then not the rows, and a time column stamps copies. Chance: in the static spans, channel c repeats its previous
+    value with probability p_c (with one added to the count and to the pairs); the channels' noise is independent,
+    so a whole row repeats with probability Π p_c, and over the log's n − 1 pairs the count is Poisson with mean
+    (n − 1)·Π p_c. Reported where the count found is at least 3 and has a Poisson upper tail of at most
+    :data:`REPEATED_ROWS_PROBABILITY`; else None.
+    """
+    from scipy.stats import poisson
+
+    n = x.shape[0]
+    if n < 2:
+        return None
+    same = np.all(np.diff(x, axis=0) == 0, axis=1)
+    found = int(np.count_nonzero(same))
+    if found < 3:
+        return None
+    chance = 1.0
+    for c in range(x.shape[1]):
+        equal = sum(int(np.count_nonzero(np.diff(x[a:b, c]) == 0)) for a, b in rests)
+        pairs = sum(max(b - a - 1, 0) for a, b in rests)
+        chance *= (equal + 1) / (pairs + 2)
+    expected = (n - 1) * chance
+    if poisson.sf(found - 1, expected) > REPEATED_ROWS_PROBABILITY:
+        return None
+    return RepeatedRows(tuple((np.flatnonzero(same) + 1).tolist()), expected)

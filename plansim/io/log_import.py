@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from plansim.estimate.frozen import repeated_rows
 from plansim.estimate.segmentation import (
     APPROXIMATE_TILT,
     AXES,
@@ -73,7 +74,7 @@ FULL_SCALE_EXCEEDED = 0.02
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
-                 "units_disagree", "frozen")
+                 "units_disagree", "frozen", "repeated_rows")
 #: up to this many glitch rows are listed by line in the warning
 GLITCHES_LISTED = 10
 #: up to this many frozen stretches are listed in the warning
@@ -378,6 +379,17 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                              f"logger repeating its last value): {listed}. Kept in the recording as "
                                              "logged, but in no static pose (a pose is cut around each), and a turn "
                                              "across a frozen gyro is a move"))
+    repeated = repeated_rows(samples, [(span.start, span.stop) for span in segmentation.of_kind("static")])
+    if repeated is not None:
+        rows = repeated.rows
+        listed = ", ".join(str(table.lines[k]) for k in rows[:GLITCHES_LISTED]) + (", …" if len(rows) >
+                                                                                   GLITCHES_LISTED else "")
+        warnings.append(LogWarning("repeated_rows", f"{len(rows)} row(s) ({100.0 * len(rows) / n:.2g} % of the log) "
+                                   f"repeat the row before in all six channels, where chance gives "
+                                   f"{repeated.expected:.2g} (the static poses' channels repeating a value "
+                                   "independently), on line(s) " + listed + ": a logger writing rows when its "
+                                   "sensors had no new sample (a log written faster than its sensors, a link "
+                                   "repeating its last packet)? Kept as logged: such rows are copies, not new samples"))
     for episode in _saturation_episodes(segmentation.saturation, SATURATION_EPISODE_WINDOWS * segmentation.window):
         c, start, stop = episode[0].channel, episode[0].start, max(s.stop for s in episode)
         first, last = table.lines[start], table.lines[stop - 1]
