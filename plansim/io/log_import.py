@@ -75,7 +75,7 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree", "frozen", "repeated_rows")
-#: up to this many glitch rows are listed by line in the warning
+#: up to this many glitch rows (or repeated rows) are listed by line in the warning
 GLITCHES_LISTED = 10
 #: up to this many frozen stretches are listed in the warning
 FROZEN_LISTED = 6
@@ -119,6 +119,12 @@ class ImportResult:
     offset: tuple[float, ...] | None = None  # counts at zero input (--offset), or None
     #: the channels read reversed (a leading '-' in ``columns``: an axis whose sign the log has the other way)
     reversed_channels: tuple[str, ...] = ()
+
+
+def _lines_listed(table: LogTable, rows) -> str:
+    """The file lines of the log's *rows*, the first :data:`GLITCHES_LISTED` of them, for a warning."""
+    return ", ".join(str(table.lines[k]) for k in rows[:GLITCHES_LISTED]) + (", …" if len(rows) > GLITCHES_LISTED
+                                                                              else "")
 
 
 def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = None, time_column: str | None = None,
@@ -360,8 +366,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                          f"accelerometer columns, units or scale right? (read as {unit_text})")
     if segmentation.glitches:
         rows = segmentation.glitches
-        listed = ", ".join(str(table.lines[k]) for k in rows[:GLITCHES_LISTED]) + (", …" if len(rows) >
-                                                                                   GLITCHES_LISTED else "")
+        listed = _lines_listed(table, rows)
         warnings.append(LogWarning("glitch", f"{len(rows)} isolated glitch row(s) (all six channels exactly 0, or "
                                              "a sample far off both its neighbours), on line(s) " + listed + ": kept "
                                              "in the recording as logged, but in no static pose (a pose is cut or "
@@ -382,8 +387,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     repeated = repeated_rows(samples, [(span.start, span.stop) for span in segmentation.of_kind("static")])
     if repeated is not None:
         rows = repeated.rows
-        listed = ", ".join(str(table.lines[k]) for k in rows[:GLITCHES_LISTED]) + (", …" if len(rows) >
-                                                                                   GLITCHES_LISTED else "")
+        listed = _lines_listed(table, rows)
         warnings.append(LogWarning("repeated_rows", f"{len(rows)} row(s) ({100.0 * len(rows) / n:.2g} % of the log) "
                                    f"repeat the row before in all six channels, where chance gives "
                                    f"{repeated.expected:.2g} (the static poses' channels repeating a value "

@@ -184,7 +184,7 @@ def diagnose_report(d) -> str:
         info = d.information[label]
         lines.append(f"chi2/dof {label}: {_g(ratio, 4)} (AIC {_g(info['aic'], 5)}, BIC {_g(info['bic'], 5)}: "
                      "information only)")
-    skipped, partial = d.holdout["before"]["skipped"], d.holdout["before"].get("partial", 0)
+    skipped, partial = d.holdout["before"]["skipped"], d.holdout["before"]["partial"]
     lines.append(f"held out: {d.holdout['after']['scheme']}" + (
         f"; {partial} of {d.before.observed.shape[0]} segments held out in part (a pose placed by hand, or the only "
         "segment to identify a combination)" if partial else "") + (
