@@ -64,6 +64,11 @@ QUANTISATION_PRINTED = 5e-3
 #: the drop in χ² for which the Allan fit takes a bias-instability or random-walk term (per term); calibrated by
 #: simulation (tests/test_fit.py): pure white noise in 21 segments of 3000 samples gets one in 0.9 % of 1000 channels
 TERM_THRESHOLD = 13.0
+#: the lags searched for noise correlated from one sample to the next (:func:`noise_autocorrelation`)
+CORRELATION_LAGS = 64
+#: a lag counts as correlated where |ρ_k| exceeds this many standard errors 1/√(pairs); the run must start at lag
+#: one, which white noise passes in 6e-5 of channels (two-sided)
+CORRELATION_Z = 4.0
 #: the harmonics in the table angle removed from a turning segment before its scatter is taken
 TURNING_HARMONICS = 2
 
@@ -139,6 +144,58 @@ def pooled_allan_variance(records) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return tau, avar, dof
 
 
+def noise_autocorrelation(records, step: float = 0.0) -> np.ndarray:
+    """The correlation of a channel's noise from one sample to the next, where the data show one: ρ_1 … ρ_L.
+
+    Each record (a static segment) is taken about its own straight line (a slow drift is not the correlation
+    looked for), and the autocorrelation at lag k is pooled over the records:
+    ρ_k = Σ_records Σ_i r_i r_{i+k} / Σ_records Σ_i r_i², k = 1 … :data:`CORRELATION_LAGS`. White noise gives
+    ρ_k ≈ 0 with standard error 1/√(pairs at lag k); L is the number of leading lags whose |ρ_k| exceeds
+    :data:`CORRELATION_Z` such errors. A sensor's own low-pass filter (a MEMS part's digital filter, a log resampled
+    by its host) makes L ≥ 1; a white channel gives L = 0 (an empty array) in all but 6e-5 of channels.
+
+    Two kinds of correlation are not a filter's, and give an empty array:
+
+    - correlation over all :data:`CORRELATION_LAGS` lags: slow noise (a drift that is not a straight line, a bias
+      instability), which the Allan fit's B and K describe;
+    - a quantised channel (*step* > 0) whose samples scatter no more than half a step (as samples on two codes at
+      most do): a level that wanders near a code boundary makes runs of one code then of the other, correlated
+      as long as the wander is, whatever the noise before the quantiser.
+
+    Parameters
+    ----------
+    records : iterable of (values, sample_rate)
+        As :func:`pooled_allan_variance` takes them.
+    step : float, optional
+        The channel's quantisation step (0: not quantised), its unit.
+
+    Returns
+    -------
+    (L,) ndarray
+        ρ_1 … ρ_L, dimensionless; empty where the noise shows no correlation.
+    """
+    products = np.zeros(CORRELATION_LAGS + 1)
+    pairs = np.zeros(CORRELATION_LAGS + 1)
+    for values, _rate in records:
+        x = np.asarray(values, dtype=float)
+        n = x.size
+        if n < 8:
+            continue
+        t = np.arange(n) - (n - 1) / 2.0
+        r = x - x.mean() - t * (t @ x) / (t @ t)
+        lags = min(CORRELATION_LAGS, n // 4)
+        for k in range(lags + 1):
+            products[k] += r[: n - k] @ r[k:]
+            pairs[k] += n - k
+    if not products[0] > 0 or (step > 0 and products[0] / pairs[0] <= (step / 2.0) ** 2):
+        return np.zeros(0)
+    rho = products[1:] / products[0]
+    significant = (np.abs(rho) > CORRELATION_Z / np.sqrt(np.maximum(pairs[1:], 1.0))) & (pairs[1:] > 0)
+    if np.all(significant):
+        return np.zeros(0)
+    return rho[:int(np.argmin(significant))]
+
+
 def allan_model(tau, white: float, bias_instability: float, rate_random_walk: float) -> np.ndarray:
     """σ_A²(τ) = N²/τ + (2 ln 2/π)B² + K²τ/3 (IEEE Std 952, Annex C)."""
     tau = np.asarray(tau, dtype=float)
@@ -164,7 +221,7 @@ def _weighted_nnls(basis: np.ndarray, avar: np.ndarray, dof: np.ndarray) -> tupl
 
 
 def fit_allan(tau: np.ndarray, avar: np.ndarray, dof: np.ndarray,
-              threshold: float | None = None) -> tuple[float, float, float]:
+              threshold: float | None = None, filter_term: int = 0) -> tuple[float, float, float]:
     """N, B, K ≥ 0 of :func:`allan_model` by weighted non-negative least squares on σ_A²(τ).
 
     White noise N is always fitted. Bias instability B and random walk K enter only where the data ask
@@ -172,16 +229,27 @@ def fit_allan(tau: np.ndarray, avar: np.ndarray, dof: np.ndarray,
     *threshold* (default :data:`TERM_THRESHOLD`, calibrated by simulation to add a term to pure white noise
     in about 1 % of channels: docs/fitting.md). Otherwise a non-negative fit always finds a little B or
     K in the scatter of the long-τ points and inflates every segment mean's variance.
+
+    *filter_term* (+1 or −1; 0: none) adds to the white noise the term ∓D/τ², D ≥ 0, that noise correlated over
+    L samples has beyond them: for an autocovariance γ_k that vanishes beyond lag L, the Allan variance at
+    τ = m samples, m > L, is exactly S/m − 3·Σ_k k·γ_k/m² (S = Σ_k γ_k over all lags, the white level N² per
+    unit of sample rate; the expansion of the variance of two adjacent means of m samples). A low-pass filter
+    (Σ k·γ_k > 0) puts σ_A² below the white slope: +1. Without the term, the fit lowers N and reads the
+    difference as a B that is not there. Fit only τ beyond the correlation (:func:`noise_autocorrelation`).
     """
     threshold = TERM_THRESHOLD if threshold is None else threshold
+    if filter_term not in (-1, 0, 1):
+        raise ValueError(f"filter_term: expected -1, 0 or +1, got {filter_term!r}")
     tau, avar, dof = (np.asarray(x, dtype=float) for x in (tau, avar, dof))
     if tau.size == 0:
         return math.nan, math.nan, math.nan
-    columns = {"N": 1.0 / tau, "B": np.full_like(tau, FLICKER_VARIANCE), "K": tau / 3.0}
-    chosen = ["N"]
-    coefficients, chi2 = _weighted_nnls(columns["N"][:, None], avar, dof)
+    columns = {"N": 1.0 / tau, "B": np.full_like(tau, FLICKER_VARIANCE), "K": tau / 3.0,
+               "F": -float(filter_term) / tau**2}
+    base = ["N", "F"] if filter_term else ["N"]
+    chosen = base
+    coefficients, chi2 = _weighted_nnls(np.column_stack([columns[t] for t in base]), avar, dof)
     for extra in (["B"], ["K"], ["B", "K"]):
-        trial = ["N"] + extra
+        trial = base + extra
         if len(tau) <= len(trial):
             continue
         c, x2 = _weighted_nnls(np.column_stack([columns[t] for t in trial]), avar, dof)
@@ -189,6 +257,39 @@ def fit_allan(tau: np.ndarray, avar: np.ndarray, dof: np.ndarray,
             chosen, coefficients, chi2 = trial, c, x2
     values = dict(zip(chosen, coefficients))
     return tuple(float(math.sqrt(max(values.get(t, 0.0), 0.0))) for t in ("N", "B", "K"))
+
+
+#: the Allan fit of correlated noise needs at least this many octaves beyond the correlation (N, the filter's term
+#: and one more to test B or K against)
+ALLAN_MIN_POINTS = 4
+
+
+def fit_static_allan(records, tau: np.ndarray, avar: np.ndarray, dof: np.ndarray, step: float = 0.0,
+                     correlation_records=None):
+    """N, B, K of a channel from its static records' pooled Allan variance, fitted beyond the noise's correlation.
+
+    Where the records show noise correlated over L samples (:func:`noise_autocorrelation`; *step*: the channel's
+    quantisation step, 0 if none), the fit takes only
+    τ ≥ m₀ samples, m₀ the smallest power of two above L, and the filter's term D/τ² (:func:`fit_allan`), which is
+    exact there; elsewhere (white noise, or fewer than :data:`ALLAN_MIN_POINTS` octaves beyond the correlation)
+    every τ. *correlation_records* (default *records*): the records the correlation is read from — the quiet
+    static segments, where a hand's tremor in the others would read as a filter (its correlation oscillates at
+    the tremor's period).
+
+    Returns
+    -------
+    (N, B, K), rho, start
+        :func:`fit_allan`'s outcome; ρ_1 … ρ_L (empty: white); the shortest τ fitted, s.
+    """
+    rho = noise_autocorrelation(records if correlation_records is None else correlation_records, step)
+    if rho.size:
+        rate = float(np.median([r for _x, r in records]))
+        m0 = 2.0 ** math.ceil(math.log2(rho.size + 1))
+        keep = tau * rate >= m0 * (1.0 - 1e-9)
+        if np.count_nonzero(keep) >= ALLAN_MIN_POINTS:
+            sign = 1 if float(np.arange(1, rho.size + 1) @ rho) >= 0 else -1
+            return fit_allan(tau[keep], avar[keep], dof[keep], filter_term=sign), rho, float(tau[keep][0])
+    return fit_allan(tau, avar, dof), rho, float(tau[0])
 
 
 def quantisation_step(segments: list[np.ndarray]) -> float:
@@ -554,6 +655,10 @@ class ChannelNoise:
     tau: np.ndarray = field(repr=False)
     adev: np.ndarray = field(repr=False)
     dof: np.ndarray = field(repr=False)
+    #: ρ_1 … ρ_L of the static noise where it is correlated from sample to sample (:func:`noise_autocorrelation`)
+    autocorrelation: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    #: the shortest τ the Allan fit took, s (:func:`fit_static_allan`)
+    allan_start: float = math.nan
 
     @property
     def kind(self) -> str:
@@ -790,19 +895,33 @@ def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_wh
     for c, name in enumerate(CHANNELS):
         step = steps[c]
         # the Allan deviation of the static segments, without those that scatter more than the channel's quiet ones
-        flagged = _noisier_segments(within[:, c], within_dof, static, step) if noisier else []
+        noisier_ones = _noisier_segments(within[:, c], within_dof, static, step)
+        flagged = noisier_ones if noisier else []
         pooled_from = [k for k in static if k not in flagged]
-        tau, avar, dof = pooled_allan_variance([(segment_samples[k][:, c], segments[k].sample_rate)
-                                                for k in pooled_from])
+        records = [(segment_samples[k][:, c], segments[k].sample_rate) for k in pooled_from]
+        tau, avar, dof = pooled_allan_variance(records)
+        rho, start = np.zeros(0), math.nan
         if tau.size:
-            white, bias_instability, random_walk = fit_allan(tau, avar, dof)
+            # the sensor's filter is seen in the quiet segments: a hand's tremor in the others is not the sensor's
+            quiet = [(segment_samples[k][:, c], segments[k].sample_rate) for k in static if k not in noisier_ones]
+            (white, bias_instability, random_walk), rho, start = fit_static_allan(records, tau, avar, dof, step,
+                                                                                   quiet)
+            if rho.size:
+                rate_k = float(np.median([r for _x, r in records]))
+                notes.append(f"{name}: its noise is correlated over {rho.size} sample(s) (lag-one autocorrelation "
+                             f"{rho[0]:.2f}: the sensor's own filter, or a log resampled by its host): the Allan fit "
+                             f"starts at tau = {start:.4g} s ({start * rate_k:.0f} samples), with the filter's term "
+                             "(docs/fitting.md)" if start > tau[0] else
+                             f"{name}: its noise is correlated over {rho.size} sample(s) (lag-one autocorrelation "
+                             f"{rho[0]:.2f}), but too few octaves of the Allan deviation lie beyond it: fitted from "
+                             "one sample, where a filter reads as bias instability (docs/fitting.md)")
         else:
             tau = avar = dof = np.zeros(0)
             white = bias_instability = random_walk = math.nan
         shaken[flagged, c] = True
         channels.append(ChannelNoise(name, white, bias_instability, random_walk, step, len(pooled_from),
                                      int(sum(segment_samples[k].shape[0] for k in pooled_from)), tau,
-                                     np.sqrt(avar), dof))
+                                     np.sqrt(avar), dof, rho, start))
         if flagged:
             quiet = math.sqrt(sum(within[k, c] ** 2 * within_dof[k] for k in pooled_from)
                               / sum(within_dof[k] for k in pooled_from))

@@ -43,7 +43,11 @@ def fit_json(result: FitResult) -> dict:
                       "bias_instability_unit": units["bias_instability"],
                       "rate_random_walk": _number(ch.rate_random_walk),
                       "rate_random_walk_unit": units["rate_random_walk"],
-                      "quantisation_step": _number(ch.quantisation_step), "quantisation_step_unit": units["mean"]})
+                      "quantisation_step": _number(ch.quantisation_step), "quantisation_step_unit": units["mean"],
+                      # the noise's correlation from sample to sample (a sensor's filter; docs/fitting.md)
+                      "correlated_lags": int(ch.autocorrelation.size),
+                      "lag_one_autocorrelation": _number(ch.autocorrelation[0]) if ch.autocorrelation.size else 0.0,
+                      "allan_fit_from": _number(ch.allan_start), "allan_fit_from_unit": "s"})
     between = result.between_noise
     if between is not None:
         for c, entry in enumerate(noise):  # the segment means' noise beyond the within-segment model (docs/fitting.md)
@@ -141,6 +145,11 @@ def fit_dataset(result: FitResult) -> xr.Dataset:
                                   {"long_name": long_name,
                                    "units": "; ".join(f"{ch.channel}: {ch.units().get(field, ch.units()['mean'])}"
                                                       for ch in result.noise.channels)})
+    data["noise_correlated_lags"] = ("channel", np.array([ch.autocorrelation.size for ch in result.noise.channels]),
+                                     {"long_name": "lags over which the static noise is correlated from sample to "
+                                                   "sample (a sensor's own filter; 0: white)", "units": "1"})
+    data["noise_allan_fit_from"] = ("channel", np.array([ch.allan_start for ch in result.noise.channels]),
+                                    {"long_name": "shortest tau of the Allan fit", "units": "s"})
     if result.between_noise is not None:
         data["between_noise_sd"] = ("channel", np.sqrt(result.between_noise.variance),
                                     {"long_name": "noise of the segment means beyond the within-segment model, "
