@@ -16,12 +16,12 @@ from scipy.signal import lfilter
 
 from plansim.estimate.segmentation import (
     DEFAULT_WINDOW,
-    analyse_time,
     moving_mean_variance,
     nearest_axis,
     resolution,
     segment_log,
 )
+from plansim.estimate.timebase import analyse_time
 
 FS = 100.0
 GRAVITY = np.array([0.0, 0.0, 9.81])

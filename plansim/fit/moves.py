@@ -78,7 +78,8 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import chi2 as chi2_distribution
 
-from plansim.estimate.segmentation import GAP_FACTOR, SATURATION_STEP, stuck_runs
+from plansim.estimate.segmentation import SATURATION_STEP, stuck_runs
+from plansim.estimate.timebase import GAP_FACTOR
 from plansim.fit.between import BETWEEN_LR_THRESHOLD
 from plansim.fit.budget import Sources, chi2_verdict, propagate
 from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability

@@ -33,14 +33,12 @@ from plansim.estimate.segmentation import (
     AXES,
     DEFAULT_MIN_STATIC,
     DEFAULT_WINDOW,
-    DROPPED_MAX,
     FULL_SCALE_MARGIN,
     Segmentation,
     Span,
-    TimeReport,
-    analyse_time,
     segment_log,
 )
+from plansim.estimate.timebase import DROPPED_MAX, TimeReport, analyse_time
 from plansim.io.log_pairing import pair_logs, split_interleaved
 from plansim.io.log_table import (
     TIME_UNITS,
