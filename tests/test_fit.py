@@ -659,6 +659,34 @@ def test_a_sensors_low_pass_filter_is_not_read_as_bias_instability(a):
         assert white == pytest.approx(N, rel=0.08)
 
 
+@pytest.mark.parametrize("name", ["butterworth-2", "butterworth-4", "boxcar-8"])
+def test_higher_order_filters_keep_the_white_noise_of_the_same_draws(name):
+    """Filters other than the first-order one the method was derived on (a Butterworth of order 2 at 0.1 of
+    Nyquist, of order 4 at 0.2; a boxcar mean of 8 samples, unit gain at 0 Hz): the fit of the filtered draws gives
+    the N the same draws give unfiltered, within 8 % (measured 0.96-1.04), on 6 seeds. B is another matter on a
+    draw where the white fit itself takes a B at its threshold (seed 0, 1 % of white channels): there the filtered
+    and the white fits may decide differently, so B is compared on the other five."""
+    from scipy.signal import butter, lfilter
+
+    b, a = {"butterworth-2": butter(2, 0.1), "butterworth-4": butter(4, 0.2),
+            "boxcar-8": (np.ones(8) / 8, np.array([1.0]))}[name]
+    gain = np.sum(b) / np.sum(a)
+    agree = 0
+    for seed in range(6):
+        rng = np.random.default_rng(seed)
+        draws = [rng.normal(0.0, 1e-3, 3200) for _ in range(21)]
+        fits = []
+        for records in ([(x[200:], 100.0) for x in draws], [(lfilter(b, a, x)[200:] / gain, 100.0) for x in draws]):
+            tau, avar, dof = pooled_allan_variance(records)
+            fits.append(fit_static_allan(records, tau, avar, dof))
+        (white_n, white_b, _), _, _ = fits[0]
+        (n, bias, _), rho, _ = fits[1]
+        assert rho.size >= 1
+        assert n == pytest.approx(white_n, rel=0.08)
+        agree += (bias > 0) == (white_b > 0)
+    assert agree >= 5
+
+
 def test_a_log_written_at_twice_its_rate_keeps_its_noise():
     """The same white noise logged at 100 Hz and interpolated to 200 Hz (a host resampling its sensor): the
     interpolated log's samples are correlated (ρ₁ ≈ 0.8) but its segment means are the original's, so its noise
