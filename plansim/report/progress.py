@@ -46,10 +46,12 @@ def stderr_progress(label: str = "simulating", unit: str = "trials") -> Progress
         elapsed = time.perf_counter() - start
         rate = done / elapsed if elapsed > 0 else float("nan")
         shown = f"{rate:,.0f}" if rate >= 10 else f"{rate:.1f}"
+        # the line is marked open before it is written: a signal between the write and the mark would otherwise
+        # find it closed, and its message would follow the progress line on the same line
+        mark_progress_line(True)
         if total is None:  # a search: how much is done, not how much is left
             sys.stderr.write(f"\r{label}: {done} {unit} ({shown}/s, {elapsed:4.0f} s)   ")
             sys.stderr.flush()
-            mark_progress_line(True)
             return
         left = (total - done) / rate if rate > 0 else float("nan")
         end = "\n" if done >= total else ""
