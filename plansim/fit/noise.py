@@ -290,6 +290,21 @@ def settling_ratio(values: np.ndarray, sample_rate: float) -> float:
     return max(ratios) if ratios else math.nan
 
 
+def settled_part(values: np.ndarray, sample_rate: float) -> tuple[np.ndarray, float | None]:
+    """The part of a rest from where it has settled: while the record lasts at least :data:`SETTLING_MIN_DURATION`
+    and its :func:`settling_ratio` exceeds :data:`SETTLING_RATIO`, its second half (tested again: a settling slower
+    than the rest is long). Returns that part and the first ratio that exceeded (``None``: the record as given)."""
+    x = np.asarray(values)
+    first = None
+    while x.size >= SETTLING_MIN_DURATION * sample_rate:
+        ratio = settling_ratio(x, sample_rate)
+        if not ratio > SETTLING_RATIO:
+            break
+        first = ratio if first is None else first
+        x = x[x.size // 2:]
+    return x, first
+
+
 #: the Allan fit of correlated noise needs at least this many octaves beyond the correlation (N, the filter's term
 #: and one more to test B or K against)
 ALLAN_MIN_POINTS = 4
@@ -932,27 +947,22 @@ def estimate_noise_models(segment_samples: list[np.ndarray], segments, stated_wh
         records = [(segment_samples[k][:, c], segments[k].sample_rate) for k in pooled_from]
         for i, k in enumerate(pooled_from):  # a long rest that settles (a warm-up): its noise from where it has settled
             x, rate_k = records[i]
-            first = None
-            while x.size >= SETTLING_MIN_DURATION * rate_k:
-                ratio = settling_ratio(x, rate_k)
-                if not ratio > SETTLING_RATIO:
-                    break
-                first = ratio if first is None else first
-                x = x[x.size // 2:]  # and the half left is tested again: a settling slower than the rest is long
+            settled, first = settled_part(x, rate_k)
             if first is not None:
-                records[i] = (x, rate_k)
+                records[i] = (settled, rate_k)
                 notes.append(f"{name}: static segment {k} ({segments[k].label}) settles: its level wanders "
                              f"{first:.3g} times as much in its first half as in its second (Allan variance at a "
                              "sixteenth or an eighth of the half; a warm-up, a unit coming to its temperature): its "
-                             f"noise is taken from its last {x.size / rate_k:.4g} s, and its mean holds the settling "
-                             "(docs/fitting.md)")
+                             f"noise is taken from its last {settled.size / rate_k:.4g} s, and its mean holds the "
+                             "settling (docs/fitting.md)")
         tau, avar, dof = pooled_allan_variance(records)
         rho, start = np.zeros(0), math.nan
         if tau.size:
             # the sensor's filter is seen in the quiet segments: a hand's tremor in the others is not the sensor's
-            quiet = [(segment_samples[k][:, c], segments[k].sample_rate) for k in static if k not in noisier_ones]
+            quiet_records = [(segment_samples[k][:, c], segments[k].sample_rate) for k in static
+                             if k not in noisier_ones]
             (white, bias_instability, random_walk), rho, start = fit_static_allan(records, tau, avar, dof, step,
-                                                                                   quiet)
+                                                                                   quiet_records)
             if rho.size:
                 rate_k = float(np.median([r for _x, r in records]))
                 notes.append(f"{name}: its noise is correlated over {rho.size} sample(s) (lag-one autocorrelation "
