@@ -41,19 +41,21 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    (0.5°) of gravity on each axis (a unit tumbling smoothly can be as quiet as its own quietest stretch,
    but its gravity turns).
 6. **At rest or turning steadily?** The run that holds ``Q`` is at rest. Working outwards from it, each
-   other run is compared with the nearest run at rest *in the same pose* (specific force within
-   ``SAME_POSE``): it is at rest unless its mean gyro output differs from that run's by more than
+   other run is compared with the nearest run at rest. In the same pose (specific force within
+   ``SAME_POSE``) it is at rest unless its mean gyro output differs from that run's by more than
    ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to ±Ω_E on any
    axis, depending on its pose; comparing neighbours, a slow drift of the bias over a long log is not a
    turn); otherwise it is a *steady turn* (a rate table holding a rate), and belongs to the motion around
-   it. Where no rest shares its pose, the gyros' g-sensitivity alone moves their output from pose to pose
+   it. In another pose, the gyros' g-sensitivity alone moves their output from pose to pose
    (up to 0.1 °/s/g for a consumer unit; ``G_SENSITIVITY_ALLOWANCE`` allows twice that): the run is then a
    steady turn only when its output differs from the nearest rest's *along its own gravity* (a table with
    gravity steady turns about the vertical) by more than the threshold there plus that allowance times the
    change of specific force. A turn slower than the threshold cannot be told from rest by any detector
-   without a reference; the threshold is reported. The run taken to be at rest first is ``Q``'s, unless more
-   of the log's quiet samples agree with another run (:func:`_rest_by_agreement`: a table's steady turn is as
-   quiet as a rest, and ``Q`` can fall in one); the gyro bias b is then that run's.
+   without a reference; the threshold is reported. Only the nearest rest is asked: a rest in the same pose
+   long before differs by the bias's drift since. The run taken to be at rest first is ``Q``'s, unless the
+   runs' agreement says otherwise (:func:`_rest_by_agreement`: a table's steady turn is as quiet as a rest, and
+   ``Q`` can fall in one; rests agree across poses, a turn about the vertical does not); the gyro bias b is
+   then that run's.
 6b. **Poses held by hand.** Outside those runs, stretches of at least ``min_static`` where the
    accelerometers pass step 5 and hold one pose while the gyros do not (a hand's tremor: 1 °/s at 5 Hz tilts
    the unit by 0.03°) are poses too, when the attitude the gyros integrate about their mean swings by at
@@ -493,7 +495,9 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         for order in (range(first + 1, len(runs)), range(first - 1, -1, -1)):
             rests = [first] if at_rest[first] else []
             for i in order:
-                at_rest[i] = _at_rest(i, rests, medians, forces, bias, rate_threshold)
+                # against the nearest rest only: a rest in the same pose long before differs by the bias's
+                # drift since, and whether it was asked depended on the order the runs were visited in
+                at_rest[i] = _at_rest(i, rests[:1], medians, forces, bias, rate_threshold)
                 if at_rest[i]:
                     rests.insert(0, i)  # nearest first
     static_runs = [run for run, rest in zip(runs, at_rest) if rest]
@@ -588,35 +592,58 @@ def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span 
 
 def _rest_by_agreement(runs: list[tuple[int, int]], medians: list, forces: list, rate_threshold: np.ndarray,
                        quiet: int) -> int:
-    """The run taken to be at rest first (step 6): the one that the most samples of quiet runs agree with (a run
-    *j* agrees with run *i* when :func:`_at_rest` finds *j* at rest with *i* as the only rest), *quiet* (the run
-    nearest the quiet stretch) where it has as many as any. Where the log's first and last quiet runs agree with
-    each other, only the runs that agree with them are candidates: a log starts and ends at rest.
+    """The run taken to be at rest first (step 6).
 
-    The quiet stretch alone (step 3) cannot tell a rest from a table's steady turn: a table's rate jitter is far
-    below a MEMS gyro's noise, so the two are equally quiet, and a log of rests between table turns had been read
-    with one turn at rest and every rest turning. The rests of a log agree with each other (one bias, up to the
-    g-sensitivity between poses) and a turn agrees only with turns at its own rate, so the rests win wherever they
-    hold more of the log than the turns at any one rate. Where a rate is held longer than all the rests together (a
-    minute at each of ±100 °/s between 10 s rests), the count alone takes that turn for the rest; a log is started
-    and stopped with the unit at rest, so where its two ends agree, the rest is one of the runs agreeing with them
-    (a log that starts and ends in the same steady turn would still be misread; one whose ends differ, recorded
-    into a turn, falls back to the count). Where every run agrees with the quiet one (a log of poses), this is the
-    quiet one."""
+    Two runs *agree* when each is at rest with the other as the only rest (:func:`_at_rest` both ways: the gyro
+    outputs alike in one pose; in two poses, alike along each run's own gravity up to the g-sensitivity). The quiet
+    stretch alone (step 3) cannot tell a rest from a table's steady turn: a table's rate jitter is far below a MEMS
+    gyro's noise, so the two are equally quiet. Three things can, in this order:
+
+    1. **Poses.** Rests in different poses agree with each other, while a turn about the vertical differs from every
+       run in another pose along its own gravity by its rate. So where some run agrees with runs in two or more
+       poses (specific force :data:`SAME_POSE` apart), the candidates are the runs that agree with the most poses. A
+       log that starts and ends in the same steady turn but holds rests in two poses is read right.
+    2. **The log's ends.** In one pose (a rate table's test, every run about one vertical), a log is started and
+       stopped with the unit at rest: where the first and the last quiet runs agree, the candidates are the runs
+       that agree with them (a minute at each of ±100 °/s between 10 s rests: the turns hold more of the log).
+    3. **Samples.** Among the candidates, the run the most quiet samples agree with; *quiet* (the run nearest the
+       quiet stretch) where it has as many as any (a log of poses: every run agrees with it).
+
+    A log in one pose that starts and ends in the same steady turn cannot be told from one at rest throughout its
+    turns without the table's rates; the import warns of a rest turning about the vertical."""
     sizes = np.array([b - a for a, b in runs])
-    agree = [[j for j in range(len(runs)) if _at_rest(j, [i], medians, forces, None, rate_threshold)]
-             for i in range(len(runs))]
+    one_way = [[j for j in range(len(runs)) if _at_rest(j, [i], medians, forces, None, rate_threshold)]
+               for i in range(len(runs))]
+    agree = [[j for j in one_way[i] if i in one_way[j]] for i in range(len(runs))]
+    poses = [len(_pose_clusters([forces[j] for j in agree[i]])) for i in range(len(runs))]
     support = [int(sum(sizes[j] for j in agree[i])) for i in range(len(runs))]
-    candidates = agree[0] if len(runs) > 1 and len(runs) - 1 in agree[0] else list(range(len(runs)))
+    if max(poses) >= 2:
+        candidates = [i for i in range(len(runs)) if poses[i] == max(poses)]
+    elif len(runs) > 1 and len(runs) - 1 in agree[0]:
+        candidates = agree[0]
+    else:
+        candidates = list(range(len(runs)))
     best = max(support[i] for i in candidates)
     if quiet in candidates and support[quiet] == best:
         return quiet
     return min((i for i in candidates if support[i] == best), key=lambda i: abs(i - quiet))
 
 
+def _pose_clusters(forces: list) -> list[np.ndarray]:
+    """The distinct poses among mean specific forces: each force joins the first pose within :data:`SAME_POSE` of
+    it, or starts a new one. Returns one unit vector per pose."""
+    poses: list[np.ndarray] = []
+    for f in forces:
+        up = np.asarray(f, dtype=float) / max(float(np.linalg.norm(f)), 1e-300)
+        if not any(float(np.dot(up, p)) >= math.cos(SAME_POSE) for p in poses):
+            poses.append(up)
+    return poses
+
+
 def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray | None,
              rate_threshold: np.ndarray) -> bool:
-    """Step 6 for run *i*, given the runs found at rest so far (*rests*, nearest first).
+    """Step 6 for run *i*, given the runs at rest it is compared with (*rests*, nearest first: in the walk of step 6
+    the nearest one on the walk's side; for a held pose every rest, by distance in time).
 
     Against the nearest rest in the same pose (specific force within :data:`SAME_POSE` of run i's): at rest
     when the mean gyro outputs agree within *rate_threshold* on every axis, as a bias that drifts slowly
