@@ -256,6 +256,55 @@ def test_a_clean_synthetic_log_and_the_cli(tmp_path, capsys):
     assert "would overwrite the log" in capsys.readouterr().err
 
 
+def test_import_plot_shades_each_segment_and_draws_the_samples_in_their_units(tmp_path, capsys, monkeypatch):
+    """``--plot``: the samples against time, gyros in deg/s and accelerometers in m/s^2, one shaded span per
+    segment in its kind's colour on both panels, written with the recording; a bad figure name writes nothing."""
+    from matplotlib.colors import to_rgba
+
+    from plansim.report.plot import SEGMENT_SHADES, draw_recording, pyplot, segment_kind
+
+    t, x = synthetic_log()
+    log = tmp_path / "log.csv"
+    write_synthetic(log, t, x)
+    out, figure = tmp_path / "rec.nc", tmp_path / "segments.png"
+    assert main(["import", str(log), "--out", str(out), "--time", "time", "--plot", str(figure)]) == 0
+    assert "wrote figure" in capsys.readouterr().out
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    recording = read_recording(out)
+    fig, (gyros, accels) = draw_recording(recording)
+    try:
+        kinds = [segment_kind(s) for s in recording.schedule.segments]
+        assert kinds == ["static", "rotation", "static"]
+        for ax in (gyros, accels):
+            shades = [p for p in ax.patches if p.get_alpha() is not None and p.get_alpha() < 0.2]
+            assert len(shades) == len(kinds)
+            for patch, kind in zip(shades, kinds):
+                assert patch.get_facecolor()[:3] == pytest.approx(to_rgba(SEGMENT_SHADES[kind])[:3])
+        # the lines are the samples in the panel's unit: the turn's peak in deg/s, gravity in m/s^2
+        peak = max(float(np.max(np.abs(line.get_ydata()))) for line in gyros.get_lines())
+        assert peak == pytest.approx(math.degrees(float(np.max(np.abs(recording.samples[:, :3])))), rel=1e-12)
+        gravity = max(float(np.max(np.abs(line.get_ydata()))) for line in accels.get_lines())
+        assert gravity == pytest.approx(float(np.max(np.abs(recording.samples[:, 3:]))), rel=1e-12)
+    finally:
+        pyplot().close(fig)
+    # a long recording is drawn as each channel's envelope over bins: its extremes are the samples' own
+    import plansim.report.plot as plot_module
+
+    monkeypatch.setattr(plot_module, "ENVELOPE_ABOVE", 200)
+    fig, (gyros, _accels) = draw_recording(recording)
+    try:
+        assert not gyros.get_lines() and len(gyros.collections) == 3
+        top = max(float(np.max(np.abs(c.get_paths()[0].vertices[:, 1]))) for c in gyros.collections)
+        assert top == pytest.approx(math.degrees(float(np.max(np.abs(recording.samples[:, :3])))), rel=1e-12)
+    finally:
+        pyplot().close(fig)
+    # a figure format it cannot write: an error before anything is written
+    assert main(["import", str(log), "--out", str(tmp_path / "b.nc"), "--time", "time", "--plot",
+                 str(tmp_path / "b.txt")]) == 2
+    assert "--plot" in capsys.readouterr().err
+    assert not (tmp_path / "b.nc").exists() and not (tmp_path / "b.txt").exists()
+
+
 def test_a_temperature_column_becomes_the_temperature_channel(tmp_path):
     t, x = synthetic_log()
     temperature = 25.0 + 0.001 * np.arange(t.size)

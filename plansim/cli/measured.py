@@ -7,6 +7,7 @@ import os
 
 from plansim.cli.common import COMMANDS
 from plansim.io.files import OutputSet, check_output_path
+from plansim.report.plot import FIGURE_SUFFIXES
 
 
 def _cmd_import(args) -> int:
@@ -17,6 +18,8 @@ def _cmd_import(args) -> int:
 
     target = check_output_path(args.out, "--out", (".nc", ".csv"))
     outputs = [target]
+    if args.plot is not None:
+        outputs.append(check_output_path(args.plot, "--plot", FIGURE_SUFFIXES))
     if target.suffix.lower() == ".csv":  # the segment table is written beside the samples
         outputs.append(check_output_path(segment_table_path(target), "--out's segment table"))
     for log in (args.log, args.accel_log):
@@ -30,9 +33,18 @@ def _cmd_import(args) -> int:
                         temperature_column=args.temperature_column, temperature=args.temperature,
                         latitude=args.latitude, height=args.height, full_scale=args.full_scale,
                         accel_log=args.accel_log, **options)
-    write_recording(result.recording, args.out)  # whole or not at all
+    with OutputSet() as staged:
+        if args.plot is not None:  # drawn before the recording is written; committed once it is
+            from plansim.report.plot import recording_figure
+
+            recording_figure(result.recording, staged.stage(args.plot, "--plot", FIGURE_SUFFIXES),
+                             format=os.path.splitext(args.plot)[1].lstrip("."))
+        write_recording(result.recording, args.out)  # whole or not at all
+        staged.commit()
     print(format_summary(result))
     print(f"\nwrote recording: {args.out} (review its segment table: docs/measured-data.md)")
+    if args.plot is not None:
+        print(f"wrote figure: {args.plot} (the samples against time, the segments shaded and numbered)")
     return 0
 
 
@@ -88,6 +100,9 @@ def _add_import_command(sub) -> None:
                    help="window of the rest detector (default 0.5 s)")
     p.add_argument("--min-static", type=float, default=None, metavar="S",
                    help="shortest static pose kept (default 1 s)")
+    p.add_argument("--plot", default=None, metavar="FIGURE",
+                   help="also draw the samples against time with the segments found shaded and numbered as in the "
+                        "segment table (.png, .pdf or .svg), to review it by eye")
     p.set_defaults(func=_cmd_import)
 
 

@@ -269,3 +269,89 @@ def sweep_jjf1535_figure(sweep, path: str | os.PathLike, items=None, targets=Non
     fig.suptitle(f"plansim sweep jjf1535 on {sweep.attrs.get('unit_scenario', '?')}: "
                  f"{sweep.attrs.get('trials_per_cell', '?')} trials per cell", fontsize=10)
     save(fig, path, chosen, dpi=110)
+
+
+#: a recording of more samples than this is drawn as each channel's envelope (minimum and maximum) over bins
+ENVELOPE_ABOVE = 20000
+#: the shading of each kind of segment in :func:`recording_figure` (matplotlib colours)
+SEGMENT_SHADES = {"static": "tab:green", "rotation": "tab:blue", "move": "0.6"}
+
+
+def segment_kind(segment) -> str:
+    """The shading kind of a recording's segment: ``"move"`` (the motion between poses, which no estimator uses),
+    ``"rotation"`` (the table turns: a non-zero or unlogged rate) or ``"static"``."""
+    if segment.test == "move":
+        return "move"
+    return "rotation" if segment.is_rotating else "static"
+
+
+def draw_recording(recording, plt=None):
+    """The figure of :func:`recording_figure`, not saved: returns ``(figure, (gyro_axes, accel_axes))``."""
+    from matplotlib.patches import Patch
+
+    from plansim.kernels.layout import CHANNELS
+
+    plt = pyplot() if plt is None else plt
+    time = np.asarray(recording.time, dtype=float)
+    samples = np.asarray(recording.samples, dtype=float)
+    fig, axes = plt.subplots(2, 1, figsize=(13, 6.4), sharex=True, constrained_layout=True)
+    colours = ("tab:red", "tab:green", "tab:blue")
+    for ax, channels, factor, unit in ((axes[0], range(3), 180.0 / math.pi, "deg/s"),
+                                       (axes[1], range(3, 6), 1.0, "m/s^2")):
+        for c, colour in zip(channels, colours):
+            y = samples[:, c] * factor
+            if y.size > ENVELOPE_ABOVE:  # each bin's minimum and maximum: nothing a spike does is hidden
+                bins = math.ceil(y.size / (ENVELOPE_ABOVE // 2))
+                cut = y.size // bins * bins
+                t_bin = time[:cut].reshape(-1, bins).mean(axis=1)
+                lo, hi = y[:cut].reshape(-1, bins).min(axis=1), y[:cut].reshape(-1, bins).max(axis=1)
+                ax.fill_between(t_bin, lo, hi, color=colour, lw=0.4, alpha=0.8, label=CHANNELS[c])
+            else:
+                ax.plot(time, y, color=colour, lw=0.6, label=CHANNELS[c])
+        ax.set_ylabel(f"{'gyros' if unit == 'deg/s' else 'accelerometers'} ({unit})", fontsize=9)
+        ax.tick_params(labelsize=8)
+    first = np.asarray(recording.first_sample)
+    counts = {kind: 0 for kind in SEGMENT_SHADES}
+    numbered = len(recording.schedule) <= 80  # beyond that the numbers overlap; the table has them
+    for k, (start, segment) in enumerate(zip(first, recording.schedule.segments)):
+        kind = segment_kind(segment)
+        counts[kind] += 1
+        stop = min(int(start) + segment.samples, time.size) - 1
+        t0, t1 = float(time[int(start)]), float(time[stop])
+        for ax in axes:
+            ax.axvspan(t0, t1, color=SEGMENT_SHADES[kind], alpha=0.12 if kind != "move" else 0.08, lw=0)
+        if numbered and kind != "move":
+            axes[0].text(0.5 * (t0 + t1), 1.0, str(k), transform=axes[0].get_xaxis_transform(), ha="center",
+                         va="bottom", fontsize=6, color=SEGMENT_SHADES[kind])
+    axes[1].set_xlabel("time (s)", fontsize=9)
+    lines = axes[0].legend(fontsize=8, loc="upper right", ncol=3)
+    axes[0].add_artist(lines)
+    axes[1].legend(fontsize=8, loc="upper right", ncol=3)
+    shades = [Patch(color=SEGMENT_SHADES[k], alpha=0.3, label=f"{k} ({counts[k]})") for k in SEGMENT_SHADES]
+    axes[0].legend(handles=shades, fontsize=8, loc="upper left", ncol=3)
+    fig.suptitle(f"recording: {len(recording.schedule)} segments ({counts['static']} static, {counts['rotation']} "
+                 f"rotation, {counts['move']} move), {time.size} samples; the numbers are the segment table's",
+                 fontsize=10)
+    return fig, tuple(axes)
+
+
+def recording_figure(recording, path: str | os.PathLike, format: str | None = None) -> None:
+    """A recording's samples against time with its segments shaded, for reviewing the segment table that
+    ``plansim import`` found (docs/measured-data.md).
+
+    Top: the gyros in °/s; bottom: the accelerometers in m/s². Static segments are shaded green, rotations
+    blue, moves grey, each numbered as in the segment table (up to 80 segments). A recording of more than
+    :data:`ENVELOPE_ABOVE` samples is drawn as each channel's minimum and maximum over bins of samples, so a
+    spike or a rail still shows.
+
+    Parameters
+    ----------
+    recording : plansim.io.recording_data.Recording
+    path : str or os.PathLike
+        The figure file, written whole or not at all (:func:`plansim.io.files.atomic_write`).
+    format : {"png", "pdf", "svg"}, optional
+        Default: from the suffix of *path*.
+    """
+    chosen = figure_format(path, format)
+    fig, _axes = draw_recording(recording)
+    save(fig, path, chosen, dpi=110)
