@@ -254,7 +254,8 @@ def test_a_log_that_starts_and_ends_in_the_same_steady_turn_is_read_from_its_res
     the log's two ends agree with each other, so the rule 'a log starts and ends at rest' took the turn for the rest
     and every rest for a turn (the previous version: one static span, the bias 30 deg/s off). The rests agree with
     each other across the two poses, a turn about the vertical with no run in another pose (step 6, 'Poses'):
-    the three rests are static, with their poses, and the gyro bias is the rests'."""
+    the three rests are static, with their poses, and the gyro bias is the rests'. The two turns, with a pose on one
+    side only, are rotations with their measured rates (they were moves 'not integrated')."""
     for seed in (1, 2):
         rng = np.random.default_rng(seed)
         turn = _table_turn(rng, 1.0, 60.0, 30.0)
@@ -268,6 +269,15 @@ def test_a_log_that_starts_and_ends_in_the_same_steady_turn_is_read_from_its_res
         assert all(s.stop - s.start >= 18.0 * FS for s in statics)
         # the bias from a quiet stretch of 400 samples or more (8 windows): 0.01 deg/s standard error; 5 of them
         assert np.degrees(result.noise.gyro_bias) == pytest.approx([0.3, -0.1, 0.0], abs=0.05)
+        # the steady turns the log starts and ends in are rotations with their rates (step 9), measured against the
+        # pose beside each (6000 samples of 0.2 deg/s noise and 0.1 deg/s jitter, a 20 s rest: 0.006 deg/s; 5 of
+        # them), and the stop and spin-up between them and the rests are moves
+        assert [s.kind for s in result.spans] == ["rotation", "move", "static", "move", "static", "move", "static",
+                                                  "move", "rotation"]
+        ends = (result.spans[0], result.spans[-1])
+        assert [math.degrees(r.steady_rate) for r in ends] == pytest.approx([30.0, 30.0], abs=0.03)
+        assert all(math.isnan(r.angle) and r.axis == 2 for r in ends)
+        assert result.steady_turns[0][0] == 0 and result.steady_turns[-1][1] == x.shape[0]
 
 
 def test_a_step_in_a_gyro_bias_does_not_make_the_poses_after_it_turns():

@@ -74,11 +74,11 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    whole number of full turns. Anything else is a *move*: the unit was carried from one pose to another and no reference
    says by how much. A motion that holds a time gap or a saturated sample is a move too: its integral
    is not known.
-9. **Steady turns.** Step 8 is for turns by hand against a stop. A motion between two static spans that holds
-   steady turns (step 6) is a table's, which need not stop on a quarter turn (a −567° turn would be labelled
-   −540°): each steady turn is a *rotation* of its own with its measured rate (``Span.steady_rate``) and no
-   angle (the table's rate, not in the log, is its reference), and the stretches around them (spin-up, change
-   of rate, stop) are *moves* (:func:`_motion_pieces`).
+9. **Steady turns.** Step 8 is for turns by hand against a stop. A motion that holds steady turns (step 6) is a
+   table's, which need not stop on a quarter turn (a −567° turn would be labelled −540°): each steady turn is a
+   *rotation* of its own with its measured rate (``Span.steady_rate``) and no angle (the table's rate, not in
+   the log, is its reference), and the stretches around them (spin-up, change of rate, stop) are *moves*
+   (:func:`_motion_pieces`). So is a steady turn the log starts or ends in, against the one pose beside it.
 10. **Saturation.** ``SATURATION_RUN`` or more equal consecutive samples at a channel's largest or smallest
     value in the log (two are enough where the value is held by two such runs or more: a rail reached twice),
     outside the static spans, entered or left by a step of more than ``SATURATION_STEP`` σ, at a value
@@ -856,29 +856,37 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
                    gap_starts: np.ndarray, saturation: list[Saturation], steady: list[tuple[int, int]]
                    ) -> list[Span]:
     """The motion ``[lo, hi)`` between the static spans *before* and *after*: one span (:func:`_motion`), or, where
-    it holds steady turns (step 6) and a pose on both sides, each steady turn as a ``rotation`` of its own with its
-    measured rate and no angle, and the stretches around them (a table's spin-up, a change of rate, its stop) as
-    moves (step 9).
+    it holds steady turns (step 6), each steady turn as a ``rotation`` of its own with its measured rate and no
+    angle, and the stretches around them (a table's spin-up, a change of rate, its stop) as moves (step 9).
 
     The nearest whole number of quarter turns is a reference for a turn by hand against a stop, not for a table
     that turns at a rate for a time: a −567° table turn would be labelled −540° (within 10° + 5 %), and a fit that
-    took that angle would be 5 % off. The table's rate is the reference, and it holds only over the steady part."""
+    took that angle would be 5 % off. The table's rate is the reference, and it holds only over the steady part.
+    So a log that starts or ends in a steady turn (recorded into a table's turn, or stopped before the table) has
+    its steady part as a rotation too, its rate measured against the one pose beside it (*before* or *after*),
+    whose rest output is the bias; the stretch between the log's end and the steady part is a move."""
     inside = [(a, b) for a, b in steady if a >= lo and b <= hi]
-    if not inside or before is None or after is None or np.any((gap_starts > lo) & (gap_starts <= hi)):
+    if not inside or (before is None and after is None) or np.any((gap_starts > lo) & (gap_starts <= hi)):
         return [_motion(x, times, lo, hi, before, after, gap_starts, saturation)]
-    g = before.mean[3:]
+    side = before if before is not None else after  # the pose whose rest output is the bias, where one is missing
+    g = side.mean[3:]
     pieces: list[Span] = []
     edges = [lo] + [v for run in inside for v in run] + [hi]
     for k in range(len(edges) - 1):
         p, q = edges[k], edges[k + 1]
         if q <= p:
             continue
-        integrated, bias = _integrate(x, times, p, q, before, after)
+        integrated, bias = _integrate(x, times, p, q, before or side, after or side)
         axis = int(np.argmax(np.abs(integrated)))
         mean = x[p:q].mean(axis=0)
         if k % 2 == 0:  # around the steady turns
-            where = "a spin-up" if k == 0 else ("a stop" if q == hi else "a change of rate")
-            pieces.append(Span("move", p, q, mean, up=before.up, integrated=integrated, axis=axis,
+            if k == 0 and before is None:
+                where = "the log's start, in a turn"
+            elif q == hi and after is None:
+                where = "the log's end, in a turn"
+            else:
+                where = "a spin-up" if k == 0 else ("a stop" if q == hi else "a change of rate")
+            pieces.append(Span("move", p, q, mean, up=side.up, integrated=integrated, axis=axis,
                                reason=f"{where} around a steady turn (step 9): no reference for its angle"))
             continue
         rate = x[p:q, :3].mean(axis=0) - bias.mean(axis=0)
@@ -892,9 +900,9 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
         else:
             why = ""
         if why:
-            pieces.append(Span("move", p, q, mean, up=before.up, integrated=integrated, axis=axis, reason=why))
+            pieces.append(Span("move", p, q, mean, up=side.up, integrated=integrated, axis=axis, reason=why))
         else:
-            pieces.append(Span("rotation", p, q, mean, up=before.up, integrated=integrated, axis=axis,
+            pieces.append(Span("rotation", p, q, mean, up=side.up, integrated=integrated, axis=axis,
                                orientation="approximate" if vertical else "unknown",
                                steady_rate=float(rate[axis])))
     return pieces
