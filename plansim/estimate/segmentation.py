@@ -56,6 +56,9 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    runs' agreement says otherwise (:func:`_rest_by_agreement`: a table's steady turn is as quiet as a rest, and
    ``Q`` can fall in one; rests agree across poses, a turn about the vertical does not); the gyro bias b is
    then that run's.
+6a. **A gyro more g-sensitive than the allowance.** Runs read as turns in a pose no rest shares are rests
+   when the runs' own fit of each gyro's rest output (bias, drift, g-sensitivity) predicts them, left out, to
+   within the threshold along their gravity (:func:`_rests_by_g_sensitivity`).
 6b. **Poses held by hand.** Outside those runs, stretches of at least ``min_static`` where the
    accelerometers pass step 5 and hold one pose while the gyros do not (a hand's tremor: 1 °/s at 5 Hz tilts
    the unit by 0.03°) are poses too, when the attitude the gyros integrate about their mean swings by at
@@ -131,6 +134,8 @@ SAME_POSE = math.radians(2.0)
 #: unit's data-sheet figure (InvenSense MPU-6050, "linear acceleration sensitivity" 0.1 °/s/g); rests in different
 #: poses may differ by it times the change of specific force (step 6)
 G_SENSITIVITY_ALLOWANCE = math.radians(0.2) / 9.80665
+#: step 6a fits each gyro's rest output over the runs (bias, drift, three g-sensitivities) only from this many runs
+G_FIT_MIN_RUNS = 8
 #: a rotation's integral lies along one body axis: the other two components at most this fraction of it
 OFF_AXIS_FRACTION = 0.1
 #: a rotation's integral is within this of its nominal angle: ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION × nominal
@@ -500,6 +505,9 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
                 at_rest[i] = _at_rest(i, rests[:1], medians, forces, bias, rate_threshold)
                 if at_rest[i]:
                     rests.insert(0, i)  # nearest first
+        # 6a. a gyro g-sensitivity beyond the allowance, told by the runs themselves
+        centres = [0.5 * (float(times[a]) + float(times[b - 1])) for a, b in runs]
+        at_rest = _rests_by_g_sensitivity(medians, forces, centres, at_rest, rate_threshold)
     static_runs = [run for run, rest in zip(runs, at_rest) if rest]
     steady = [run for run, rest in zip(runs, at_rest) if not rest]
     # 6b. poses held by hand: the accelerometers quiet and one pose, the gyros shaking about a steady mean
@@ -627,6 +635,48 @@ def _rest_by_agreement(runs: list[tuple[int, int]], medians: list, forces: list,
     if quiet in candidates and support[quiet] == best:
         return quiet
     return min((i for i in candidates if support[i] == best), key=lambda i: abs(i - quiet))
+
+
+def _rests_by_g_sensitivity(medians: list, forces: list, centres: list[float], at_rest: list[bool],
+                            rate_threshold: np.ndarray) -> list[bool]:
+    """Step 6a: runs read as steady turns in poses no rest shares, that are rests of a gyro more g-sensitive than
+    :data:`G_SENSITIVITY_ALLOWANCE` allows.
+
+    The allowance of step 6 is a data-sheet figure; a unit twice as g-sensitive (0.3 °/s/g) had half the poses of
+    a 12-pose hand session read as turns about the vertical. Where the runs span enough poses, they tell the unit's
+    own g-sensitivity: each run's mean gyro output is modelled as a rest's, b + d·t + G f (bias, a linear drift
+    over the log, the g-sensitivity matrix; per axis 5 unknowns, fitted over the runs by least squares), and a run
+    whose output is predicted, left out of the fit, to within the rest threshold *along its own gravity* (where a
+    turn about the vertical would show) is at rest. The run predicted worst is dropped from the fit while any is
+    out of that threshold, and the fit is used only while it holds at least :data:`G_FIT_MIN_RUNS` runs whose
+    poses are not coplanar (G is then determined with room to spare). Only runs in a pose of their own are
+    decided this way: where a rest shares a run's pose, the comparison of step 6 is exact (no g-sensitivity
+    between them), and a run found at rest stays at rest."""
+    n = len(medians)
+    ups = [np.asarray(f, dtype=float) / max(float(np.linalg.norm(f)), 1e-300) for f in forces]
+    lonely = [i for i in range(n) if not at_rest[i] and not any(
+        at_rest[j] and float(np.dot(ups[i], ups[j])) >= math.cos(SAME_POSE) for j in range(n))]
+    if not lonely:
+        return at_rest
+    used = [i for i in range(n) if at_rest[i] or i in lonely]
+    while len(used) >= G_FIT_MIN_RUNS:
+        t = np.array([centres[i] for i in used])
+        design = np.column_stack([np.ones(len(used)), t - t.mean(), np.array([forces[i] for i in used])])
+        if np.linalg.matrix_rank(design / np.maximum(np.abs(design).max(axis=0), 1e-300)) < design.shape[1]:
+            break  # the poses are coplanar (or too few): G is not determined
+        outputs = np.array([medians[i] for i in used])
+        coefficients, *_ = np.linalg.lstsq(design, outputs, rcond=None)
+        hat = np.einsum("ij,jk,ik->i", design, np.linalg.pinv(design.T @ design), design)
+        if np.any(hat >= 1.0 - 1e-9):
+            break  # a run the fit must pass through: nothing predicts it
+        left_out = (outputs - design @ coefficients) / (1.0 - hat)[:, None]  # each run predicted without it
+        ratios = np.array([abs(float(np.dot(r, ups[i]))) / float(np.linalg.norm(rate_threshold * ups[i]))
+                           for r, i in zip(left_out, used)])
+        worst = int(np.argmax(ratios))
+        if ratios[worst] <= 1.0:
+            return [rest or i in used for i, rest in enumerate(at_rest)]
+        used.pop(worst)
+    return at_rest
 
 
 def _pose_clusters(forces: list) -> list[np.ndarray]:
