@@ -858,12 +858,12 @@ def test_a_shake_at_the_rail_is_one_saturated_warning_in_counts(tmp_path):
 
 
 def _rate_table_log(rates_deg_s, scale: float, seed: int, rest_s: float = 6.0, ramp_s: float = 1.0,
-                    steady_s: float = 5.0, fs: float = 100.0):
+                    steady_s: float = 5.0, fs: float = 100.0, table_rate: bool = False):
     """A rate-table log about z (up), written here without plansim's simulator: rests of *rest_s* between turns
     that spin up linearly over *ramp_s*, hold each rate for *steady_s* and stop as they started. The table's rate
     is exact (its jitter is far below the gyro's noise: the turn is as quiet as a rest); the z gyro reads *scale*
     times it plus a bias of 0.2 deg/s; white noise 0.05 deg/s and 0.005 m/s^2 per sample. Returns time and samples
-    (gyros in deg/s)."""
+    (gyros in deg/s), and with *table_rate* the table's rate too (deg/s)."""
     rng = np.random.default_rng(seed)
     ramp = np.linspace(0.0, 1.0, int(ramp_s * fs), endpoint=False)
     rest = np.zeros(int(rest_s * fs))
@@ -876,6 +876,8 @@ def _rate_table_log(rates_deg_s, scale: float, seed: int, rest_s: float = 6.0, r
     x[:, :3] += 0.05 * rng.standard_normal((rate.size, 3))
     x[:, 5] = 9.80
     x[:, 3:] += 0.005 * rng.standard_normal((rate.size, 3))
+    if table_rate:
+        return np.arange(rate.size) / fs, x, rate
     return np.arange(rate.size) / fs, x
 
 
@@ -923,6 +925,66 @@ def test_a_rate_table_log_is_fitted_once_the_table_rates_are_given(tmp_path, cap
     kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
     assert abs(kgzz["estimate"] - scale) < 3.3 * kgzz["u"], kgzz
     assert kgzz["u"] < 1e-4
+
+
+def test_a_table_rate_column_gives_each_steady_turn_its_rate(tmp_path, capsys):
+    """The rate-table log above with the table's rate logged beside the IMU (its controller's rate, jittering by
+    0.001 deg/s), the table's positive sense the body's negative (the unit mounted upside down on it):
+    ``--table-rate-column`` gives each steady turn the column's mean over the segment, signed as the gyros measured
+    the turn, with a note on the sense, and `plansim fit` gives the z gyro's scale factor within its u with the
+    segment table as imported. The same column read in the wrong unit (rad/s as deg/s) disagrees with the gyros by
+    57 times: the rates are left not known, with a warning naming the turns."""
+    rates = [63, -63, 100, -100]
+    scale = 1.003
+    t, x, rate = _rate_table_log(rates, scale, seed=22, table_rate=True)
+    column = -rate + 0.001 * np.random.default_rng(5).standard_normal(rate.size)
+    log = tmp_path / "table.csv"
+    write_synthetic(log, t, x, extra={"table_dps": column})
+    rec = tmp_path / "rec.nc"
+    assert main(["import", str(log), "--out", str(rec), "--time", "time", "--units", "deg/s,m/s^2", "--columns",
+                 "gx,gy,gz,ax,ay,az", "--table-rate-column", "table_dps"]) == 0
+    out = capsys.readouterr().out
+    assert "rate from the table's rate column 'table_dps'" in out and "for 4 of 4" in out
+    assert "give each one the rate the table held" not in out and "warning [table_rate_sense]" in out
+    recording = read_recording(rec)
+    steady = [s for s in recording.schedule.segments if s.test == "rotation"]
+    assert [math.degrees(s.rate) for s in steady] == pytest.approx(rates, abs=1e-3)
+    assert main(["fit", str(rec), "--latitude", "40", "--height", "50", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["identified"] == ["Kgzz"]
+    kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
+    assert abs(kgzz["estimate"] - scale) < 3.3 * kgzz["u"], kgzz
+    # the column in rad/s read as deg/s: 57 times off, the rates left to the user
+    write_synthetic(log, t, x, extra={"table_dps": np.radians(column)})
+    assert main(["import", str(log), "--out", str(tmp_path / "wrong.nc"), "--time", "time", "--units",
+                 "deg/s,m/s^2", "--columns", "gx,gy,gz,ax,ay,az", "--table-rate-column", "table_dps"]) == 0
+    out = capsys.readouterr().out
+    assert "warning [table_rate_disagrees]: 4 steady turn(s)" in out and "give each one the rate" in out
+    wrong = read_recording(tmp_path / "wrong.nc")
+    assert all(not s.rate_known for s in wrong.schedule.segments if s.test == "rotation")
+    # bad input names the option
+    assert main(["import", str(log), "--out", str(tmp_path / "x.nc"), "--time", "time", "--columns",
+                 "gx,gy,gz,ax,ay,az", "--table-rate-column", "table_dps", "--table-rate-unit", "rpm"]) == 2
+    assert "--table-rate-unit 'rpm'" in capsys.readouterr().err
+    assert main(["import", str(log), "--out", str(tmp_path / "x.nc"), "--time", "time", "--columns",
+                 "gx,gy,gz,ax,ay,az", "--table-rate-column", "encoder"]) == 2
+    assert "column 'encoder' is missing" in capsys.readouterr().err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_a_table_rate_column_tells_a_turn_about_the_vertical_taken_for_a_rest(tmp_path, capsys):
+    """A log that is one steady turn of +3 deg/s about z (up) from end to end: nothing in the IMU's data tells it
+    from a rest with a 3 deg/s bias, and it is taken for one (with the rest_turning_about_vertical warning); the
+    table's rate column says it turned (table_turning_at_rest)."""
+    t, x, rate = _rate_table_log([], 1.0, seed=23, rest_s=30.0, table_rate=True)
+    x[:, 2] += 3.0
+    log = tmp_path / "turning.csv"
+    write_synthetic(log, t, x, extra={"table_dps": rate + 3.0})
+    assert main(["import", str(log), "--out", str(tmp_path / "rec.nc"), "--time", "time", "--units", "deg/s,m/s^2",
+                 "--columns", "gx,gy,gz,ax,ay,az", "--table-rate-column", "table_dps"]) == 0
+    out = capsys.readouterr().out
+    assert "warning [table_turning_at_rest]" in out and "reads +3 deg/s over it" in out
+    assert "warning [rest_turning_about_vertical]" in out
 
 
 def _write_sensor_log(path: Path, time_s: np.ndarray, values: np.ndarray, unit: str) -> None:

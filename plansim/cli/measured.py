@@ -32,7 +32,8 @@ def _cmd_import(args) -> int:
                         units=args.units, scale=args.scale, offset=args.offset, sample_rate=args.sample_rate,
                         temperature_column=args.temperature_column, temperature=args.temperature,
                         latitude=args.latitude, height=args.height, full_scale=args.full_scale,
-                        accel_log=args.accel_log, **options)
+                        accel_log=args.accel_log, table_rate_column=args.table_rate_column,
+                        table_rate_unit=args.table_rate_unit, **options)
     with OutputSet() as staged:
         if args.plot is not None:  # drawn before the recording is written; committed once it is
             from plansim.report.plot import recording_figure
@@ -92,6 +93,12 @@ def _add_import_command(sub) -> None:
                         f"{FULL_SCALE_MARGIN * 100:g} %% of it is at the rail, a steady turn held there included. "
                         "Default: a rail is looked for in the data")
     p.add_argument("--temperature-column", default=None, metavar="COL", help="a temperature column in degC")
+    p.add_argument("--table-rate-column", default=None, metavar="COL",
+                   help="a column holding the turntable's rate (its encoder's or controller's): each steady turn's "
+                        "rate is its mean over the segment, signed as the gyros measured the turn, so the fit uses "
+                        "it without editing the segment table")
+    p.add_argument("--table-rate-unit", default="deg/s", metavar="UNIT",
+                   help="unit of --table-rate-column (deg/s, rad/s or deg/h; default deg/s)")
     p.add_argument("--temperature", type=float, default=None, metavar="DEGC",
                    help="the lab's temperature, for a log without a temperature column (default 20, noted as assumed)")
     p.add_argument("--latitude", type=float, default=None, metavar="DEG", help="site latitude (site_latitude_deg)")

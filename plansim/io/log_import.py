@@ -42,6 +42,7 @@ from plansim.estimate.timebase import DROPPED_MAX, TimeReport, analyse_time
 from plansim.io.log_pairing import pair_logs, split_interleaved
 from plansim.io.log_table import (
     TIME_UNITS,
+    UNIT_SPELLINGS,
     LogTable,
     header_units,
     parse_full_scale,
@@ -72,7 +73,11 @@ FULL_SCALE_EXCEEDED = 0.02
 WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "saturated", "tilted_pose",
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
-                 "units_disagree", "frozen", "repeated_rows")
+                 "units_disagree", "frozen", "repeated_rows", "table_rate_disagrees", "table_rate_sense",
+                 "table_turning_at_rest")
+#: a steady turn takes the table's rate column's mean where it and the gyros' measured rate agree within this
+#: fraction of it (a MEMS gyro's scale factor is within a few per cent; a column in another unit is off by 57x)
+TABLE_RATE_AGREEMENT = 0.1
 #: up to this many glitch rows (or repeated rows) are listed by line in the warning
 GLITCHES_LISTED = 10
 #: up to this many frozen stretches are listed in the warning
@@ -130,7 +135,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                offset: str | None = None, sample_rate: float | None = None, temperature_column: str | None = None,
                temperature: float | None = None, latitude: float | None = None, height: float | None = None,
                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
-               full_scale: str | None = None, accel_log: str | os.PathLike | None = None) -> ImportResult:
+               full_scale: str | None = None, accel_log: str | os.PathLike | None = None,
+               table_rate_column: str | None = None, table_rate_unit: str = "deg/s") -> ImportResult:
     """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
 
     Parameters
@@ -155,6 +161,13 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         Hz. Without a time column, required; with one, the nominal rate (default: estimated from it).
     temperature_column : str or None
         A temperature column in degC, kept as the recording's temperature channel.
+    table_rate_column : str or None
+        A column holding the turntable's rate (its encoder or its controller's setpoint), in *table_rate_unit*:
+        each steady turn's ``rate`` is its mean over the segment, signed as the gyros measured the turn (the
+        table's sense and the body axis's may differ), so the fit can use it without editing the table. A log of
+        one file only (not with ``accel_log``).
+    table_rate_unit : str
+        Unit of that column: one of :data:`plansim.units.KINDS` ``angular_rate`` (``deg/s`` by default).
     temperature : float or None
         The lab's temperature, degC, for the segment table when the log has no temperature column
         (default 20 degC, noted in the attributes as assumed).
@@ -198,6 +211,15 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                          "--sample-rate HZ")
     if time_unit == "samples" and sample_rate is None:
         raise ValueError("--time-unit samples: a sample counter needs --sample-rate HZ")
+    if table_rate_column is not None:
+        if accel_log is not None:
+            raise ValueError("--table-rate-column with --accel-log: the table's rate is read from a log of one file "
+                             "only")
+        unit = UNIT_SPELLINGS.get(table_rate_unit, table_rate_unit)
+        if unit not in KINDS["angular_rate"]:
+            raise ValueError(f"--table-rate-unit {table_rate_unit!r}: allowed: "
+                             f"{', '.join(u for u in KINDS['angular_rate'] if u)}")
+        table_rate_factor = KINDS["angular_rate"][unit]
     if temperature_column is not None and temperature is not None:
         raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
                          "temperature)")
@@ -225,7 +247,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         columns = tuple(str(name)[1:].strip() if sign < 0 else name for name, sign in zip(columns, signs))
     seconds_per_unit = TIME_UNITS[time_unit] if time_unit != "samples" else 1.0 / sample_rate
     if accel_log is None:
-        table = read_log(path, columns, time_column, temperature_column)
+        table = read_log(path, columns, time_column, temperature_column, table_rate_column=table_rate_column)
+        if table.interleaved and table_rate_column is not None:
+            raise ValueError(f"log {str(table.path)!r}: its gyro and accelerometer samples are in rows of their own, "
+                             "paired by time; --table-rate-column is read from a log whose rows hold all six")
         if table.interleaved:  # the gyros' and the accelerometers' samples in rows of their own: paired by time
             table = pair_logs(*split_interleaved(table), seconds_per_unit)
     else:
@@ -451,16 +476,23 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                           f"{table.lines[span.stop - 1]} lie before the first or after "
                                                           "the last static span: kept as a 'move'"))
 
+    table_rates = {}
+    if table.table_rate is not None:
+        table_rates = _rates_from_table(segmentation, table, table.table_rate * table_rate_factor, warnings)
+
     segment_temperature = DEFAULT_TEMPERATURE if temperature is None else float(temperature)
     segments = []
     details = []
     counters = {"static": 0, "rotation": 0, "move": 0}
-    for span in segmentation.spans:
+    for k, span in enumerate(segmentation.spans):
         counters[span.kind] += 1
         seg_temperature = (float(np.mean(table.temperature[span.start:span.stop])) if table.temperature is not None
                            else segment_temperature)
-        segments.append(_segment(span, counters[span.kind], timing.sample_rate, seg_temperature))
+        segments.append(_segment(span, counters[span.kind], timing.sample_rate, seg_temperature,
+                                 table_rates.get(k, math.nan)))
         details.append(_detail(span, table))
+        if k in table_rates:
+            details[-1]["table_rate_deg_s"] = math.degrees(table_rates[k])
     schedule = Schedule(tuple(segments), procedure="imported", notes={"import": {
         "log": table.path.name,
         "accel_log": None if accel_log is None else Path(accel_log).name,
@@ -478,6 +510,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "preamble": list(table.preamble),
         "header": table.has_header,
         "time_column": table.time_column,
+        "table_rate_column": table.table_rate_column,
+        "table_rate_unit": table_rate_unit if table.table_rate_column is not None else None,
         "time_unit": time_unit if table.time_column is not None else None,
         "detector": {
             "window_samples": segmentation.window,
@@ -553,7 +587,49 @@ def _as_logged(value: float, c: int, factors, divisors, offsets, unit_names, cou
     return f"{value / factors[c] * divisors[c]:.6g} {unit_names[c]}"
 
 
-def _segment(span: Span, number: int, sample_rate: float, temperature: float) -> Segment:
+def _rates_from_table(segmentation, table: LogTable, table_rate: np.ndarray, warnings: list) -> dict[int, float]:
+    """Each steady turn's rate from the table's rate column (SI, *table_rate*): its mean over the segment, signed
+    as the gyros measured the turn, by span number. Warns (``table_rate_disagrees``) where the column's mean and
+    the gyros' measured rate differ by more than :data:`TABLE_RATE_AGREEMENT` of the column's (a column in
+    another unit, or not the turning axis's), and (``table_turning_at_rest``) where a static pose's column reads
+    more than the rest threshold (a turn about the vertical taken for a rest)."""
+    rates = {}
+    disagree, senses = [], set()
+    for k, span in enumerate(segmentation.spans):
+        mean = float(np.mean(table_rate[span.start:span.stop]))
+        if span.kind == "static":
+            if abs(mean) > float(np.max(segmentation.rate_threshold)):
+                warnings.append(LogWarning("table_turning_at_rest", f"the static span on lines "
+                                           f"{table.lines[span.start]}-{table.lines[span.stop - 1]}: the table's rate "
+                                           f"column {table.table_rate_column!r} reads {math.degrees(mean):+.5g} deg/s "
+                                           "over it: a turn about the vertical taken for a rest? Make it a 'rotation' "
+                                           "with that rate in the segment table"))
+            continue
+        if span.kind != "rotation" or not math.isfinite(span.steady_rate):
+            continue
+        measured = span.steady_rate
+        if mean == 0.0 or abs(abs(mean) - abs(measured)) > TABLE_RATE_AGREEMENT * abs(mean):
+            disagree.append(f"lines {table.lines[span.start]}-{table.lines[span.stop - 1]}: column "
+                            f"{math.degrees(mean):+.5g} deg/s, gyros {math.degrees(measured):+.5g} deg/s")
+            continue
+        rates[k] = math.copysign(abs(mean), measured)
+        senses.add(mean * measured > 0)
+    if disagree:
+        warnings.append(LogWarning("table_rate_disagrees", f"{len(disagree)} steady turn(s) where the table's rate "
+                                   f"column {table.table_rate_column!r} and the gyros' measured rate differ by more "
+                                   f"than {TABLE_RATE_AGREEMENT:.0%} (a column in another unit, --table-rate-unit?): "
+                                   f"their rate is left not known; " + "; ".join(disagree[:4])
+                                   + ("; …" if len(disagree) > 4 else "")))
+    if senses == {False}:
+        warnings.append(LogWarning("table_rate_sense", f"the table's rate column {table.table_rate_column!r} has the "
+                                   "opposite sign of the gyros' measured rate in every steady turn: the table's "
+                                   "positive sense is the body axis's negative (the unit mounted upside down on it?); "
+                                   "each turn's rate is given about the body axis, signed as the gyros measured it"))
+    return rates
+
+
+def _segment(span: Span, number: int, sample_rate: float, temperature: float, table_rate: float = math.nan
+             ) -> Segment:
     common = dict(dwell=span.samples / sample_rate, settle=0.0, sample_rate=sample_rate, temperature=temperature)
     if span.kind == "static":
         held = f", held (gyros shaking {span.held:.3g}x their quiet noise)" if math.isfinite(span.held) else ""
@@ -561,13 +637,16 @@ def _segment(span: Span, number: int, sample_rate: float, temperature: float) ->
                        span.up, heading=math.nan, orientation=span.orientation, **common)
     measured = math.degrees(float(span.integrated[span.axis])) if span.axis >= 0 else math.nan
     if span.kind == "rotation":
-        if math.isfinite(span.steady_rate):  # a steady turn: the table's rate is its reference, and not logged
+        if math.isfinite(span.steady_rate) and math.isfinite(table_rate):  # the table's rate from its column
+            label = (f"rotation {number}: steady at {math.degrees(table_rate):+.6g} deg/s about +{AXES[span.axis]} "
+                     f"(the table's rate column; the gyros measured {math.degrees(span.steady_rate):+.6g} deg/s)")
+        elif math.isfinite(span.steady_rate):  # a steady turn: the table's rate is its reference, and not logged
             label = (f"rotation {number}: steady at {math.degrees(span.steady_rate):+.5g} deg/s about "
                      f"+{AXES[span.axis]} (measured; {measured:+.2f} deg): give the table's rate")
         else:
             label = (f"rotation {number}: {math.degrees(span.angle):+.0f} deg about +{AXES[span.axis]} (measured "
                      f"{measured:+.2f} deg)")
-        return Segment(label, "rotation", span.axis, span.up, heading=math.nan, rate=math.nan,
+        return Segment(label, "rotation", span.axis, span.up, heading=math.nan, rate=table_rate,
                        rate_axis=f"+{AXES[span.axis]}", angle=span.angle, orientation=span.orientation, **common)
     about = f"turned {measured:+.1f} deg about {AXES[span.axis]}" if span.axis >= 0 else "not integrated"
     return Segment(f"move {number}: {about}", "move", 0, span.up or "+z", heading=math.nan, rate=math.nan,

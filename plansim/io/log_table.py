@@ -89,6 +89,9 @@ class LogTable:
     #: some rows hold only the gyros' three channels or only the accelerometers' (the other three empty, NaN in
     #: ``channels``): two sensors sampled apart, logged in one file (:func:`plansim.io.log_pairing.split_interleaved`)
     interleaved: bool = False
+    #: the table's rate column (``--table-rate-column``) in the file's unit, and its name; or None
+    table_rate: np.ndarray | None = None
+    table_rate_column: str | None = None
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -212,7 +215,8 @@ def _per_channel(text: str | None, option: str, pair: str, positive: bool,
 
 
 def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, time_column: str | None = None,
-             temperature_column: str | None = None, channels: tuple[str, ...] = CHANNELS) -> LogTable:
+             temperature_column: str | None = None, channels: tuple[str, ...] = CHANNELS,
+             table_rate_column: str | None = None) -> LogTable:
     """Read the columns of a plain CSV log, checking every row.
 
     Parameters
@@ -232,6 +236,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     channels : tuple of str
         The channels the log holds, in the order of ``columns``: all six, or the gyros' or the accelerometers'
         three where the two are logged in two files (:func:`plansim.io.log_pairing.pair_logs`).
+    table_rate_column : str or None
+        Name of a column holding the turntable's rate (read in the file's unit; ``plansim import`` converts it).
 
     Raises
     ------
@@ -249,11 +255,11 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     if len(names) != n_channels:
         raise ValueError(f"--columns {','.join(names)!r}: {len(names)} names for {where}; expected {n_channels}, "
                          f"in the order {', '.join(channels)}")
-    wanted = list(names) + [c for c in (time_column, temperature_column) if c is not None]
+    wanted = list(names) + [c for c in (time_column, temperature_column, table_rate_column) if c is not None]
     repeated = sorted({name for name in wanted if wanted.count(name) > 1})
     if repeated:
         raise ValueError(f"{where}: column {repeated[0]!r} is named for two uses (channels, --time, "
-                         "--temperature-column)")
+                         "--temperature-column, --table-rate-column)")
     with _text_file(target, where) as fh:
         header_line = 0
         header = None
@@ -325,9 +331,9 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         ignored = tuple(name for name in header_names if name not in wanted)
         if columns is None and ignored:
             raise ValueError(f"{where}: column {ignored[0]!r} is not expected: without --columns the log holds "
-                             f"exactly the channels {', '.join(channels)} (and the --time and --temperature-column "
-                             "columns if given); name the six channel columns with --columns (the other columns "
-                             "are then ignored)")
+                             f"exactly the channels {', '.join(channels)} (and the --time, --temperature-column and "
+                             "--table-rate-column columns if given); name the six channel columns with --columns (the "
+                             "other columns are then ignored)")
         index = [header_names.index(name) for name in wanted]
         width = len(header_names)
         decimal_comma = False
@@ -431,13 +437,15 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     if len(trailing) > MAX_TRAILING_LINES:
         raise ValueError(next(error for _, _, error in trailing if error))
     data = np.concatenate(blocks)
-    time = data[:, n_channels] if time_column is not None else None
-    temperature = data[:, -1] if temperature_column is not None else None
+    extra = iter(range(n_channels, data.shape[1]))  # the time, temperature and table rate columns, as wanted
+    time = data[:, next(extra)] if time_column is not None else None
+    temperature = data[:, next(extra)] if temperature_column is not None else None
+    table_rate = data[:, next(extra)] if table_rate_column is not None else None
     return LogTable(target, data[:, :n_channels], names, time, time_column, temperature, temperature_column,
                     ignored, lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
                     has_header, units_row, tuple((line, why) for line, why, _ in trailing),
                     clock[2] if clock else None, ((clock[0] or 0) * 86400.0 + clock[1]) if clock else None,
-                    interleaved=interleaved)
+                    interleaved=interleaved, table_rate=table_rate, table_rate_column=table_rate_column)
 
 
 def _delimiter(line: str) -> str:

@@ -75,7 +75,13 @@ def format_summary(result: ImportResult) -> str:
     if any(not math.isfinite(r.steady_rate) for r in rotations):
         lines.append("  rotations: angle = the whole number of quarter turns nearest the measured integral (bias "
                      "removed); check it against what was done; rate = nan (not logged)")
-    if any(math.isfinite(r.steady_rate) for r in rotations):
+    steady = [k for k, r in enumerate(seg.spans) if r.kind == "rotation" and math.isfinite(r.steady_rate)]
+    given = [k for k in steady if math.isfinite(rec.schedule.segments[k].rate)]
+    if given:
+        lines.append(f"  steady turns: rate from the table's rate column {table.table_rate_column!r} (its mean over "
+                     f"each segment, signed as the gyros measured the turn) for {len(given)} of {len(steady)}; "
+                     "angle = nan; the moves beside them are the table's spin-up and stop")
+    if len(given) < len(steady):
         lines.append("  steady turns: angle = nan and rate = nan (a table's rate is not in the log): give each one "
                      "the rate the table held for the fit to use it (in the segment table, rate_deg_s and "
                      "rate_rad_s, or one of them with the other column deleted); the moves beside them are the "
