@@ -1239,6 +1239,45 @@ def test_plansim_fit_bad_input_exits_2_and_writes_nothing(tmp_path, capsys):
     assert main(["fit", str(tmp_path / "missing.nc")]) == 2
 
 
+def test_plansim_fit_plot_draws_each_residual_with_its_bars_and_the_far_ones_red(tmp_path, capsys):
+    """``plansim fit --plot``: per channel, every fitted residual against the reading and against time, in deg/h and
+    ug, with ±2 sd bars; a residual beyond 3 sd (one segment's gz mean moved by 8 sd here) is red. A figure name it
+    cannot write is an error before the fit, and nothing is written."""
+    from plansim.report.fit import OUTPUT_UNITS
+    from plansim.report.plot import draw_fit, pyplot
+
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=7, trial=0)
+    path = tmp_path / "rec.nc"
+    write_recording(recording, path)
+    figure = tmp_path / "fit.png"
+    assert main(["fit", str(path), "--scenario", "linear_gaussian", "--plot", str(figure), "--no-residuals"]) == 0
+    assert "wrote figure" in capsys.readouterr().out and figure.read_bytes()[:4] == b"\x89PNG"
+    from plansim.fit import scenario_fit_options
+
+    result = fit_recording(recording, resolve_site(scenario=scenario), **scenario_fit_options(scenario))
+    residuals = np.array(result.residuals)
+    residuals[10, 2] = 8.0 * result.residual_sd[10, 2]  # the figure reads the residuals (observed - fitted) and sd
+    far = np.abs(residuals) > 3.0 * result.residual_sd
+    assert far[10, 2]
+    fig = draw_fit(dataclasses.replace(result, fitted=result.observed - residuals))
+    try:
+        assert len(fig.axes) == 12
+        for c in range(6):
+            factor = OUTPUT_UNITS["gyro" if c < 3 else "accel"][1]
+            for ax in (fig.axes[c], fig.axes[6 + c]):  # against the reading, against time
+                blue, red = [line for line in ax.get_lines() if line.get_marker() == "o"]
+                shown = np.concatenate([blue.get_ydata(), red.get_ydata()])
+                assert np.sort(shown[np.isfinite(shown)]) == pytest.approx(np.sort(residuals[:, c] / factor),
+                                                                          rel=1e-12)
+                assert np.count_nonzero(np.isfinite(red.get_ydata())) == np.count_nonzero(far[:, c])
+    finally:
+        pyplot().close(fig)
+    assert main(["fit", str(path), "--plot", str(tmp_path / "fit.txt"), "--out", str(tmp_path / "f.nc")]) == 2
+    assert "--plot" in capsys.readouterr().err
+    assert not (tmp_path / "fit.txt").exists() and not (tmp_path / "f.nc").exists()
+
+
 def test_the_site_comes_from_the_command_line_then_the_recording_then_the_scenario():
     scenario = load_scenario("jjf2003")
     attrs = {"site_latitude_deg": 49.6, "site_height_m": 280.0}

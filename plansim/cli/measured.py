@@ -120,11 +120,18 @@ def _cmd_fit(args) -> int:
 
     if args.out is not None:
         check_output_path(args.out, "--out", (".nc",))
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
     recording, site, options = recording_and_fit_options(args)
     result = fit_recording(recording, site, **options)
     with OutputSet() as outputs:
         if args.out is not None:
             fit_dataset(result).to_netcdf(outputs.stage(args.out, "--out", (".nc",)), engine="h5netcdf")
+        if args.plot is not None:
+            from plansim.report.plot import fit_figure
+
+            fit_figure(result, outputs.stage(args.plot, "--plot", FIGURE_SUFFIXES),
+                       format=os.path.splitext(args.plot)[1].lstrip("."))
         outputs.commit()
     if args.json:
         print(json.dumps(fit_json(result), indent=2))
@@ -132,6 +139,8 @@ def _cmd_fit(args) -> int:
         print(fit_report(result, residuals=not args.no_residuals))
         if args.out is not None:
             print(f"\nwrote fit: {args.out}")
+        if args.plot is not None:
+            print(f"wrote figure: {args.plot} (the residuals per channel against the reading and against time)")
     return 0
 
 
@@ -171,6 +180,9 @@ def _add_fit_command(sub) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the report")
     p.add_argument("--out", default=None, help="write the fit as a NetCDF file (.nc)")
     p.add_argument("--no-residuals", action="store_true", help="leave the per-segment residual table out of the report")
+    p.add_argument("--plot", default=None, metavar="FIGURE",
+                   help="also draw the residuals per channel, with ±2 sd of each, against the channel's reading and "
+                        "against time (.png, .pdf or .svg)")
     p.set_defaults(func=_cmd_fit)
 
 

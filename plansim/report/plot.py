@@ -93,6 +93,50 @@ def appendix_a_histograms(results, scenario, comparisons, path: str | os.PathLik
     save(fig, path, chosen, dpi=120)
 
 
+def _residual_panels(fit, series, title: str):
+    """A 2 × 6 grid of a fit's segment-mean residuals per channel: top row against the channel's own reading,
+    bottom row against time. *series*: ``(residuals (S, 6) SI, error bar (S, 6) SI or None, label, style)``, drawn
+    in order; the scale of each panel is set by the residuals, a bar far longer cut at 1.6 times the largest
+    residual. Returns the figure."""
+    from plansim.kernels.layout import CHANNELS
+    from plansim.report.fit import OUTPUT_UNITS
+
+    plt = pyplot()
+    times = np.asarray(fit.segment_times, dtype=float)
+    reading_units = {"gyro": ("deg/s", np.pi / 180.0), "accel": ("m/s^2", 1.0)}
+    fig, axes = plt.subplots(2, 6, figsize=(19, 6.4), constrained_layout=True)
+    rows_all = np.asarray(fit.fitted_rows, dtype=bool)
+    for c, name in enumerate(CHANNELS):
+        kind = "gyro" if c < 3 else "accel"
+        unit, factor = OUTPUT_UNITS[kind]
+        reading_unit, reading_factor = reading_units[kind]
+        rows = rows_all[:, c]
+        reading = np.asarray(fit.observed[:, c], dtype=float) / reading_factor
+        for ax, x, label in ((axes[0, c], reading, f"{name} reading ({reading_unit})"),
+                             (axes[1, c], times, "time (s)")):
+            ax.axhline(0.0, color="0.7", lw=0.8)
+            for residuals, bar, name_of, style in series:
+                y = np.asarray(residuals)[rows, c] / factor
+                if bar is None:
+                    ax.plot(x[rows], y, "o", label=name_of, **style)
+                else:
+                    ax.errorbar(x[rows], y, yerr=np.asarray(bar)[rows, c] / factor, fmt="o", label=name_of,
+                                **style)
+            ax.set_xlabel(label, fontsize=8)
+            ax.tick_params(labelsize=7)
+            # the residuals set the scale; a bar far longer (a turn by hand, known only by its angle) is cut
+            spread = np.nanmax(np.abs(np.concatenate([np.asarray(r)[rows, c] for r, *_ in series])),
+                               initial=0.0) / factor
+            if spread > 0:
+                ax.set_ylim(-1.6 * spread, 1.6 * spread)
+        axes[0, c].set_title(name, fontsize=9)
+        axes[0, c].set_ylabel(f"residual ({unit})", fontsize=8)
+        axes[1, c].set_ylabel(f"residual ({unit})", fontsize=8)
+    axes[0, 0].legend(fontsize=7, loc="best")
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
 def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = None) -> None:
     """Residuals of the segment means before and after the refit, per channel, against what effects depend on.
 
@@ -112,46 +156,52 @@ def diagnosis_figure(diagnosis, path: str | os.PathLike, format: str | None = No
     format : {"png", "pdf", "svg"}, optional
         Default: from the suffix of *path*.
     """
-    from plansim.kernels.layout import CHANNELS
-    from plansim.report.fit import OUTPUT_UNITS
-
     chosen = figure_format(path, format)
-    plt = pyplot()
-
     before, after = diagnosis.before, diagnosis.after
-    times = np.asarray(before.segment_times, dtype=float)
-    reading_units = {"gyro": ("deg/s", np.pi / 180.0), "accel": ("m/s^2", 1.0)}
-    fig, axes = plt.subplots(2, 6, figsize=(19, 6.4), constrained_layout=True)
-    for c, name in enumerate(CHANNELS):
-        kind = "gyro" if c < 3 else "accel"
-        unit, factor = OUTPUT_UNITS[kind]
-        reading_unit, reading_factor = reading_units[kind]
-        rows = np.asarray(before.fitted_rows[:, c], dtype=bool)
-        u = np.sqrt(np.maximum(np.diag(after.covariance), 0.0)).reshape(-1, 6)[:, c] / factor
-        reading = np.asarray(before.observed[:, c], dtype=float) / reading_factor
-        for ax, x, label in ((axes[0, c], reading, f"{name} reading ({reading_unit})"),
-                             (axes[1, c], times, "time (s)")):
-            ax.axhline(0.0, color="0.7", lw=0.8)
-            ax.plot(x[rows], before.residuals[rows, c] / factor, "o", mfc="none", mec="0.55", ms=4,
-                    label="before")
-            ax.errorbar(x[rows], after.residuals[rows, c] / factor, yerr=2.0 * u[rows], fmt="o", ms=3,
-                        color="tab:blue", ecolor="tab:blue", elinewidth=0.6, alpha=0.8, label="after (±2u)")
-            ax.set_xlabel(label, fontsize=8)
-            ax.tick_params(labelsize=7)
-            # the residuals set the scale; a bar far longer (a turn by hand, known only by its angle) is cut
-            spread = np.nanmax(np.abs(np.concatenate([before.residuals[rows, c], after.residuals[rows, c]])),
-                               initial=0.0) / factor
-            if spread > 0:
-                ax.set_ylim(-1.6 * spread, 1.6 * spread)
-        axes[0, c].set_title(name, fontsize=9)
-        axes[0, c].set_ylabel(f"residual ({unit})", fontsize=8)
-        axes[1, c].set_ylabel(f"residual ({unit})", fontsize=8)
-    axes[0, 0].legend(fontsize=7, loc="best")
+    u = np.sqrt(np.maximum(np.diag(after.covariance), 0.0)).reshape(-1, 6)
     found = ", ".join(diagnosis.selected) if diagnosis.selected else "no catalogue effect"
     verdict = "unexplained residual remains" if diagnosis.unexplained.get("flagged") else "no lack of fit remains"
-    fig.suptitle(f"plansim diagnose: found {found}; {verdict} (family-wise alpha = {diagnosis.alpha:g})",
-                 fontsize=10)
+    fig = _residual_panels(before, [
+        (before.residuals, None, "before", dict(mfc="none", mec="0.55", ms=4)),
+        (after.residuals, 2.0 * u, "after (±2u)", dict(ms=3, color="tab:blue", ecolor="tab:blue", elinewidth=0.6,
+                                                        alpha=0.8))],
+        f"plansim diagnose: found {found}; {verdict} (family-wise alpha = {diagnosis.alpha:g})")
     save(fig, path, chosen, dpi=110)
+
+
+def fit_figure(result, path: str | os.PathLike, format: str | None = None) -> None:
+    """A fit's residuals (observed − fitted segment mean) per channel, with ±2 standard deviations of each
+    residual (``residual_sd``: the noise model's prediction less what the fit itself takes up), against the
+    channel's own reading (top: a scale asymmetry shows as a V, a nonlinearity as a curve, a K2 term as a
+    parabola) and against time (bottom: a drift as a slope, a step as a jump, a warm-up as a decay). Points
+    beyond 3 standard deviations are red, as the report marks them with ``*``. Residuals in °/h and µg.
+
+    Parameters
+    ----------
+    result : plansim.fit.FitResult
+    path : str or os.PathLike
+        The figure file, written whole or not at all (:func:`plansim.io.files.atomic_write`).
+    format : {"png", "pdf", "svg"}, optional
+        Default: from the suffix of *path*.
+    """
+    chosen = figure_format(path, format)
+    save(draw_fit(result), path, chosen, dpi=110)
+
+
+def draw_fit(result):
+    """The figure of :func:`fit_figure`, not saved."""
+    sd = np.asarray(result.residual_sd, dtype=float)
+    residuals = np.asarray(result.residuals, dtype=float)
+    far = np.abs(residuals) > 3.0 * sd
+    inside = np.where(far, np.nan, residuals)
+    outside = np.where(far, residuals, np.nan)
+    ratio = result.chi2 / result.chi2_dof if result.chi2_dof > 0 else math.nan
+    return _residual_panels(result, [
+        (inside, 2.0 * sd, "residual (±2 sd)", dict(ms=3, color="tab:blue", ecolor="tab:blue", elinewidth=0.6,
+                                                      alpha=0.8)),
+        (outside, 2.0 * sd, "beyond 3 sd", dict(ms=4, color="tab:red", ecolor="tab:red", elinewidth=0.6))],
+        f"plansim fit: residual = observed - fitted segment mean; chi2/dof = {result.chi2:.5g}/{result.chi2_dof} "
+        f"= {ratio:.4g} ({result.chi2_verdict})")
 
 
 def sweep_figure(sweep, path: str | os.PathLike, format: str | None = None) -> None:
