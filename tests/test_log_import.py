@@ -305,6 +305,29 @@ def test_import_plot_shades_each_segment_and_draws_the_samples_in_their_units(tm
     assert not (tmp_path / "b.nc").exists() and not (tmp_path / "b.txt").exists()
 
 
+def test_the_summary_says_when_the_noise_is_correlated_from_sample_to_sample(tmp_path, capsys):
+    """The per-sample noise of the quiet stretch understates a segment mean's where the part's filter correlates
+    neighbouring samples. The same log with its noise through a first-order filter (pole 0.6: rho_1 = 0.6) is
+    said to be correlated in every channel, with its lag-one autocorrelation, as plansim fit reads it; the white
+    one is not."""
+    from scipy.signal import lfilter
+
+    t, x = synthetic_log(seed=4, seconds_rest=30.0)  # 30 s rest, a 2 s turn, 30 s rest at 100 Hz
+    filtered = x.copy()
+    for rest in (slice(0, 3000), slice(3200, None)):  # each rest's noise through the filter, its variance kept
+        level = x[rest].mean(axis=0)
+        filtered[rest] = level + lfilter([math.sqrt(1.0 - 0.6**2)], [1.0, -0.6], x[rest] - level, axis=0)
+    for name, samples, said in (("white", x, False), ("filtered", filtered, True)):
+        log = tmp_path / f"{name}.csv"
+        write_synthetic(log, t, samples)
+        assert main(["import", str(log), "--out", str(tmp_path / f"{name}.nc"), "--time", "time"]) == 0
+        out = capsys.readouterr().out
+        assert ("noise correlated from one sample to the next in gx gy gz ax ay az" in out) is said, out
+        if said:
+            rho = [float(v) for v in re.findall(r"lag-one autocorrelation ([0-9.]+) to ([0-9.]+)", out)[0]]
+            assert 0.5 < rho[0] <= rho[1] < 0.7  # 6000 samples: a standard error of 0.013
+
+
 def test_a_temperature_column_becomes_the_temperature_channel(tmp_path):
     t, x = synthetic_log()
     temperature = 25.0 + 0.001 * np.arange(t.size)

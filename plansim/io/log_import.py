@@ -39,6 +39,7 @@ from plansim.estimate.segmentation import (
     segment_log,
 )
 from plansim.estimate.timebase import DROPPED_MAX, TimeReport, analyse_time
+from plansim.fit import recording_noise_models
 from plansim.io.log_pairing import pair_logs, split_interleaved
 from plansim.io.log_table import (
     TIME_UNITS,
@@ -122,6 +123,9 @@ class ImportResult:
     offset: tuple[float, ...] | None = None  # counts at zero input (--offset), or None
     #: the channels read reversed (a leading '-' in ``columns``: an axis whose sign the log has the other way)
     reversed_channels: tuple[str, ...] = ()
+    #: per channel (gx … az), the correlation of its noise from one sample to the next over the static poses not
+    #: held by hand: ρ_1 … ρ_L (:func:`plansim.fit.noise.noise_autocorrelation`; empty where none shows)
+    correlation: tuple[np.ndarray, ...] = ()
 
 
 def _lines_listed(table: LogTable, rows) -> str:
@@ -562,8 +566,15 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         recording = Recording(samples, schedule, attrs, timestamps=timestamps, temperature=table.temperature)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: {exc}") from None
+    # the sensor's own filter (or a host's resampling) correlates neighbouring samples: the per-sample noise of the
+    # quiet stretch then understates a segment mean's. Told as plansim fit tells it, over the static poses whose
+    # scatter is the channel's quiet one (a hand's tremor makes an oscillating correlation); the quiet stretch
+    # alone is too short (400 samples: 4 standard errors of rho_1 are 0.2). The quantiser's level posterior, the
+    # costly part of the noise estimate, is not needed here
+    noise = recording_noise_models(recording, conditionals=(False,))[0]
+    correlation = tuple(np.asarray(channel.autocorrelation) for channel in noise.channels)
     return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings),
-                        zero_counts, tuple(CHANNELS[c] for c in range(6) if signs[c] < 0))
+                        zero_counts, tuple(CHANNELS[c] for c in range(6) if signs[c] < 0), correlation)
 
 
 def _saturation_episodes(saturation, apart: int) -> list[list]:

@@ -57,6 +57,15 @@ def format_summary(result: ImportResult) -> str:
                        for c, v in zip(CHANNELS[:3], noise.sigma[:3]))
     lines.append(f"  noise per sample (quiet stretch, lines {table.lines[noise.start]}-{table.lines[noise.stop - 1]}): "
                  f"{gyro} deg/s; {accel} m/s^2 (as white noise: {density} deg/sqrt(h))")
+    correlated = [(name, rho) for name, rho in zip(CHANNELS, result.correlation) if len(rho)]
+    if correlated:
+        first = [float(rho[0]) for _, rho in correlated]
+        lags = [len(rho) for _, rho in correlated]
+        lines.append(f"  noise correlated from one sample to the next in {' '.join(n for n, _ in correlated)} (lag-one "
+                     f"autocorrelation {min(first):.2g} to {max(first):.2g}, over {min(lags)} to {max(lags)} "
+                     "sample(s), pooled over the static poses of the channel's quiet scatter, as plansim fit reads it: "
+                     "the part's own low-pass filter, or a log resampled by its host): the per-sample figures above "
+                     "understate a segment mean's noise; plansim fit models the correlation (docs/fitting.md)")
     rate = " ".join(f"{math.degrees(v):.3g}" for v in seg.rate_threshold)
     lines.append(f"  at rest: variance ratios <= {seg.variance_threshold[0]:.3g} (accelerometers), "
                  f"{seg.variance_threshold[1]:.3g} (gyros) over {seg.window} samples "
