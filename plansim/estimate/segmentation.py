@@ -46,19 +46,19 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    ``RATE_FACTOR`` × s + 2 Ω_E on some axis (Ω_E the Earth rate: a unit at rest sees up to ±Ω_E on any
    axis, depending on its pose; comparing neighbours, a slow drift of the bias over a long log is not a
    turn); otherwise it is a *steady turn* (a rate table holding a rate), and belongs to the motion around
-   it. In another pose, the gyros' g-sensitivity alone moves their output from pose to pose
-   (up to 0.1 °/s/g for a consumer unit; ``G_SENSITIVITY_ALLOWANCE`` allows twice that): the run is then a
-   steady turn only when its output differs from the nearest rest's *along its own gravity* (a table with
+   it. In another pose, the gyros' g-sensitivity alone moves their output from pose to pose (up to 0.1 °/s/g
+   for a consumer unit; :data:`plansim.estimate.rests.G_SENSITIVITY_ALLOWANCE` allows twice that): the run is
+   then a steady turn only when its output differs from the nearest rest's *along its own gravity* (a table with
    gravity steady turns about the vertical) by more than the threshold there plus that allowance times the
    change of specific force. A turn slower than the threshold cannot be told from rest by any detector
    without a reference; the threshold is reported. Only the nearest rest is asked: a rest in the same pose
    long before differs by the bias's drift since. The run taken to be at rest first is ``Q``'s, unless the
-   runs' agreement says otherwise (:func:`_rest_by_agreement`: a table's steady turn is as quiet as a rest, and
+   runs' agreement says otherwise (:func:`first_rest`: a table's steady turn is as quiet as a rest, and
    ``Q`` can fall in one; rests agree across poses, a turn about the vertical does not); the gyro bias b is
    then that run's.
 6a. **A gyro more g-sensitive than the allowance.** Runs read as turns in a pose no rest shares are rests
    when the runs' own fit of each gyro's rest output (bias, drift, g-sensitivity) predicts them, left out, to
-   within the threshold along their gravity (:func:`_rests_by_g_sensitivity`).
+   within the threshold along their gravity (:func:`rests_by_g_sensitivity`).
 6b. **Poses held by hand.** Outside those runs, stretches of at least ``min_static`` where the
    accelerometers pass step 5 and hold one pose while the gyros do not (a hand's tremor: 1 °/s at 5 Hz tilts
    the unit by 0.03°) are poses too, when the attitude the gyros integrate about their mean swings by at
@@ -107,6 +107,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from plansim.estimate.frozen import Frozen, frozen_mask, frozen_runs
+from plansim.estimate.rests import SAME_POSE, at_rest_against, first_rest, rests_by_g_sensitivity
 from plansim.model.environment import EARTH_RATE
 
 #: default window of the moving statistics, s
@@ -128,14 +129,6 @@ MIN_WINDOW_SAMPLES = 10
 POSE_TOLERANCE = math.radians(0.5)
 #: the quietest stretch holds at least this many windows
 QUIET_WINDOWS = 8
-#: two runs are in the same pose when their mean specific forces are within this angle (step 6)
-SAME_POSE = math.radians(2.0)
-#: the g-sensitivity a MEMS gyro's rests in different poses are allowed, rad/s per m/s²: 0.2 °/s/g, twice a consumer
-#: unit's data-sheet figure (InvenSense MPU-6050, "linear acceleration sensitivity" 0.1 °/s/g); rests in different
-#: poses may differ by it times the change of specific force (step 6)
-G_SENSITIVITY_ALLOWANCE = math.radians(0.2) / 9.80665
-#: step 6a fits each gyro's rest output over the runs (bias, drift, three g-sensitivities) only from this many runs
-G_FIT_MIN_RUNS = 8
 #: a rotation's integral lies along one body axis: the other two components at most this fraction of it
 OFF_AXIS_FRACTION = 0.1
 #: a rotation's integral is within this of its nominal angle: ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION × nominal
@@ -490,7 +483,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         # the run that holds the quiet stretch is at rest by assumption (step 3), unless more of the log agrees
         # with another run (step 6: a table's steady turn is as quiet as a rest)
         holds_quiet = runs[first][0] <= start and start + quiet_length <= runs[first][1]
-        seed = _rest_by_agreement(runs, medians, forces, rate_threshold, first)
+        seed = first_rest(runs, medians, forces, rate_threshold, first)
         if seed != first:
             first, holds_quiet = seed, True
             a, b = runs[seed]
@@ -502,12 +495,12 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
             for i in order:
                 # against the nearest rest only: a rest in the same pose long before differs by the bias's
                 # drift since, and whether it was asked depended on the order the runs were visited in
-                at_rest[i] = _at_rest(i, rests[:1], medians, forces, bias, rate_threshold)
+                at_rest[i] = at_rest_against(i, rests[:1], medians, forces, bias, rate_threshold)
                 if at_rest[i]:
                     rests.insert(0, i)  # nearest first
         # 6a. a gyro g-sensitivity beyond the allowance, told by the runs themselves
         centres = [0.5 * (float(times[a]) + float(times[b - 1])) for a, b in runs]
-        at_rest = _rests_by_g_sensitivity(medians, forces, centres, at_rest, rate_threshold)
+        at_rest = rests_by_g_sensitivity(medians, forces, centres, at_rest, rate_threshold)
     static_runs = [run for run, rest in zip(runs, at_rest) if rest]
     steady = [run for run, rest in zip(runs, at_rest) if not rest]
     # 6b. poses held by hand: the accelerometers quiet and one pose, the gyros shaking about a steady mean
@@ -598,125 +591,6 @@ def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span 
     return float(np.dot(f, g)) >= math.cos(SAME_POSE) * float(np.linalg.norm(f) * np.linalg.norm(g))
 
 
-def _rest_by_agreement(runs: list[tuple[int, int]], medians: list, forces: list, rate_threshold: np.ndarray,
-                       quiet: int) -> int:
-    """The run taken to be at rest first (step 6).
-
-    Two runs *agree* when each is at rest with the other as the only rest (:func:`_at_rest` both ways: the gyro
-    outputs alike in one pose; in two poses, alike along each run's own gravity up to the g-sensitivity). The quiet
-    stretch alone (step 3) cannot tell a rest from a table's steady turn: a table's rate jitter is far below a MEMS
-    gyro's noise, so the two are equally quiet. Three things can, in this order:
-
-    1. **Poses.** Rests in different poses agree with each other, while a turn about the vertical differs from every
-       run in another pose along its own gravity by its rate. So where some run agrees with runs in two or more
-       poses (specific force :data:`SAME_POSE` apart), the candidates are the runs that agree with the most poses. A
-       log that starts and ends in the same steady turn but holds rests in two poses is read right.
-    2. **The log's ends.** In one pose (a rate table's test, every run about one vertical), a log is started and
-       stopped with the unit at rest: where the first and the last quiet runs agree, the candidates are the runs
-       that agree with them (a minute at each of ±100 °/s between 10 s rests: the turns hold more of the log).
-    3. **Samples.** Among the candidates, the run the most quiet samples agree with; *quiet* (the run nearest the
-       quiet stretch) where it has as many as any (a log of poses: every run agrees with it).
-
-    A log in one pose that starts and ends in the same steady turn cannot be told from one at rest throughout its
-    turns without the table's rates; the import warns of a rest turning about the vertical."""
-    sizes = np.array([b - a for a, b in runs])
-    one_way = [[j for j in range(len(runs)) if _at_rest(j, [i], medians, forces, None, rate_threshold)]
-               for i in range(len(runs))]
-    agree = [[j for j in one_way[i] if i in one_way[j]] for i in range(len(runs))]
-    poses = [len(_pose_clusters([forces[j] for j in agree[i]])) for i in range(len(runs))]
-    support = [int(sum(sizes[j] for j in agree[i])) for i in range(len(runs))]
-    if max(poses) >= 2:
-        candidates = [i for i in range(len(runs)) if poses[i] == max(poses)]
-    elif len(runs) > 1 and len(runs) - 1 in agree[0]:
-        candidates = agree[0]
-    else:
-        candidates = list(range(len(runs)))
-    best = max(support[i] for i in candidates)
-    if quiet in candidates and support[quiet] == best:
-        return quiet
-    return min((i for i in candidates if support[i] == best), key=lambda i: abs(i - quiet))
-
-
-def _rests_by_g_sensitivity(medians: list, forces: list, centres: list[float], at_rest: list[bool],
-                            rate_threshold: np.ndarray) -> list[bool]:
-    """Step 6a: runs read as steady turns in poses no rest shares, that are rests of a gyro more g-sensitive than
-    :data:`G_SENSITIVITY_ALLOWANCE` allows.
-
-    The allowance of step 6 is a data-sheet figure; a unit twice as g-sensitive (0.3 °/s/g) had half the poses of
-    a 12-pose hand session read as turns about the vertical. Where the runs span enough poses, they tell the unit's
-    own g-sensitivity: each run's mean gyro output is modelled as a rest's, b + d·t + G f (bias, a linear drift
-    over the log, the g-sensitivity matrix; per axis 5 unknowns, fitted over the runs by least squares), and a run
-    whose output is predicted, left out of the fit, to within the rest threshold *along its own gravity* (where a
-    turn about the vertical would show) is at rest. The run predicted worst is dropped from the fit while any is
-    out of that threshold, and the fit is used only while it holds at least :data:`G_FIT_MIN_RUNS` runs whose
-    poses are not coplanar (G is then determined with room to spare). Only runs in a pose of their own are
-    decided this way: where a rest shares a run's pose, the comparison of step 6 is exact (no g-sensitivity
-    between them), and a run found at rest stays at rest."""
-    n = len(medians)
-    ups = [np.asarray(f, dtype=float) / max(float(np.linalg.norm(f)), 1e-300) for f in forces]
-    lonely = [i for i in range(n) if not at_rest[i] and not any(
-        at_rest[j] and float(np.dot(ups[i], ups[j])) >= math.cos(SAME_POSE) for j in range(n))]
-    if not lonely:
-        return at_rest
-    used = [i for i in range(n) if at_rest[i] or i in lonely]
-    while len(used) >= G_FIT_MIN_RUNS:
-        t = np.array([centres[i] for i in used])
-        design = np.column_stack([np.ones(len(used)), t - t.mean(), np.array([forces[i] for i in used])])
-        if np.linalg.matrix_rank(design / np.maximum(np.abs(design).max(axis=0), 1e-300)) < design.shape[1]:
-            break  # the poses are coplanar (or too few): G is not determined
-        outputs = np.array([medians[i] for i in used])
-        coefficients, *_ = np.linalg.lstsq(design, outputs, rcond=None)
-        hat = np.einsum("ij,jk,ik->i", design, np.linalg.pinv(design.T @ design), design)
-        if np.any(hat >= 1.0 - 1e-9):
-            break  # a run the fit must pass through: nothing predicts it
-        left_out = (outputs - design @ coefficients) / (1.0 - hat)[:, None]  # each run predicted without it
-        ratios = np.array([abs(float(np.dot(r, ups[i]))) / float(np.linalg.norm(rate_threshold * ups[i]))
-                           for r, i in zip(left_out, used)])
-        worst = int(np.argmax(ratios))
-        if ratios[worst] <= 1.0:
-            return [rest or i in used for i, rest in enumerate(at_rest)]
-        used.pop(worst)
-    return at_rest
-
-
-def _pose_clusters(forces: list) -> list[np.ndarray]:
-    """The distinct poses among mean specific forces: each force joins the first pose within :data:`SAME_POSE` of
-    it, or starts a new one. Returns one unit vector per pose."""
-    poses: list[np.ndarray] = []
-    for f in forces:
-        up = np.asarray(f, dtype=float) / max(float(np.linalg.norm(f)), 1e-300)
-        if not any(float(np.dot(up, p)) >= math.cos(SAME_POSE) for p in poses):
-            poses.append(up)
-    return poses
-
-
-def _at_rest(i: int, rests: list[int], medians: list, forces: list, bias: np.ndarray | None,
-             rate_threshold: np.ndarray) -> bool:
-    """Step 6 for run *i*, given the runs at rest it is compared with (*rests*, nearest first: in the walk of step 6
-    the nearest one on the walk's side; for a held pose every rest, by distance in time).
-
-    Against the nearest rest in the same pose (specific force within :data:`SAME_POSE` of run i's): at rest
-    when the mean gyro outputs agree within *rate_threshold* on every axis, as a bias that drifts slowly
-    would. Where no rest shares the pose, the gyro outputs of two rests also differ by the gyros'
-    g-sensitivity times the change of specific force, which for consumer MEMS exceeds the threshold (0.1
-    °/s/g between two flips is 0.2 °/s); and a rate table holding a rate with gravity steady turns about the
-    vertical. So the run is a steady turn only when its gyro output differs from the nearest rest's *along
-    its own gravity direction* by more than the threshold there plus :data:`G_SENSITIVITY_ALLOWANCE` times
-    the change of specific force."""
-    if not rests:
-        return bool(np.all(np.abs(medians[i] - bias) <= rate_threshold))
-    up = forces[i] / max(np.linalg.norm(forces[i]), 1e-300)
-    for j in rests:
-        other = forces[j] / max(np.linalg.norm(forces[j]), 1e-300)
-        if float(np.dot(up, other)) >= math.cos(SAME_POSE):
-            return bool(np.all(np.abs(medians[i] - medians[j]) <= rate_threshold))
-    j = rests[0]
-    along = abs(float(np.dot(medians[i] - medians[j], up)))
-    allowed = float(np.linalg.norm(rate_threshold * up)) + G_SENSITIVITY_ALLOWANCE * float(
-        np.linalg.norm(forces[i] - forces[j]))
-    return along <= allowed
-
-
 def _merge_same_pose(runs: list[tuple[int, int]], x: np.ndarray, w: int) -> list[tuple[int, int]]:
     """Join runs at rest that are at most a window apart and in the same pose (specific force within
     :data:`SAME_POSE`): a hand that shakes only now and then splits one pose into quiet and held pieces."""
@@ -738,7 +612,7 @@ def _held_runs(x, times, accel_test, near_gap, n_min, w, accel_window, static_ru
     hand, whose tremor the gyros see and the accelerometers hardly do (a tremor of 1 °/s at 5 Hz tilts the unit
     by 0.03°). Such a stretch is a pose when the attitude the gyros integrate about their mean rate swings by
     no more than ±``POSE_TOLERANCE`` (no turn started and stopped inside it) and, as in step 6, its mean gyro
-    output is that of a rest (:func:`_at_rest`: along its own gravity, against the nearest rest)."""
+    output is that of a rest (:func:`at_rest_against`: along its own gravity, against the nearest rest)."""
     ratio, threshold = accel_test
     taken = np.zeros(x.shape[0], dtype=bool)
     for a, b in static_runs + steady:
@@ -761,7 +635,7 @@ def _held_runs(x, times, accel_test, near_gap, n_min, w, accel_window, static_ru
         forces.append(x[a:b, 3:].mean(axis=0))
         i = len(medians) - 1
         nearest = sorted(range(i), key=lambda j: abs(where[j] - 0.5 * (a + b)))
-        if _at_rest(i, nearest, medians, forces, bias, rate_threshold):
+        if at_rest_against(i, nearest, medians, forces, bias, rate_threshold):
             out.append((a, b))
             where.append(0.5 * (a + b))
         else:
