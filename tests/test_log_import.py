@@ -995,19 +995,44 @@ def test_a_table_rate_column_gives_each_steady_turn_its_rate(tmp_path, capsys):
     assert not (tmp_path / "x.nc").exists()
 
 
-def test_a_table_rate_column_tells_a_turn_about_the_vertical_taken_for_a_rest(tmp_path, capsys):
-    """A log that is one steady turn of +3 deg/s about z (up) from end to end: nothing in the IMU's data tells it
-    from a rest with a 3 deg/s bias, and it is taken for one (with the rest_turning_about_vertical warning); the
-    table's rate column says it turned (table_turning_at_rest)."""
-    t, x, rate = _rate_table_log([], 1.0, seed=23, rest_s=30.0, table_rate=True)
-    x[:, 2] += 3.0
+def test_a_table_rate_column_reads_a_one_pose_log_that_starts_and_ends_in_a_turn(tmp_path, capsys):
+    """A log in one pose (+z up) that starts and ends in the same steady turn: 40 s at +3 deg/s, a 1 s stop, a 20 s
+    rest, a 1 s spin-up, 40 s at +3 deg/s. From the IMU alone it is ambiguous: the turns hold more of the log and
+    the log's two ends agree, so the turn is taken for the rest (a 3 deg/s bias, with the
+    rest_turning_about_vertical warning) and the rest for a turn. With the table's rate column, the table decides
+    step 6: the rest is the one static pose, the gyro bias is its own (0.2 deg/s), and both ends are rotations with
+    the column's rate."""
+    fs = 100.0
+    ramp = np.linspace(0.0, 1.0, int(fs), endpoint=False)
+    profile = np.concatenate([np.full(int(40 * fs), 3.0), 3.0 * ramp[::-1], np.zeros(int(20 * fs)), 3.0 * ramp,
+                              np.full(int(40 * fs), 3.0)])
+    rng = np.random.default_rng(23)
+    x = np.zeros((profile.size, 6))
+    x[:, 2] = profile + 0.2
+    x[:, :3] += 0.05 * rng.standard_normal((profile.size, 3))
+    x[:, 5] = 9.80
+    x[:, 3:] += 0.005 * rng.standard_normal((profile.size, 3))
+    t = np.arange(profile.size) / fs
     log = tmp_path / "turning.csv"
-    write_synthetic(log, t, x, extra={"table_dps": rate + 3.0})
-    assert main(["import", str(log), "--out", str(tmp_path / "rec.nc"), "--time", "time", "--units", "deg/s,m/s^2",
-                 "--columns", "gx,gy,gz,ax,ay,az", "--table-rate-column", "table_dps"]) == 0
+    write_synthetic(log, t, x, extra={"table_dps": profile})
+    options = ["--time", "time", "--units", "deg/s,m/s^2", "--columns", "gx,gy,gz,ax,ay,az"]
+    assert main(["import", str(log), "--out", str(tmp_path / "alone.nc"), *options]) == 0
     out = capsys.readouterr().out
-    assert "warning [table_turning_at_rest]" in out and "reads +3 deg/s over it" in out
-    assert "warning [rest_turning_about_vertical]" in out
+    assert "warning [rest_turning_about_vertical]" in out  # the IMU alone: the turn taken for the rest
+    assert main(["import", str(log), "--out", str(tmp_path / "rec.nc"), *options, "--table-rate-column",
+                 "table_dps"]) == 0
+    out = capsys.readouterr().out
+    assert "rest_turning_about_vertical" not in out and "table_turning_at_rest" not in out
+    recording = read_recording(tmp_path / "rec.nc")
+    tests = [s.test for s in recording.schedule.segments]
+    assert tests == ["rotation", "move", "static", "move", "rotation"], tests
+    static = recording.segment_samples(2)
+    assert np.degrees(static[:, 2].mean()) == pytest.approx(0.2, abs=0.01)  # 2000 samples of 0.05 deg/s: 0.001
+    ends = [recording.schedule.segments[k] for k in (0, 4)]
+    # each the column's mean over its own samples (a few of the stop or spin-up's are in the segment: 3 - 1e-4)
+    column = [profile[first:first + s.samples].mean() for first, s in zip(recording.first_sample[[0, 4]], ends)]
+    assert [math.degrees(s.rate) for s in ends] == pytest.approx(column, rel=1e-12)
+    assert column == pytest.approx([3.0, 3.0], abs=1e-3) and all(s.rate_axis == "+z" for s in ends)
 
 
 def _write_sensor_log(path: Path, time_s: np.ndarray, values: np.ndarray, unit: str) -> None:

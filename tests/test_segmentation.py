@@ -299,6 +299,14 @@ def test_a_step_in_a_gyro_bias_does_not_make_the_poses_after_it_turns():
     assert all(s.stop - s.start >= 18.0 * FS for s in statics) and not result.steady_turns
 
 
+def test_a_table_rate_of_the_wrong_length_is_refused():
+    x = static_noise("white", 20.0, np.random.default_rng(1))
+    with pytest.raises(ValueError, match=r"table_rate: shape \(5,\); expected \(2000,\)"):
+        segment_log(x, None, FS, table_rate=np.zeros(5))
+    with pytest.raises(ValueError, match="table_rate"):
+        segment_log(x, None, FS, table_rate=np.full(x.shape[0], np.nan))
+
+
 def test_a_turn_too_long_for_its_quarter_turn_to_be_told_is_a_move():
     """A turn of 830 deg that holds no steady rate: 10 deg + 5 % of it passes half a quarter turn, so the nearest
     whole number of quarter turns (810 deg) is no reference; it is a move, saying why (an independent simulator's

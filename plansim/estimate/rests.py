@@ -46,7 +46,8 @@ def first_rest(runs: list[tuple[int, int]], medians: list, forces: list, rate_th
        quiet stretch) where it has as many as any (a log of poses: every run agrees with it).
 
     A log in one pose that starts and ends in the same steady turn cannot be told from one at rest throughout its
-    turns without the table's rates; the import warns of a rest turning about the vertical."""
+    turns without the table's rates; the import warns of a rest turning about the vertical, and a logged table
+    rate (``segment_log(table_rate=…)``) decides in its place."""
     sizes = np.array([b - a for a, b in runs])
     one_way = [[j for j in range(len(runs)) if at_rest_against(j, [i], medians, forces, None, rate_threshold)]
                for i in range(len(runs))]

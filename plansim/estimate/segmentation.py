@@ -347,7 +347,8 @@ def _quiet_stretch(ratio: np.ndarray, length: int, blocked: np.ndarray) -> int:
 
 def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float, *,
                 window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
-                gap_starts: np.ndarray | None = None, full_scale: np.ndarray | None = None) -> Segmentation:
+                gap_starts: np.ndarray | None = None, full_scale: np.ndarray | None = None,
+                table_rate: np.ndarray | None = None) -> Segmentation:
     """Find the static spans of a log and classify the motion between them (see the module docstring).
 
     Parameters
@@ -368,6 +369,11 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     full_scale : (6,) array or None
         Each channel's full scale (the largest magnitude it can read), rad/s or m/s²; NaN where not known,
         ``None``: none known. A declared full scale replaces the detector of step 10 for its channel.
+    table_rate : (N,) array or None
+        The turntable's rate at every sample (its controller's or encoder's, logged beside the IMU), rad/s; its
+        sense does not matter. Given, it decides step 6: a quiet run is a steady turn where the table's mean rate
+        over it exceeds the rest threshold, and at rest where it does not, whatever the gyros' agreement says (a
+        log in one pose that starts and ends in the same steady turn is otherwise ambiguous).
 
     Returns
     -------
@@ -394,6 +400,11 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
             raise ValueError(f"full_scale = {full_scale.tolist()!r}; expected 6 positive numbers (rad/s for gx gy gz, "
                              "m/s^2 for ax ay az), NaN where not known")
     n = x.shape[0]
+    if table_rate is not None:
+        table_rate = np.asarray(table_rate, dtype=np.float64)
+        if table_rate.shape != (n,) or not np.all(np.isfinite(table_rate)):
+            raise ValueError(f"table_rate: shape {table_rate.shape}; expected ({n},) finite rates (rad/s), one per "
+                             "sample")
     w = max(MIN_WINDOW_SAMPLES, int(round(window * sample_rate)))
     half = w // 2
     n_min = max(1, int(round(min_static * sample_rate)))
@@ -501,6 +512,12 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         # 6a. a gyro g-sensitivity beyond the allowance, told by the runs themselves
         centres = [0.5 * (float(times[a]) + float(times[b - 1])) for a, b in runs]
         at_rest = rests_by_g_sensitivity(medians, forces, centres, at_rest, rate_threshold)
+        if table_rate is not None:  # the table's own rate is the reference: it turned, or it did not
+            at_rest = [abs(float(np.mean(table_rate[a:b]))) <= float(np.max(rate_threshold)) for a, b in runs]
+            if any(at_rest) and not at_rest[first]:  # the bias from a run the table says was at rest
+                a, b = max((run for run, rest in zip(runs, at_rest) if rest), key=lambda run: run[1] - run[0])
+                bias = clipped[a:b, :3].mean(axis=0)
+                noise = dataclasses.replace(noise, gyro_bias=bias)
     static_runs = [run for run, rest in zip(runs, at_rest) if rest]
     steady = [run for run, rest in zip(runs, at_rest) if not rest]
     # 6b. poses held by hand: the accelerometers quiet and one pose, the gyros shaking about a steady mean

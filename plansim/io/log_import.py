@@ -380,8 +380,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
 
     if timing.sample_times is not None:
         time_s = timing.sample_times
+    table_rate_si = None if table.table_rate is None else table.table_rate * table_rate_factor
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
-                               gap_starts=timing.gap_starts, full_scale=rail_si)
+                               gap_starts=timing.gap_starts, full_scale=rail_si, table_rate=table_rate_si)
     statics = segmentation.of_kind("static")
     at_rest = float(np.median([np.linalg.norm(span.mean[3:]) for span in statics]))
     if abs(at_rest / STANDARD_GRAVITY - 1.0) > GRAVITY_TOLERANCE:
@@ -481,8 +482,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                           "the last static span: kept as a 'move'"))
 
     table_rates = {}
-    if table.table_rate is not None:
-        table_rates = _rates_from_table(segmentation, table, table.table_rate * table_rate_factor, warnings)
+    if table_rate_si is not None:
+        table_rates = _rates_from_table(segmentation, table, table_rate_si, warnings)
 
     segment_temperature = DEFAULT_TEMPERATURE if temperature is None else float(temperature)
     segments = []
@@ -603,7 +604,8 @@ def _rates_from_table(segmentation, table: LogTable, table_rate: np.ndarray, war
     as the gyros measured the turn, by span number. Warns (``table_rate_disagrees``) where the column's mean and
     the gyros' measured rate differ by more than :data:`TABLE_RATE_AGREEMENT` of the column's (a column in
     another unit, or not the turning axis's), and (``table_turning_at_rest``) where a static pose's column reads
-    more than the rest threshold (a turn about the vertical taken for a rest)."""
+    more than the rest threshold: a pose held by hand (step 6b), since the table's rate decides step 6 for the
+    quiet runs (:func:`plansim.estimate.segmentation.segment_log`)."""
     rates = {}
     disagree, senses = [], set()
     for k, span in enumerate(segmentation.spans):
