@@ -123,8 +123,9 @@ class ImportResult:
     offset: tuple[float, ...] | None = None  # counts at zero input (--offset), or None
     #: the channels read reversed (a leading '-' in ``columns``: an axis whose sign the log has the other way)
     reversed_channels: tuple[str, ...] = ()
-    #: per channel (gx … az), the correlation of its noise from one sample to the next over the static poses not
-    #: held by hand: ρ_1 … ρ_L (:func:`plansim.fit.noise.noise_autocorrelation`; empty where none shows)
+    #: per channel (gx … az), the correlation of its noise from one sample to the next over the static poses of
+    #: the channel's quiet scatter, as plansim fit reads it: ρ_1 … ρ_L (:func:`plansim.fit.noise.noise_autocorrelation`
+    #: through :func:`plansim.fit.recording_noise_models`; empty where none shows)
     correlation: tuple[np.ndarray, ...] = ()
 
 
