@@ -500,24 +500,25 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
             a, b = runs[seed]
             bias = clipped[a:b, :3].mean(axis=0)
             noise = dataclasses.replace(noise, gyro_bias=bias)
-        at_rest[first] = holds_quiet or bool(np.all(np.abs(medians[first] - bias) <= rate_threshold))
-        for order in (range(first + 1, len(runs)), range(first - 1, -1, -1)):
-            rests = [first] if at_rest[first] else []
-            for i in order:
-                # against the nearest rest only: a rest in the same pose long before differs by the bias's
-                # drift since, and whether it was asked depended on the order the runs were visited in
-                at_rest[i] = at_rest_against(i, rests[:1], medians, forces, bias, rate_threshold)
-                if at_rest[i]:
-                    rests.insert(0, i)  # nearest first
-        # 6a. a gyro g-sensitivity beyond the allowance, told by the runs themselves
-        centres = [0.5 * (float(times[a]) + float(times[b - 1])) for a, b in runs]
-        at_rest = rests_by_g_sensitivity(medians, forces, centres, at_rest, rate_threshold)
         if table_rate is not None:  # the table's own rate is the reference: it turned, or it did not
             at_rest = [abs(float(np.mean(table_rate[a:b]))) <= float(np.max(rate_threshold)) for a, b in runs]
             if any(at_rest) and not at_rest[first]:  # the bias from a run the table says was at rest
                 a, b = max((run for run, rest in zip(runs, at_rest) if rest), key=lambda run: run[1] - run[0])
                 bias = clipped[a:b, :3].mean(axis=0)
                 noise = dataclasses.replace(noise, gyro_bias=bias)
+        else:
+            at_rest[first] = holds_quiet or bool(np.all(np.abs(medians[first] - bias) <= rate_threshold))
+            for order in (range(first + 1, len(runs)), range(first - 1, -1, -1)):
+                rests = [first] if at_rest[first] else []
+                for i in order:
+                    # against the nearest rest only: a rest in the same pose long before differs by the bias's
+                    # drift since, and whether it was asked depended on the order the runs were visited in
+                    at_rest[i] = at_rest_against(i, rests[:1], medians, forces, bias, rate_threshold)
+                    if at_rest[i]:
+                        rests.insert(0, i)  # nearest first
+            # 6a. a gyro g-sensitivity beyond the allowance, told by the runs themselves
+            centres = [0.5 * (float(times[a]) + float(times[b - 1])) for a, b in runs]
+            at_rest = rests_by_g_sensitivity(medians, forces, centres, at_rest, rate_threshold)
     static_runs = [run for run, rest in zip(runs, at_rest) if rest]
     steady = [run for run, rest in zip(runs, at_rest) if not rest]
     # 6b. poses held by hand: the accelerometers quiet and one pose, the gyros shaking about a steady mean
