@@ -1035,6 +1035,104 @@ def test_a_table_rate_column_reads_a_one_pose_log_that_starts_and_ends_in_a_turn
     assert column == pytest.approx([3.0, 3.0], abs=1e-3) and all(s.rate_axis == "+z" for s in ends)
 
 
+def _indexed_turns_log(turns_deg, seed: int, fs: float = 100.0, scale: float = 1.003):
+    """A table's indexing log about z (up), written here without plansim's simulator: 6 s rests between turns by
+    *turns_deg* that spin up linearly over 1 s, hold their peak for 0.3 s (no steady turn: step 9 does not split
+    them) and stop as they started; then a steady turn at 50 deg/s for 8 s between the same ramps. The z gyro reads
+    *scale* times the table's rate plus 0.2 deg/s; white noise 0.05 deg/s and 0.005 m/s^2 per sample. Returns time,
+    samples (gyros in deg/s), the table's rate (deg/s) and its angle at each sample (deg, the angle turned before
+    it), and each turn's whole angle (deg)."""
+    ramp = np.linspace(0.0, 1.0, int(fs), endpoint=False)
+
+    def turn(angle, hold):
+        peak = angle / (1.0 + hold)
+        return np.concatenate([peak * ramp, np.full(int(round(hold * fs)), peak), peak * ramp[::-1]])
+
+    rest = np.zeros(int(6 * fs))
+    pieces = [rest]
+    for angle in turns_deg:
+        pieces += [turn(angle, 0.3), rest]
+    pieces += [turn(50.0 * 9.0, 8.0), rest]
+    rate = np.concatenate(pieces)
+    rng = np.random.default_rng(seed)
+    x = np.zeros((rate.size, 6))
+    x[:, 2] = scale * rate + 0.2
+    x[:, :3] += 0.05 * rng.standard_normal((rate.size, 3))
+    x[:, 5] = 9.80
+    x[:, 3:] += 0.005 * rng.standard_normal((rate.size, 3))
+    angle = np.concatenate(([0.0], np.cumsum(rate[:-1]) / fs))
+    whole = [float(np.sum(turn(a, 0.3)) / fs) for a in turns_deg]
+    return np.arange(rate.size) / fs, x, rate, angle, whole
+
+
+@pytest.mark.parametrize("column", ["angle", "rate"])
+def test_a_table_angle_or_rate_column_gives_each_turn_between_rests_its_angle(tmp_path, capsys, column):
+    """A table indexing about the vertical by 45, -30, 405, 90 and -567 deg (each with its 1 s spin-up and stop,
+    no steady part), then a steady turn at 50 deg/s, the table's encoder logged beside the IMU (wrapping at 360 deg,
+    0.0001 deg resolution) or its rate. From the IMU alone only the nearest quarter turn is a reference: 45, -30 and
+    405 deg are moves, and the -567 deg turn is taken for -540 deg (within 10 deg + 5 %), 4 % off. With the table's
+    column each turn between two rests takes the table's own angle over it (step 8), whatever it is: within the
+    encoder's resolution of the turn made (the rate column's integral is the angle exactly), signed as the gyros
+    measured; the steady turn gets its rate from the angle's change per sample; and `plansim fit` gives the z
+    gyro's scale factor within its stated u (|z| < 3.3, a 0.1 % two-sided test) with the segment table as
+    imported."""
+    turns = [45, -30, 405, 90, -567]
+    t, x, rate, angle, whole = _indexed_turns_log(turns, seed=31)
+    encoder = np.round((angle + 123.0) % 360.0, 4)
+    log = tmp_path / "table.csv"
+    write_synthetic(log, t, x, extra={"table": encoder if column == "angle" else rate})
+    options = ["--time", "time", "--units", "deg/s,m/s^2", "--columns", "gx,gy,gz,ax,ay,az"]
+    assert main(["import", str(log), "--out", str(tmp_path / "alone.nc"), *options]) == 0
+    capsys.readouterr()
+    alone = [s for s in read_recording(tmp_path / "alone.nc").schedule.segments if s.test != "static"]
+    assert [s.test for s in alone[:5]] == ["move", "move", "move", "rotation", "rotation"], [s.label for s in alone]
+    assert math.degrees(alone[4].angle) == pytest.approx(-540.0)
+    assert main(["import", str(log), "--out", str(tmp_path / "rec.nc"), *options, f"--table-{column}-column",
+                 "table"]) == 0
+    out = capsys.readouterr().out
+    assert "angle = the table's turn from rest to rest" in out and "for 5 of 5" in out, out
+    assert "warning [table" not in out, out
+    recording = read_recording(tmp_path / "rec.nc")
+    rotations = [s for s in recording.schedule.segments if s.test == "rotation"]
+    assert len(rotations) == 6
+    assert [math.degrees(s.angle) for s in rotations[:5]] == pytest.approx(whole, abs=1e-3)
+    assert all(math.isnan(s.rate) for s in rotations[:5]) and math.isnan(rotations[5].angle)
+    assert math.degrees(rotations[5].rate) == pytest.approx(50.0, abs=1e-3)
+    assert main(["fit", str(tmp_path / "rec.nc"), "--latitude", "40", "--height", "50", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["identified"] == ["Kgzz"]
+    kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
+    assert abs(kgzz["estimate"] - 1.003) < 3.3 * kgzz["u"], kgzz
+
+
+def test_a_table_angle_column_in_the_wrong_unit_or_not_finite_is_named(tmp_path, capsys):
+    """The encoder's column in rad read as deg (the default unit): the table turns 57 times less than the gyros
+    measure, so the turns it reads beyond 1 deg are moves, named in one warning (``table_turn_not_a_rotation``);
+    read with ``--table-angle-unit rad`` they are rotations. A unit that is no angle, a NaN in the column, and the
+    column with a second file are refused, naming the option or the line."""
+    t, x, rate, angle, whole = _indexed_turns_log([90, -180], seed=32)
+    log = tmp_path / "table.csv"
+    write_synthetic(log, t, x, extra={"enc": np.radians(angle)})
+    options = ["--time", "time", "--units", "deg/s,m/s^2", "--columns", "gx,gy,gz,ax,ay,az", "--table-angle-column",
+               "enc"]
+    assert main(["import", str(log), "--out", str(tmp_path / "wrong.nc"), *options]) == 0
+    out = capsys.readouterr().out
+    assert "warning [table_turn_not_a_rotation]: 2 motion(s)" in out and "more than 10% apart" in out, out
+    assert main(["import", str(log), "--out", str(tmp_path / "rec.nc"), *options, "--table-angle-unit", "rad"]) == 0
+    capsys.readouterr()
+    rotations = [s for s in read_recording(tmp_path / "rec.nc").schedule.segments if s.test == "rotation"]
+    assert [math.degrees(s.angle) for s in rotations[:2]] == pytest.approx(whole, abs=1e-6)
+    with pytest.raises(ValueError, match=r"--table-angle-unit 'deg/s': allowed: rad, deg"):
+        import_log(log, time_column="time", units="deg/s,m/s^2", table_angle_column="enc", table_angle_unit="deg/s")
+    with pytest.raises(ValueError, match="--table-angle-column with --accel-log"):
+        import_log(log, time_column="time", units="deg/s,m/s^2", table_angle_column="enc", accel_log=log)
+    column = np.radians(angle)
+    column[700] = np.nan
+    write_synthetic(log, t, x, extra={"enc": column})
+    with pytest.raises(ValueError, match="enc"):
+        import_log(log, time_column="time", units="deg/s,m/s^2", table_angle_column="enc")
+
+
 def _write_sensor_log(path: Path, time_s: np.ndarray, values: np.ndarray, unit: str) -> None:
     """One sensor's log as phyphox and the phone sensor loggers write it: a time column and three axes, quoted."""
     header = ",".join(f'"{name}"' for name in ("Time (s)", f"X ({unit})", f"Y ({unit})", f"Z ({unit})"))

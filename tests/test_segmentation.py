@@ -305,6 +305,10 @@ def test_a_table_rate_of_the_wrong_length_is_refused():
         segment_log(x, None, FS, table_rate=np.zeros(5))
     with pytest.raises(ValueError, match="table_rate"):
         segment_log(x, None, FS, table_rate=np.full(x.shape[0], np.nan))
+    with pytest.raises(ValueError, match=r"table_angle: shape \(5,\); expected \(2000,\)"):
+        segment_log(x, None, FS, table_angle=np.zeros(5))
+    with pytest.raises(ValueError, match="table_angle"):
+        segment_log(x, None, FS, table_angle=np.full(x.shape[0], np.inf))
 
 
 def test_a_turn_too_long_for_its_quarter_turn_to_be_told_is_a_move():

@@ -33,7 +33,8 @@ def _cmd_import(args) -> int:
                         temperature_column=args.temperature_column, temperature=args.temperature,
                         latitude=args.latitude, height=args.height, full_scale=args.full_scale,
                         accel_log=args.accel_log, table_rate_column=args.table_rate_column,
-                        table_rate_unit=args.table_rate_unit, **options)
+                        table_rate_unit=args.table_rate_unit, table_angle_column=args.table_angle_column,
+                        table_angle_unit=args.table_angle_unit, **options)
     with OutputSet() as staged:
         if args.plot is not None:  # drawn before the recording is written; committed once it is
             from plansim.report.plot import recording_figure
@@ -99,6 +100,12 @@ def _add_import_command(sub) -> None:
                         "it without editing the segment table")
     p.add_argument("--table-rate-unit", default="deg/s", metavar="UNIT",
                    help="unit of --table-rate-column (deg/s, rad/s or deg/h; default deg/s)")
+    p.add_argument("--table-angle-column", default=None, metavar="COL",
+                   help="a column holding the turntable's angle (its encoder's position, wrapping or not): each turn "
+                        "between two rests takes the table's change of angle as its reference, whatever the angle, "
+                        "and without --table-rate-column its rate gives each steady turn's")
+    p.add_argument("--table-angle-unit", default="deg", metavar="UNIT",
+                   help="unit of --table-angle-column (deg, rad, arcmin or arcsec; default deg)")
     p.add_argument("--temperature", type=float, default=None, metavar="DEGC",
                    help="the lab's temperature, for a log without a temperature column (default 20, noted as assumed)")
     p.add_argument("--latitude", type=float, default=None, metavar="DEG", help="site latitude (site_latitude_deg)")

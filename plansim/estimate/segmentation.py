@@ -76,7 +76,12 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    started, and (d) the turn is about the vertical (the axis within 20° of the mean specific force) or is a
    whole number of full turns. Anything else is a *move*: the unit was carried from one pose to another and no reference
    says by how much. A motion that holds a time gap or a saturated sample is a move too: its integral
-   is not known.
+   is not known. **With the table's angle or rate logged** (``table_angle``, ``table_rate``), a motion over which
+   the table turned by more than ``TABLE_STILL`` has the table's own angle as its reference, whatever it is
+   (45°, 10°, 567°), in place of the nearest quarter turn: it is a rotation by that angle, signed as the gyros
+   measured it, where (a) holds, the gyros' integral is within ``TABLE_AGREEMENT`` of the table's angle, the
+   unit ends with the same axis up, and the turn is about the vertical or a whole number of full turns (within
+   10°); a move otherwise, its reason saying which failed.
 9. **Steady turns.** Step 8 is for turns by hand against a stop. A motion that holds steady turns (step 6) is a
    table's, which need not stop on a quarter turn (a −567° turn would be labelled −540°): each steady turn is a
    *rotation* of its own with its measured rate (``Span.steady_rate``) and no angle (the table's rate, not in
@@ -134,6 +139,10 @@ OFF_AXIS_FRACTION = 0.1
 #: a rotation's integral is within this of its nominal angle: ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION × nominal
 ANGLE_TOLERANCE_RAD = math.radians(10.0)
 ANGLE_TOLERANCE_FRACTION = 0.05
+#: a table's logged rate or angle and the gyros' agree when they differ by at most this fraction of the table's
+TABLE_AGREEMENT = 0.1
+#: a motion over which the table's logged angle changed by at most this is not the table's turn (step 8)
+TABLE_STILL = math.radians(1.0)
 #: a rotation about the vertical: the axis within this angle of the mean specific force
 VERTICAL_AXIS_TOLERANCE = math.radians(20.0)
 #: a static pose is "approximate" (near a nominal pose) when its tilt from the nearest axis is at most this
@@ -200,8 +209,9 @@ class Span:
     axis : int
         Motion: the body axis (0, 1, 2) of the largest integrated component (−1 when not known).
     angle : float
-        Rotation by hand: the nominal angle about ``+axis``, rad, a whole number of quarter turns; NaN otherwise
-        (a steady turn included).
+        Rotation between two rests: the reference angle about ``+axis``, rad: the table's logged angle over the
+        span where it was logged (``table_turned``, signed as the gyros measured the turn), else the nominal
+        angle, a whole number of quarter turns; NaN otherwise (a steady turn included).
     orientation : str
         ``"approximate"`` (static: tilt ≤ APPROXIMATE_TILT; rotation: about the vertical) or ``"unknown"``.
     steady_rate : float
@@ -223,6 +233,9 @@ class Span:
     orientation: str = "unknown"
     steady_rate: float = math.nan
     reason: str = ""
+    #: motion, with the table's angle or rate logged: the angle the table turned over the span by its own column
+    #: (its own sense), rad; NaN otherwise
+    table_turned: float = math.nan
     #: static and held by hand (step 6b): the gyros' largest scatter over their quiet stretch's; NaN otherwise
     held: float = math.nan
 
@@ -348,7 +361,7 @@ def _quiet_stretch(ratio: np.ndarray, length: int, blocked: np.ndarray) -> int:
 def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float, *,
                 window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
                 gap_starts: np.ndarray | None = None, full_scale: np.ndarray | None = None,
-                table_rate: np.ndarray | None = None) -> Segmentation:
+                table_rate: np.ndarray | None = None, table_angle: np.ndarray | None = None) -> Segmentation:
     """Find the static spans of a log and classify the motion between them (see the module docstring).
 
     Parameters
@@ -373,7 +386,12 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         The turntable's rate at every sample (its controller's or encoder's, logged beside the IMU), rad/s; its
         sense does not matter. Given, it decides step 6: a quiet run is a steady turn where the table's mean rate
         over it exceeds the rest threshold, and at rest where it does not, whatever the gyros' agreement says (a
-        log in one pose that starts and ends in the same steady turn is otherwise ambiguous).
+        log in one pose that starts and ends in the same steady turn is otherwise ambiguous). Its integral over
+        a motion between two rests is that turn's reference angle (step 8), unless *table_angle* is given.
+    table_angle : (N,) array or None
+        The turntable's angle at every sample (its encoder's), rad, unwrapped (no jump of half a turn between
+        samples); its sense does not matter. Its change over a motion between two rests is that turn's
+        reference angle (step 8), whatever the angle: the table's own reference, not the nearest quarter turn.
 
     Returns
     -------
@@ -405,6 +423,11 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         if table_rate.shape != (n,) or not np.all(np.isfinite(table_rate)):
             raise ValueError(f"table_rate: shape {table_rate.shape}; expected ({n},) finite rates (rad/s), one per "
                              "sample")
+    if table_angle is not None:
+        table_angle = np.asarray(table_angle, dtype=np.float64)
+        if table_angle.shape != (n,) or not np.all(np.isfinite(table_angle)):
+            raise ValueError(f"table_angle: shape {table_angle.shape}; expected ({n},) finite angles (rad), one per "
+                             "sample")
     w = max(MIN_WINDOW_SAMPLES, int(round(window * sample_rate)))
     half = w // 2
     n_min = max(1, int(round(min_static * sample_rate)))
@@ -415,6 +438,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
                          f"{QUIET_WINDOWS} windows of {window:g} s))")
     times = np.arange(n) / sample_rate if time is None else np.asarray(time, dtype=np.float64)
     gap_starts = np.zeros(0, dtype=np.int64) if gap_starts is None else np.asarray(gap_starts, dtype=np.int64)
+    turned = _table_turned(times, table_rate, table_angle)
 
     # 1-2. moving statistics and resolution
     mean, var = moving_mean_variance(x, w)
@@ -587,7 +611,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
                               reason="a gyro frozen inside (one value repeated, step 4c): the turn cannot be "
                                      "integrated"))
         elif hi > lo:
-            spans.extend(_motion_pieces(x, times, lo, hi, previous, span, gap_starts, saturation, steady))
+            spans.extend(_motion_pieces(x, times, lo, hi, previous, span, gap_starts, saturation, steady, turned))
         if span is not None:
             spans.append(span)
         previous = span
@@ -781,6 +805,20 @@ def _vertical(force: np.ndarray, axis: int) -> bool:
     return math.acos(min(1.0, abs(float(force[axis])) / float(np.linalg.norm(force)))) <= VERTICAL_AXIS_TOLERANCE
 
 
+def _table_turned(times: np.ndarray, table_rate: np.ndarray | None, table_angle: np.ndarray | None
+                  ) -> np.ndarray | None:
+    """The table's angle at each sample's start and after the last, (N + 1,) rad, such that ``turned[hi] −
+    turned[lo]`` is the angle the table turned over the samples ``[lo, hi)`` as :func:`_integrate` takes the gyros'
+    (each sample's rate held from it to the next): the logged angle (the last repeated), or the logged rate's
+    running integral; ``None`` where neither was logged."""
+    if table_angle is not None:
+        return np.append(table_angle, table_angle[-1])
+    if table_rate is None:
+        return None
+    dt = np.append(np.diff(times), 0.0)
+    return np.concatenate(([0.0], np.cumsum(table_rate * dt)))
+
+
 def _integrate(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span, after: Span
                ) -> tuple[np.ndarray, np.ndarray]:
     """∫ (gyro − bias) dt over ``[lo, hi)``, rad, with the bias linear in time between the static spans *before* and
@@ -795,8 +833,8 @@ def _integrate(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span,
 
 
 def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,
-                   gap_starts: np.ndarray, saturation: list[Saturation], steady: list[tuple[int, int]]
-                   ) -> list[Span]:
+                   gap_starts: np.ndarray, saturation: list[Saturation], steady: list[tuple[int, int]],
+                   turned: np.ndarray | None = None) -> list[Span]:
     """The motion ``[lo, hi)`` between the static spans *before* and *after*: one span (:func:`_motion`), or, where
     it holds steady turns (step 6), each steady turn as a ``rotation`` of its own with its measured rate and no
     angle, and the stretches around them (a table's spin-up, a change of rate, its stop) as moves (step 9).
@@ -809,7 +847,7 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
     whose rest output is the bias; the stretch between the log's end and the steady part is a move."""
     inside = [(a, b) for a, b in steady if a >= lo and b <= hi]
     if not inside or (before is None and after is None) or np.any((gap_starts > lo) & (gap_starts <= hi)):
-        return [_motion(x, times, lo, hi, before, after, gap_starts, saturation)]
+        return [_motion(x, times, lo, hi, before, after, gap_starts, saturation, turned)]
     side = before if before is not None else after  # the pose whose rest output is the bias, where one is missing
     g = side.mean[3:]
     pieces: list[Span] = []
@@ -851,9 +889,11 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
 
 
 def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,
-            gap_starts: np.ndarray, saturation: list[Saturation]) -> Span:
+            gap_starts: np.ndarray, saturation: list[Saturation], turned: np.ndarray | None = None) -> Span:
     """Classify the motion ``[lo, hi)`` between the static spans *before* and *after* (either may be None), which
-    holds no steady turn (or cannot be split at one: :func:`_motion_pieces`)."""
+    holds no steady turn (or cannot be split at one: :func:`_motion_pieces`). With the table's angle logged
+    (*turned*, :func:`_table_turned`), a motion over which the table turned has the table's angle as its
+    reference (:func:`_table_turn`)."""
     mean = x[lo:hi].mean(axis=0)
     up = before.up if before is not None else (after.up if after is not None else "")
 
@@ -871,6 +911,8 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
     axis = int(np.argmax(np.abs(integrated)))
     main = float(integrated[axis])
     off = float(np.hypot(*np.delete(integrated, axis)))
+    if turned is not None and abs(float(turned[hi] - turned[lo])) > TABLE_STILL:
+        return _table_turn(move, float(turned[hi] - turned[lo]), integrated, axis, before, after)
     if abs(main) < math.pi / 4:
         return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: less than 45 deg", integrated, axis)
     if off > OFF_AXIS_FRACTION * abs(main):
@@ -899,3 +941,41 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
         return move("the gravity direction after the turn does not match the turn", integrated, axis)
     return Span("rotation", lo, hi, mean, up=before.up, integrated=integrated, axis=axis, angle=nominal,
                 orientation="approximate" if vertical else "unknown")
+
+
+def _table_turn(move, table: float, integrated: np.ndarray, axis: int, before: Span, after: Span) -> Span:
+    """The motion between the static spans *before* and *after* over which the table's logged angle changed by
+    *table* (rad, its own sense), the gyros having integrated *integrated* (bias removed) with its largest
+    component about *axis*: a ``rotation`` by the table's angle, signed as the gyros measured it, where the two
+    agree within :data:`TABLE_AGREEMENT`, the turn is about one body axis, the unit ends in the pose it started
+    in, and the turn is about the vertical or a whole number of full turns (step 8, with the table's angle in
+    place of the nearest quarter turn); a ``move`` otherwise, with the table's angle kept (``table_turned``) and
+    *move* (``_motion``'s) giving the reason."""
+    main = float(integrated[axis])
+    off = float(np.hypot(*np.delete(integrated, axis)))
+    here = f"the table turned {math.degrees(table):+.2f} deg by its column"
+
+    def refused(reason: str) -> Span:
+        return dataclasses.replace(move(f"{here}, but {reason}", integrated, axis), table_turned=table)
+
+    if off > OFF_AXIS_FRACTION * abs(main):
+        return refused(f"the gyros' turn is not about one body axis: the other axes turned {math.degrees(off):.1f} "
+                       f"deg against {math.degrees(main):+.1f} deg about {AXES[axis]}")
+    if abs(abs(main) - abs(table)) > TABLE_AGREEMENT * abs(table):
+        return refused(f"the gyros measured {math.degrees(main):+.2f} deg about {AXES[axis]}, more than "
+                       f"{TABLE_AGREEMENT:.0%} apart (the column in another unit, or the table not turning about "
+                       f"{AXES[axis]}?)")
+    if before.up != after.up:
+        return refused(f"the pose changed from {before.up} up to {after.up} up: a turn about a horizontal axis, which "
+                       "the fit does not use")
+    nominal = math.copysign(abs(table), main)
+    g = before.mean[3:]
+    vertical = _vertical(g, axis)
+    if not vertical and abs(math.remainder(nominal, 2.0 * math.pi)) > ANGLE_TOLERANCE_RAD:
+        return refused(f"it turned about the horizontal axis {AXES[axis]} without coming back to the same pose")
+    expected = _rotate(g, axis, nominal)
+    if float(np.dot(expected, after.mean[3:])) < math.cos(VERTICAL_AXIS_TOLERANCE) * float(
+            np.linalg.norm(expected) * np.linalg.norm(after.mean[3:])):
+        return refused("the gravity direction after the turn does not match the turn")
+    return dataclasses.replace(move(""), kind="rotation", integrated=integrated, axis=axis, angle=nominal,
+                               orientation="approximate" if vertical else "unknown", table_turned=table)

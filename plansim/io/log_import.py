@@ -34,6 +34,7 @@ from plansim.estimate.segmentation import (
     DEFAULT_MIN_STATIC,
     DEFAULT_WINDOW,
     FULL_SCALE_MARGIN,
+    TABLE_AGREEMENT,
     Segmentation,
     Span,
     segment_log,
@@ -75,10 +76,7 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree", "frozen", "repeated_rows", "table_rate_disagrees", "table_rate_sense",
-                 "table_turning_at_rest")
-#: a steady turn takes the table's rate column's mean where it and the gyros' measured rate agree within this
-#: fraction of it (a MEMS gyro's scale factor is within a few per cent; a column in another unit is off by 57x)
-TABLE_RATE_AGREEMENT = 0.1
+                 "table_turning_at_rest", "table_turn_not_a_rotation")
 #: up to this many glitch rows (or repeated rows) are listed by line in the warning
 GLITCHES_LISTED = 10
 #: up to this many frozen stretches are listed in the warning
@@ -141,7 +139,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                temperature: float | None = None, latitude: float | None = None, height: float | None = None,
                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
                full_scale: str | None = None, accel_log: str | os.PathLike | None = None,
-               table_rate_column: str | None = None, table_rate_unit: str = "deg/s") -> ImportResult:
+               table_rate_column: str | None = None, table_rate_unit: str = "deg/s",
+               table_angle_column: str | None = None, table_angle_unit: str = "deg") -> ImportResult:
     """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
 
     Parameters
@@ -173,6 +172,15 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         one file only (not with ``accel_log``).
     table_rate_unit : str
         Unit of that column: one of :data:`plansim.units.KINDS` ``angular_rate`` (``deg/s`` by default).
+    table_angle_column : str or None
+        A column holding the turntable's angle (its encoder's position), in *table_angle_unit*, wrapping or not
+        (it is unwrapped: it must not change by half a turn between two samples). Each turn between two rests
+        takes the table's change of angle over it as its reference angle, whatever the angle (step 8 of
+        :mod:`plansim.estimate.segmentation`), and without *table_rate_column* its rate (the angle's change per
+        sample times the sample rate) decides step 6 and gives each steady turn its rate as a rate column does.
+        A log of one file only.
+    table_angle_unit : str
+        Unit of that column: one of :data:`plansim.units.KINDS` ``angle`` (``deg`` by default).
     temperature : float or None
         The lab's temperature, degC, for the segment table when the log has no temperature column
         (default 20 degC, noted in the attributes as assumed).
@@ -225,6 +233,15 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
             raise ValueError(f"--table-rate-unit {table_rate_unit!r}: allowed: "
                              f"{', '.join(u for u in KINDS['angular_rate'] if u)}")
         table_rate_factor = KINDS["angular_rate"][unit]
+    if table_angle_column is not None:
+        if accel_log is not None:
+            raise ValueError("--table-angle-column with --accel-log: the table's angle is read from a log of one "
+                             "file only")
+        unit = UNIT_SPELLINGS.get(table_angle_unit, table_angle_unit)
+        if unit not in KINDS["angle"]:
+            raise ValueError(f"--table-angle-unit {table_angle_unit!r}: allowed: "
+                             f"{', '.join(u for u in KINDS['angle'] if u)}")
+        table_angle_factor = KINDS["angle"][unit]
     if temperature_column is not None and temperature is not None:
         raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
                          "temperature)")
@@ -252,10 +269,12 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         columns = tuple(str(name)[1:].strip() if sign < 0 else name for name, sign in zip(columns, signs))
     seconds_per_unit = TIME_UNITS[time_unit] if time_unit != "samples" else 1.0 / sample_rate
     if accel_log is None:
-        table = read_log(path, columns, time_column, temperature_column, table_rate_column=table_rate_column)
-        if table.interleaved and table_rate_column is not None:
+        table = read_log(path, columns, time_column, temperature_column, table_rate_column=table_rate_column,
+                         table_angle_column=table_angle_column)
+        if table.interleaved and (table_rate_column is not None or table_angle_column is not None):
             raise ValueError(f"log {str(table.path)!r}: its gyro and accelerometer samples are in rows of their own, "
-                             "paired by time; --table-rate-column is read from a log whose rows hold all six")
+                             "paired by time; --table-rate-column and --table-angle-column are read from a log "
+                             "whose rows hold all six")
         if table.interleaved:  # the gyros' and the accelerometers' samples in rows of their own: paired by time
             table = pair_logs(*split_interleaved(table), seconds_per_unit)
     else:
@@ -382,8 +401,14 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if timing.sample_times is not None:
         time_s = timing.sample_times
     table_rate_si = None if table.table_rate is None else table.table_rate * table_rate_factor
+    table_angle_si = None
+    if table.table_angle is not None:  # unwrapped; its rate per sample, where no rate column was logged
+        table_angle_si = np.unwrap(table.table_angle * table_angle_factor)
+        if table_rate_si is None and n > 1:
+            table_rate_si = np.gradient(table_angle_si) * timing.sample_rate
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
-                               gap_starts=timing.gap_starts, full_scale=rail_si, table_rate=table_rate_si)
+                               gap_starts=timing.gap_starts, full_scale=rail_si, table_rate=table_rate_si,
+                               table_angle=table_angle_si)
     statics = segmentation.of_kind("static")
     at_rest = float(np.median([np.linalg.norm(span.mean[3:]) for span in statics]))
     if abs(at_rest / STANDARD_GRAVITY - 1.0) > GRAVITY_TOLERANCE:
@@ -518,6 +543,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "time_column": table.time_column,
         "table_rate_column": table.table_rate_column,
         "table_rate_unit": table_rate_unit if table.table_rate_column is not None else None,
+        "table_angle_column": table.table_angle_column,
+        "table_angle_unit": table_angle_unit if table.table_angle_column is not None else None,
         "time_unit": time_unit if table.time_column is not None else None,
         "detector": {
             "window_samples": segmentation.window,
@@ -600,45 +627,70 @@ def _as_logged(value: float, c: int, factors, divisors, offsets, unit_names, cou
     return f"{value / factors[c] * divisors[c]:.6g} {unit_names[c]}"
 
 
+def table_source(table: LogTable, quantity: str = "rate") -> str:
+    """The table's column a turn's *quantity* (``"rate"`` or ``"angle"``) comes from, in words."""
+    if quantity == "angle":
+        if table.table_angle_column is not None:
+            return f"the table's angle column {table.table_angle_column!r}"
+        return f"the table's rate column {table.table_rate_column!r} (its integral over the turn)"
+    if table.table_rate_column is not None:
+        return f"the table's rate column {table.table_rate_column!r}"
+    return f"the table's angle column {table.table_angle_column!r} (its change per sample)"
+
+
 def _rates_from_table(segmentation, table: LogTable, table_rate: np.ndarray, warnings: list) -> dict[int, float]:
-    """Each steady turn's rate from the table's rate column (SI, *table_rate*): its mean over the segment, signed
-    as the gyros measured the turn, by span number. Warns (``table_rate_disagrees``) where the column's mean and
-    the gyros' measured rate differ by more than :data:`TABLE_RATE_AGREEMENT` of the column's (a column in
-    another unit, or not the turning axis's), and (``table_turning_at_rest``) where a static pose's column reads
-    more than the rest threshold: a pose held by hand (step 6b), since the table's rate decides step 6 for the
-    quiet runs (:func:`plansim.estimate.segmentation.segment_log`)."""
+    """Each steady turn's rate from the table's rate (SI, *table_rate*: its rate column, or its angle column's
+    change per sample): its mean over the segment, signed as the gyros measured the turn, by span number. Warns
+    (``table_rate_disagrees``) where the column's mean and the gyros' measured rate differ by more than
+    :data:`~plansim.estimate.segmentation.TABLE_AGREEMENT` of the column's (a column in another unit, or not the
+    turning axis's), (``table_turning_at_rest``) where a static pose's column reads more than the rest threshold: a
+    pose held by hand (step 6b), since the table's rate decides step 6 for the quiet runs
+    (:func:`plansim.estimate.segmentation.segment_log`), (``table_turn_not_a_rotation``) where the table turned
+    over a motion between two rests that stays a move (step 8), and (``table_rate_sense``) where the table's sense
+    is the opposite of the body axis's in every turn, the steady ones and those between rests."""
+    source = table_source(table)
     rates = {}
-    disagree, senses = [], set()
+    disagree, senses, refused = [], set(), []
     for k, span in enumerate(segmentation.spans):
         mean = float(np.mean(table_rate[span.start:span.stop]))
         if span.kind == "static":
             if abs(mean) > float(np.max(segmentation.rate_threshold)):
                 warnings.append(LogWarning("table_turning_at_rest", f"the static span on lines "
-                                           f"{table.lines[span.start]}-{table.lines[span.stop - 1]}: the table's rate "
-                                           f"column {table.table_rate_column!r} reads {math.degrees(mean):+.5g} deg/s "
-                                           "over it: a turn about the vertical taken for a rest? Make it a 'rotation' "
-                                           "with that rate in the segment table"))
+                                           f"{table.lines[span.start]}-{table.lines[span.stop - 1]}: {source} "
+                                           f"reads {math.degrees(mean):+.5g} deg/s over it: a turn about the "
+                                           "vertical taken for a rest? Make it a 'rotation' with that rate in the "
+                                           "segment table"))
+            continue
+        if math.isfinite(span.table_turned):  # a motion between two rests, over which the table turned
+            where = f"lines {table.lines[span.start]}-{table.lines[span.stop - 1]}"
+            if span.kind == "rotation":
+                senses.add(span.table_turned * span.angle > 0)
+            else:
+                refused.append(f"{where}: {span.reason}")
             continue
         if span.kind != "rotation" or not math.isfinite(span.steady_rate):
             continue
         measured = span.steady_rate
-        if mean == 0.0 or abs(abs(mean) - abs(measured)) > TABLE_RATE_AGREEMENT * abs(mean):
+        if mean == 0.0 or abs(abs(mean) - abs(measured)) > TABLE_AGREEMENT * abs(mean):
             disagree.append(f"lines {table.lines[span.start]}-{table.lines[span.stop - 1]}: column "
                             f"{math.degrees(mean):+.5g} deg/s, gyros {math.degrees(measured):+.5g} deg/s")
             continue
         rates[k] = math.copysign(abs(mean), measured)
         senses.add(mean * measured > 0)
     if disagree:
-        warnings.append(LogWarning("table_rate_disagrees", f"{len(disagree)} steady turn(s) where the table's rate "
-                                   f"column {table.table_rate_column!r} and the gyros' measured rate differ by more "
-                                   f"than {TABLE_RATE_AGREEMENT:.0%} (a column in another unit, --table-rate-unit?): "
-                                   f"their rate is left not known; " + "; ".join(disagree[:4])
-                                   + ("; …" if len(disagree) > 4 else "")))
+        warnings.append(LogWarning("table_rate_disagrees", f"{len(disagree)} steady turn(s) where {source} and the "
+                                   f"gyros' measured rate differ by more than {TABLE_AGREEMENT:.0%} (a column in "
+                                   "another unit, --table-rate-unit or --table-angle-unit?): their rate is left not "
+                                   "known; " + "; ".join(disagree[:4]) + ("; …" if len(disagree) > 4 else "")))
+    if refused:
+        warnings.append(LogWarning("table_turn_not_a_rotation", f"{len(refused)} motion(s) between two rests over "
+                                   "which the table turned are moves, not fitted: " + "; ".join(refused[:4])
+                                   + ("; …" if len(refused) > 4 else "")))
     if senses == {False}:
-        warnings.append(LogWarning("table_rate_sense", f"the table's rate column {table.table_rate_column!r} has the "
-                                   "opposite sign of the gyros' measured rate in every steady turn: the table's "
-                                   "positive sense is the body axis's negative (the unit mounted upside down on it?); "
-                                   "each turn's rate is given about the body axis, signed as the gyros measured it"))
+        warnings.append(LogWarning("table_rate_sense", f"{source} has the opposite sign of the gyros' measured turn "
+                                   "in every turn: the table's positive sense is the body axis's negative (the unit "
+                                   "mounted upside down on it?); each turn's rate and angle are given about the "
+                                   "body axis, signed as the gyros measured it"))
     return rates
 
 
@@ -653,10 +705,13 @@ def _segment(span: Span, number: int, sample_rate: float, temperature: float, ta
     if span.kind == "rotation":
         if math.isfinite(span.steady_rate) and math.isfinite(table_rate):  # the table's rate from its column
             label = (f"rotation {number}: steady at {math.degrees(table_rate):+.6g} deg/s about +{AXES[span.axis]} "
-                     f"(the table's rate column; the gyros measured {math.degrees(span.steady_rate):+.6g} deg/s)")
+                     f"(the table's logged rate; the gyros measured {math.degrees(span.steady_rate):+.6g} deg/s)")
         elif math.isfinite(span.steady_rate):  # a steady turn: the table's rate is its reference, and not logged
             label = (f"rotation {number}: steady at {math.degrees(span.steady_rate):+.5g} deg/s about "
                      f"+{AXES[span.axis]} (measured; {measured:+.2f} deg): give the table's rate")
+        elif math.isfinite(span.table_turned):  # a turn between two rests, by the table's logged angle
+            label = (f"rotation {number}: {math.degrees(span.angle):+.6g} deg about +{AXES[span.axis]} (the "
+                     f"table's angle over it; the gyros measured {measured:+.2f} deg)")
         else:
             label = (f"rotation {number}: {math.degrees(span.angle):+.0f} deg about +{AXES[span.axis]} (measured "
                      f"{measured:+.2f} deg)")
@@ -676,6 +731,8 @@ def _detail(span: Span, table: LogTable) -> dict:
         detail["integrated_deg"] = [None if not math.isfinite(v) else math.degrees(float(v)) for v in span.integrated]
         if span.kind == "rotation":
             detail["steady_rate_deg_s"] = math.degrees(span.steady_rate) if math.isfinite(span.steady_rate) else None
+        if math.isfinite(span.table_turned):
+            detail["table_turned_deg"] = math.degrees(span.table_turned)
         else:
             detail["why_not_a_rotation"] = span.reason
     return detail

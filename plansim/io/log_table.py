@@ -92,6 +92,9 @@ class LogTable:
     #: the table's rate column (``--table-rate-column``) in the file's unit, and its name; or None
     table_rate: np.ndarray | None = None
     table_rate_column: str | None = None
+    #: the table's angle column (``--table-angle-column``) in the file's unit, and its name; or None
+    table_angle: np.ndarray | None = None
+    table_angle_column: str | None = None
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -216,7 +219,7 @@ def _per_channel(text: str | None, option: str, pair: str, positive: bool,
 
 def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, time_column: str | None = None,
              temperature_column: str | None = None, channels: tuple[str, ...] = CHANNELS,
-             table_rate_column: str | None = None) -> LogTable:
+             table_rate_column: str | None = None, table_angle_column: str | None = None) -> LogTable:
     """Read the columns of a plain CSV log, checking every row.
 
     Parameters
@@ -238,6 +241,8 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         three where the two are logged in two files (:func:`plansim.io.log_pairing.pair_logs`).
     table_rate_column : str or None
         Name of a column holding the turntable's rate (read in the file's unit; ``plansim import`` converts it).
+    table_angle_column : str or None
+        Name of a column holding the turntable's angle (its encoder's; read in the file's unit).
 
     Raises
     ------
@@ -255,11 +260,12 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     if len(names) != n_channels:
         raise ValueError(f"--columns {','.join(names)!r}: {len(names)} names for {where}; expected {n_channels}, "
                          f"in the order {', '.join(channels)}")
-    wanted = list(names) + [c for c in (time_column, temperature_column, table_rate_column) if c is not None]
+    wanted = list(names) + [c for c in (time_column, temperature_column, table_rate_column, table_angle_column)
+                            if c is not None]
     repeated = sorted({name for name in wanted if wanted.count(name) > 1})
     if repeated:
         raise ValueError(f"{where}: column {repeated[0]!r} is named for two uses (channels, --time, "
-                         "--temperature-column, --table-rate-column)")
+                         "--temperature-column, --table-rate-column, --table-angle-column)")
     with _text_file(target, where) as fh:
         header_line = 0
         header = None
@@ -441,11 +447,13 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
     time = data[:, next(extra)] if time_column is not None else None
     temperature = data[:, next(extra)] if temperature_column is not None else None
     table_rate = data[:, next(extra)] if table_rate_column is not None else None
+    table_angle = data[:, next(extra)] if table_angle_column is not None else None
     return LogTable(target, data[:, :n_channels], names, time, time_column, temperature, temperature_column,
                     ignored, lines[0], np.array(lines, dtype=np.int64), tuple(preamble), header_line, decimal_comma,
                     has_header, units_row, tuple((line, why) for line, why, _ in trailing),
                     clock[2] if clock else None, ((clock[0] or 0) * 86400.0 + clock[1]) if clock else None,
-                    interleaved=interleaved, table_rate=table_rate, table_rate_column=table_rate_column)
+                    interleaved=interleaved, table_rate=table_rate, table_rate_column=table_rate_column,
+                    table_angle=table_angle, table_angle_column=table_angle_column)
 
 
 def _delimiter(line: str) -> str:

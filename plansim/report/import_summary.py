@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from plansim.io.log_import import ImportResult
+from plansim.io.log_import import ImportResult, table_source
 from plansim.io.recording_data import CHANNELS
 
 
@@ -81,15 +81,20 @@ def format_summary(result: ImportResult) -> str:
     lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
                  "approximate for the static poses")
     rotations = seg.of_kind("rotation")
-    if any(not math.isfinite(r.steady_rate) for r in rotations):
+    between = [r for r in rotations if not math.isfinite(r.steady_rate)]
+    by_table = [r for r in between if math.isfinite(r.table_turned)]
+    if by_table:
+        lines.append(f"  rotations: angle = the table's turn from rest to rest ({table_source(table, 'angle')}, "
+                     f"signed as the gyros measured the turn) for {len(by_table)} of {len(between)}; rate = nan")
+    if len(by_table) < len(between):
         lines.append("  rotations: angle = the whole number of quarter turns nearest the measured integral (bias "
                      "removed); check it against what was done; rate = nan (not logged)")
     steady = [k for k, r in enumerate(seg.spans) if r.kind == "rotation" and math.isfinite(r.steady_rate)]
     given = [k for k in steady if math.isfinite(rec.schedule.segments[k].rate)]
     if given:
-        lines.append(f"  steady turns: rate from the table's rate column {table.table_rate_column!r} (its mean over "
-                     f"each segment, signed as the gyros measured the turn) for {len(given)} of {len(steady)}; "
-                     "angle = nan; the moves beside them are the table's spin-up and stop")
+        lines.append(f"  steady turns: rate from {table_source(table)} (its mean over each segment, signed as the "
+                     f"gyros measured the turn) for {len(given)} of {len(steady)}; angle = nan; the moves beside "
+                     "them are the table's spin-up and stop")
     if len(given) < len(steady):
         lines.append("  steady turns: angle = nan and rate = nan (a table's rate is not in the log): give each one "
                      "the rate the table held for the fit to use it (in the segment table, rate_deg_s and "
