@@ -130,11 +130,15 @@ def test_a_simulated_log_with_settle_gaps_splits_at_each_gap(tmp_path):
     assert [w.name for w in result.warnings] == ["gap"]
     assert result.timing.missing_samples == 10 * 1000 - 1000  # ten settle gaps of 10 s, less one step each
     assert len(result.timing.gaps) == len(recording.schedule) - 1
-    # no static span holds a gap, and the turns (each across a gap) are moves without an angle
+    # no static span or steady turn holds a gap; each turn, logged over its dwell only, is a steady turn with its
+    # measured rate and no angle (until 2026-11-30 it was in a move, 'not integrated'), the gaps in moves
     gap_starts = set(result.timing.gap_starts.tolist())
-    for span in result.segmentation.of_kind("static"):
+    for span in result.segmentation.of_kind("static") + result.segmentation.of_kind("rotation"):
         assert not any(span.start < k < span.stop for k in gap_starts)
-    assert result.segmentation.of_kind("rotation") == []
+    turns = result.segmentation.of_kind("rotation")
+    assert [math.degrees(span.steady_rate) for span in turns] == pytest.approx([60.0, -45.0], rel=0.01)
+    assert all(math.isnan(span.angle) for span in turns)
+    assert all(any(span.start < k <= span.stop for span in result.segmentation.of_kind("move")) for k in gap_starts)
     ups = [span.up for span in result.segmentation.of_kind("static")]
     assert [u for k, u in enumerate(ups) if k == 0 or u != ups[k - 1]] == ["+x", "-x", "+y", "-y", "+z", "-z"]
 
@@ -993,6 +997,58 @@ def test_a_table_rate_column_gives_each_steady_turn_its_rate(tmp_path, capsys):
                  "gx,gy,gz,ax,ay,az", "--table-rate-column", "encoder"]) == 2
     assert "column 'encoder' is missing" in capsys.readouterr().err
     assert not (tmp_path / "x.nc").exists()
+
+
+@pytest.mark.parametrize("column", [True, False])
+def test_a_log_recorded_over_each_dwell_only_keeps_its_steady_turns(tmp_path, capsys, column):
+    """A rate test logged as a lab's acquisition often logs it: over each dwell only, the table's changes of rate
+    not logged (a 3 s gap in the time column before each dwell). The dwells, 8 s each about the vertical z: at
+    rest, then -100, -50, -5, 0, +5, +50, +100 deg/s. Before: every motion between two rests that held a gap was
+    one move, 'not integrated', steady turns and all, so the rate points were lost (a JJF 2003 run logged so lost
+    its 24 rate points). Now each steady turn is split out as before, the gaps fall in moves of their own, and with
+    the table's rate column (or the rates given by hand) `plansim fit` gives Kgzz within its u (|z| < 3.3)."""
+    fs, dwell = 100.0, int(8 * 100)
+    rates = [0, -100, -50, -5, 0, 5, 50, 100]
+    rng = np.random.default_rng(41)
+    rate = np.repeat(np.array(rates, dtype=float), dwell)
+    x = np.zeros((rate.size, 6))
+    x[:, 2] = 1.003 * rate + 0.2
+    x[:, :3] += 0.05 * rng.standard_normal((rate.size, 3))
+    x[:, 5] = 9.80
+    x[:, 3:] += 0.005 * rng.standard_normal((rate.size, 3))
+    t = np.arange(rate.size) / fs + 3.0 * (np.arange(rate.size) // dwell)  # a 3 s gap before each dwell
+    log = tmp_path / "dwells.csv"
+    write_synthetic(log, t, x, extra={"table_dps": rate})
+    options = ["--time", "time", "--units", "deg/s,m/s^2", "--columns", "gx,gy,gz,ax,ay,az"]
+    rec = tmp_path / "rec.nc"
+    assert main(["import", str(log), "--out", str(rec), *options]
+                + (["--table-rate-column", "table_dps"] if column else [])) == 0
+    out = capsys.readouterr().out
+    assert "warning [gap]: 7 gap(s)" in out, out
+    recording = read_recording(rec)
+    segments = recording.schedule.segments
+    assert [s.test for s in segments if s.test != "move"] == ["static"] + ["rotation"] * 3 + ["static"] + \
+        ["rotation"] * 3, [s.label for s in segments]
+    turns = [k for k, s in enumerate(segments) if s.test == "rotation"]
+    assert all(segments[k].samples > 0.85 * dwell for k in turns)  # each dwell whole, less a window at its ends
+    if not column:  # the rates given by hand, as the summary asks
+        schedule = dataclasses.replace(recording.schedule, segments=tuple(
+            dataclasses.replace(s, rate=math.radians(r)) if s.test == "rotation" else s
+            for s, r in zip(segments, _rates_in_order(segments, [-100, -50, -5, 5, 50, 100]))))
+        recording = dataclasses.replace(recording, schedule=schedule)
+        write_recording(recording, rec)
+    assert [round(math.degrees(s.rate), 6) for s in read_recording(rec).schedule.segments if s.test == "rotation"] \
+        == [-100, -50, -5, 5, 50, 100]
+    assert main(["fit", str(rec), "--latitude", "40", "--height", "50", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
+    assert abs(kgzz["estimate"] - 1.003) < 3.3 * kgzz["u"], kgzz
+
+
+def _rates_in_order(segments, rates):
+    """Each segment's rate: the next of *rates* for each rotation, None for the others."""
+    given = iter(rates)
+    return [next(given) if s.test == "rotation" else None for s in segments]
 
 
 def test_a_table_rate_column_reads_a_one_pose_log_that_starts_and_ends_in_a_turn(tmp_path, capsys):

@@ -86,7 +86,9 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    table's, which need not stop on a quarter turn (a −567° turn would be labelled −540°): each steady turn is a
    *rotation* of its own with its measured rate (``Span.steady_rate``) and no angle (the table's rate, not in
    the log, is its reference), and the stretches around them (spin-up, change of rate, stop) are *moves*
-   (:func:`_motion_pieces`). So is a steady turn the log starts or ends in, against the one pose beside it.
+   (:func:`_motion_pieces`). So is a steady turn the log starts or ends in, against the one pose beside it. A
+   time gap between steady turns (a log recorded over each dwell only) does not stop them being split out; the
+   piece around them that holds the gap is a move, not integrated.
 10. **Saturation.** ``SATURATION_RUN`` or more equal consecutive samples at a channel's largest or smallest
     value in the log (two are enough where the value is held by two such runs or more: a rail reached twice),
     outside the static spans, entered or left by a step of more than ``SATURATION_STEP`` σ, at a value
@@ -844,9 +846,12 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
     took that angle would be 5 % off. The table's rate is the reference, and it holds only over the steady part.
     So a log that starts or ends in a steady turn (recorded into a table's turn, or stopped before the table) has
     its steady part as a rotation too, its rate measured against the one pose beside it (*before* or *after*),
-    whose rest output is the bias; the stretch between the log's end and the steady part is a move."""
+    whose rest output is the bias; the stretch between the log's end and the steady part is a move. A time gap
+    between the steady turns (a log recorded over each dwell only, the table's changes of rate not logged) leaves
+    them whole: no steady turn holds one (step 6 keeps a window off each gap), and the piece that holds it is a
+    move, not integrated."""
     inside = [(a, b) for a, b in steady if a >= lo and b <= hi]
-    if not inside or (before is None and after is None) or np.any((gap_starts > lo) & (gap_starts <= hi)):
+    if not inside or (before is None and after is None):
         return [_motion(x, times, lo, hi, before, after, gap_starts, saturation, turned)]
     side = before if before is not None else after  # the pose whose rest output is the bias, where one is missing
     g = side.mean[3:]
@@ -859,6 +864,11 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
         integrated, bias = _integrate(x, times, p, q, before or side, after or side)
         axis = int(np.argmax(np.abs(integrated)))
         mean = x[p:q].mean(axis=0)
+        gap = bool(np.any((gap_starts > p) & (gap_starts <= q)))
+        if k % 2 == 0 and gap:  # a log recorded only over each dwell: the settling between them not logged
+            pieces.append(Span("move", p, q, mean, up=side.up, reason="a time gap inside: the turn cannot be "
+                                                                       "integrated"))
+            continue
         if k % 2 == 0:  # around the steady turns
             if k == 0 and before is None:
                 where = "the log's start, in a turn"
