@@ -1002,11 +1002,14 @@ def test_a_table_rate_column_gives_each_steady_turn_its_rate(tmp_path, capsys):
 @pytest.mark.parametrize("column", [True, False])
 def test_a_log_recorded_over_each_dwell_only_keeps_its_steady_turns(tmp_path, capsys, column):
     """A rate test logged as a lab's acquisition often logs it: over each dwell only, the table's changes of rate
-    not logged (a 3 s gap in the time column before each dwell). The dwells, 8 s each about the vertical z: at
-    rest, then -100, -50, -5, 0, +5, +50, +100 deg/s. Before: every motion between two rests that held a gap was
-    one move, 'not integrated', steady turns and all, so the rate points were lost (a JJF 2003 run logged so lost
-    its 24 rate points). Now each steady turn is split out as before, the gaps fall in moves of their own, and with
-    the table's rate column (or the rates given by hand) `plansim fit` gives Kgzz within its u (|z| < 3.3)."""
+    not logged (a 3 s gap in the time column before each dwell). The dwells, 8 s each: at rest with -z up, then
+    with +z up about the vertical z at -100, -50, -5, 0, +5, +50, +100 deg/s (the unit turned over in the first
+    gap). Before: every motion between two rests that held a gap was one move, 'not integrated', steady turns and
+    all, so the rate points were lost (a JJF 2003 run logged so lost its 24 rate points); and a steady turn took
+    the pose of the rest before it, so the three after the -z rest read as turns about a horizontal axis that the
+    fit does not use. Now each steady turn is split out as before, in its own pose, the gaps fall in moves of their
+    own, and with the table's rate column (or the rates given by hand) `plansim fit` uses all six turns and gives
+    Kgzz within its u (|z| < 3.3)."""
     fs, dwell = 100.0, int(8 * 100)
     rates = [0, -100, -50, -5, 0, 5, 50, 100]
     rng = np.random.default_rng(41)
@@ -1015,6 +1018,7 @@ def test_a_log_recorded_over_each_dwell_only_keeps_its_steady_turns(tmp_path, ca
     x[:, 2] = 1.003 * rate + 0.2
     x[:, :3] += 0.05 * rng.standard_normal((rate.size, 3))
     x[:, 5] = 9.80
+    x[:dwell, 5] = -9.80  # the first rest with -z up
     x[:, 3:] += 0.005 * rng.standard_normal((rate.size, 3))
     t = np.arange(rate.size) / fs + 3.0 * (np.arange(rate.size) // dwell)  # a 3 s gap before each dwell
     log = tmp_path / "dwells.csv"
@@ -1031,6 +1035,7 @@ def test_a_log_recorded_over_each_dwell_only_keeps_its_steady_turns(tmp_path, ca
         ["rotation"] * 3, [s.label for s in segments]
     turns = [k for k, s in enumerate(segments) if s.test == "rotation"]
     assert all(segments[k].samples > 0.85 * dwell for k in turns)  # each dwell whole, less a window at its ends
+    assert [s.up for s in segments if s.test != "move"] == ["-z"] + ["+z"] * 7
     if not column:  # the rates given by hand, as the summary asks
         schedule = dataclasses.replace(recording.schedule, segments=tuple(
             dataclasses.replace(s, rate=math.radians(r)) if s.test == "rotation" else s
@@ -1041,6 +1046,7 @@ def test_a_log_recorded_over_each_dwell_only_keeps_its_steady_turns(tmp_path, ca
         == [-100, -50, -5, 5, 50, 100]
     assert main(["fit", str(rec), "--latitude", "40", "--height", "50", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
+    assert set(turns) <= {r["segment"] for r in report["residuals"]}  # every turn fitted
     kgzz = {p["name"]: p for p in report["parameters"]}["Kgzz"]
     assert abs(kgzz["estimate"] - 1.003) < 3.3 * kgzz["u"], kgzz
 

@@ -201,8 +201,8 @@ class Span:
     mean : (6,) array
         Mean output over the span, SI.
     up : str
-        Static: the body axis nearest the mean specific force. Motion: the up axis of the static span
-        before it (``""`` when there is none).
+        Static, and a steady turn (step 9): the body axis nearest the mean specific force. Other motion: the up
+        axis of the static span before it (``""`` when there is none).
     tilt : float
         Static: angle between the mean specific force and ``up``, rad (NaN for motion).
     integrated : (3,) array
@@ -854,7 +854,6 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
     if not inside or (before is None and after is None):
         return [_motion(x, times, lo, hi, before, after, gap_starts, saturation, turned)]
     side = before if before is not None else after  # the pose whose rest output is the bias, where one is missing
-    g = side.mean[3:]
     pieces: list[Span] = []
     edges = [lo] + [v for run in inside for v in run] + [hi]
     for k in range(len(edges) - 1):
@@ -881,7 +880,10 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
             continue
         rate = x[p:q, :3].mean(axis=0) - bias.mean(axis=0)
         off = float(np.hypot(*np.delete(rate, axis)))
-        vertical = _vertical(g, axis)
+        # a steady turn about the vertical leaves the specific force as it is: its own pose, which need not be the
+        # rest's beside it (a log recorded over each dwell only: the unit turned to another pose in a time gap)
+        up, _ = nearest_axis(mean[3:])
+        vertical = _vertical(mean[3:], axis)
         if any(s.start < q and s.stop > p for s in saturation):
             why = "a saturated sample inside: the steady rate is not known"
         elif off > OFF_AXIS_FRACTION * abs(float(rate[axis])):
@@ -892,7 +894,7 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
         if why:
             pieces.append(Span("move", p, q, mean, up=side.up, integrated=integrated, axis=axis, reason=why))
         else:
-            pieces.append(Span("rotation", p, q, mean, up=side.up, integrated=integrated, axis=axis,
+            pieces.append(Span("rotation", p, q, mean, up=up, integrated=integrated, axis=axis,
                                orientation="approximate" if vertical else "unknown",
                                steady_rate=float(rate[axis])))
     return pieces
