@@ -1051,6 +1051,36 @@ def test_a_log_recorded_over_each_dwell_only_keeps_its_steady_turns(tmp_path, ca
     assert abs(kgzz["estimate"] - 1.003) < 3.3 * kgzz["u"], kgzz
 
 
+def test_a_table_rate_column_cuts_a_quiet_run_where_the_table_changes_rate(tmp_path, capsys):
+    """A rate table that changes rate slowly (0.5 deg/s^2: 10 s from rest to 5 deg/s) is as quiet as its steady
+    turns, so rest, ramp and turn were one quiet run: with the table's rate column, a 76 s 'steady turn' at
+    -2.16 deg/s held -5 deg/s, the ramp, the rest at 0 and part of the next ramp (a JJF 2003 run logged with its
+    changes of rate). Step 5b cuts each quiet run where the table's rate changes: the rests and the turns at -5 and
+    +5 deg/s come out whole, each turn with the table's rate, and the ramps are moves."""
+    fs = 100.0
+    ramp = np.linspace(0.0, 1.0, int(10 * fs), endpoint=False)
+    dwell = np.ones(int(20 * fs))
+    profile = np.concatenate([0 * dwell, -5 * ramp, -5 * dwell, -5 * ramp[::-1], 0 * dwell, 5 * ramp, 5 * dwell,
+                              5 * ramp[::-1], 0 * dwell])
+    rng = np.random.default_rng(43)
+    x = np.zeros((profile.size, 6))
+    x[:, 2] = 1.003 * profile + 0.2
+    x[:, :3] += 0.05 * rng.standard_normal((profile.size, 3))
+    x[:, 5] = 9.80
+    x[:, 3:] += 0.005 * rng.standard_normal((profile.size, 3))
+    log = tmp_path / "ramps.csv"
+    write_synthetic(log, np.arange(profile.size) / fs, x, extra={"table_dps": profile})
+    assert main(["import", str(log), "--out", str(tmp_path / "rec.nc"), "--time", "time", "--units", "deg/s,m/s^2",
+                 "--columns", "gx,gy,gz,ax,ay,az", "--table-rate-column", "table_dps"]) == 0
+    capsys.readouterr()
+    segments = read_recording(tmp_path / "rec.nc").schedule.segments
+    kept = [s for s in segments if s.test != "move"]
+    assert [s.test for s in kept] == ["static", "rotation", "static", "rotation", "static"], [s.label for s in kept]
+    # the column's mean over each turn's samples (a few of the next ramp's are in it: 5 - 1e-4)
+    assert [math.degrees(s.rate) for s in kept if s.test == "rotation"] == pytest.approx([-5.0, 5.0], abs=1e-3)
+    assert all(s.dwell > 19.0 for s in kept)
+
+
 def _rates_in_order(segments, rates):
     """Each segment's rate: the next of *rates* for each rotation, None for the others."""
     given = iter(rates)

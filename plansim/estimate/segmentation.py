@@ -40,6 +40,10 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
    windows differ by at most ``RATE_FACTOR`` √2 times the noise of a window mean plus ``POSE_TOLERANCE``
    (0.5°) of gravity on each axis (a unit tumbling smoothly can be as quiet as its own quietest stretch,
    but its gravity turns).
+5b. **One table rate.** With the table's rate logged (``table_rate``, or the change of its logged angle), each
+   run is cut where the table's rate (its mean over a window) leaves max(rest threshold, ``TABLE_STEADY_FRACTION``
+   of it) of its value at the piece's start, and pieces of at least ``min_static`` are kept: a table's slow change
+   of rate is as quiet as its steady turns.
 6. **At rest or turning steadily?** The run that holds ``Q`` is at rest. Working outwards from it, each
    other run is compared with the nearest run at rest. In the same pose (specific force within
    ``SAME_POSE``) it is at rest unless its mean gyro output differs from that run's by more than
@@ -143,6 +147,9 @@ ANGLE_TOLERANCE_RAD = math.radians(10.0)
 ANGLE_TOLERANCE_FRACTION = 0.05
 #: a table's logged rate or angle and the gyros' agree when they differ by at most this fraction of the table's
 TABLE_AGREEMENT = 0.1
+#: a quiet run holds one table rate while the logged rate stays within this fraction of it (or the rest threshold),
+#: step 5b: 20 times the rate smoothness a JJF 2003 table is held to (5e-4, Table 1)
+TABLE_STEADY_FRACTION = 0.01
 #: a motion over which the table's logged angle changed by at most this is not the table's turn (step 8)
 TABLE_STILL = math.radians(1.0)
 #: a rotation about the vertical: the axis within this angle of the mean specific force
@@ -511,6 +518,8 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     # 6. rest or steady turn: each run against the nearest run at rest, outwards from the quiet stretch (a
     # slow drift of the bias over a long log is not a turn)
     rate_threshold = RATE_FACTOR * window_sigma + 2.0 * EARTH_RATE
+    if table_rate is not None:  # 5b. one table rate from end to end
+        runs = _one_table_rate(runs, table_rate, w, float(np.max(rate_threshold)), n_min)
     medians = [clipped[a:b, :3].mean(axis=0) for a, b in runs]
     forces = [x[a:b, 3:].mean(axis=0) for a, b in runs]
     at_rest = [False] * len(runs)
@@ -805,6 +814,28 @@ def stuck_runs(values: np.ndarray, value: float, jump: float) -> list[tuple[int,
 def _vertical(force: np.ndarray, axis: int) -> bool:
     """Body axis *axis* lies within :data:`VERTICAL_AXIS_TOLERANCE` of the specific force *force* (either sense)."""
     return math.acos(min(1.0, abs(float(force[axis])) / float(np.linalg.norm(force)))) <= VERTICAL_AXIS_TOLERANCE
+
+
+def _one_table_rate(runs: list[tuple[int, int]], table_rate: np.ndarray, w: int, threshold: float, n_min: int
+                    ) -> list[tuple[int, int]]:
+    """Step 5b: each quiet run cut into the stretches over which the table's logged rate (its mean over *w*
+    samples, so that an encoder's steps average out) stays within max(*threshold*, ``TABLE_STEADY_FRACTION`` of
+    it) of its value at the stretch's start; those of at least *n_min* samples kept. A table's slow change of rate
+    is as quiet as its steady turns: a run across one (−5 °/s, a ramp, a rest, a ramp, +5 °/s) is neither one
+    steady turn nor a rest."""
+    smooth = moving_mean_variance(table_rate[:, None], w)[0][:, 0]
+    out = []
+    for a, b in runs:
+        start = a
+        while start < b:
+            reference = float(smooth[start])
+            tolerance = max(threshold, TABLE_STEADY_FRACTION * abs(reference))
+            off = np.flatnonzero(np.abs(smooth[start:b] - reference) > tolerance)
+            stop = start + int(off[0]) if off.size else b
+            if stop - start >= n_min:
+                out.append((start, stop))
+            start = stop
+    return out
 
 
 def _table_turned(times: np.ndarray, table_rate: np.ndarray | None, table_angle: np.ndarray | None
