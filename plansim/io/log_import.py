@@ -224,24 +224,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                          "--sample-rate HZ")
     if time_unit == "samples" and sample_rate is None:
         raise ValueError("--time-unit samples: a sample counter needs --sample-rate HZ")
-    if table_rate_column is not None:
-        if accel_log is not None:
-            raise ValueError("--table-rate-column with --accel-log: the table's rate is read from a log of one file "
-                             "only")
-        unit = UNIT_SPELLINGS.get(table_rate_unit, table_rate_unit)
-        if unit not in KINDS["angular_rate"]:
-            raise ValueError(f"--table-rate-unit {table_rate_unit!r}: allowed: "
-                             f"{', '.join(u for u in KINDS['angular_rate'] if u)}")
-        table_rate_factor = KINDS["angular_rate"][unit]
-    if table_angle_column is not None:
-        if accel_log is not None:
-            raise ValueError("--table-angle-column with --accel-log: the table's angle is read from a log of one "
-                             "file only")
-        unit = UNIT_SPELLINGS.get(table_angle_unit, table_angle_unit)
-        if unit not in KINDS["angle"]:
-            raise ValueError(f"--table-angle-unit {table_angle_unit!r}: allowed: "
-                             f"{', '.join(u for u in KINDS['angle'] if u)}")
-        table_angle_factor = KINDS["angle"][unit]
+    table_rate_factor = _table_factor("rate", table_rate_column, table_rate_unit, accel_log)
+    table_angle_factor = _table_factor("angle", table_angle_column, table_angle_unit, accel_log)
     if temperature_column is not None and temperature is not None:
         raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
                          "temperature)")
@@ -625,6 +609,21 @@ def _as_logged(value: float, c: int, factors, divisors, offsets, unit_names, cou
     if counts:
         return f"{value / factors[c] * divisors[c] + offsets[c]:.6g} counts ({value:.6g} {si_unit})"
     return f"{value / factors[c] * divisors[c]:.6g} {unit_names[c]}"
+
+
+def _table_factor(quantity: str, column: str | None, unit: str, accel_log) -> float:
+    """SI per unit of the table's *quantity* column (``"rate"``: :data:`plansim.units.KINDS` ``angular_rate``;
+    ``"angle"``: ``angle``), checking its option; NaN where the column is not given."""
+    if column is None:
+        return math.nan
+    if accel_log is not None:
+        raise ValueError(f"--table-{quantity}-column with --accel-log: the table's {quantity} is read from a log of "
+                         "one file only")
+    kind = "angular_rate" if quantity == "rate" else "angle"
+    spelled = UNIT_SPELLINGS.get(unit, unit)
+    if spelled not in KINDS[kind]:
+        raise ValueError(f"--table-{quantity}-unit {unit!r}: allowed: {', '.join(u for u in KINDS[kind] if u)}")
+    return KINDS[kind][spelled]
 
 
 def table_source(table: LogTable, quantity: str = "rate") -> str:
