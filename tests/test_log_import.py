@@ -1214,6 +1214,15 @@ def test_a_table_angle_column_in_the_wrong_unit_or_not_finite_is_named(tmp_path,
     capsys.readouterr()
     rotations = [s for s in read_recording(tmp_path / "rec.nc").schedule.segments if s.test == "rotation"]
     assert [math.degrees(s.angle) for s in rotations[:2]] == pytest.approx(whole, abs=1e-6)
+    # the log cut before its steady turn: every turn by the table's angle, whose errors the fit does not know
+    k = int(round((6.0 + 2 * (2.6 + 6.0)) * 100))
+    write_synthetic(tmp_path / "short.csv", t[:k], x[:k], extra={"enc": np.radians(angle[:k])})
+    assert main(["import", str(tmp_path / "short.csv"), "--out", str(tmp_path / "short.nc"), *options,
+                 "--table-angle-unit", "rad"]) == 0
+    capsys.readouterr()
+    assert main(["fit", str(tmp_path / "short.nc"), "--latitude", "40", "--height", "50", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert "the log holds the table's column 'enc'" in report["turntable"], report["turntable"]
     with pytest.raises(ValueError, match=r"--table-angle-unit 'deg/s': allowed: rad, deg"):
         import_log(log, time_column="time", units="deg/s,m/s^2", table_angle_column="enc", table_angle_unit="deg/s")
     with pytest.raises(ValueError, match="--table-angle-column with --accel-log"):

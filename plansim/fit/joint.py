@@ -690,7 +690,16 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                 "pose is placed by hand)")
         else:
             turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
-            turntable_source = "none: every pose and turn is by hand (no table)"
+            logged = {key: value for key, value in schedule.notes.get("import", {}).items()
+                      if key in ("table_rate_column", "table_angle_column") and value}
+            if logged and any(s.is_rotating for s in used_schedule.segments):
+                # plansim import took the turns' angles from the table's column (docs/measured-data.md)
+                turntable_source = (f"none: the poses are placed by hand; the log holds the table's column "
+                                    f"{', '.join(map(repr, logged.values()))}, and a turn by the table's angle "
+                                    "carries no Type B for its errors (its encoder's accuracy is not an input of "
+                                    "the fit)")
+            else:
+                turntable_source = "none: every pose and turn is by hand (no table)"
     model_schedule = Schedule(tuple(use.model_segments), procedure=schedule.procedure)
     rows = np.ones((len(used), 6), dtype=bool)
     rows[np.asarray(use.gyro_only, dtype=bool), 3:] = False  # a hand turn's accelerometers feel the hand
