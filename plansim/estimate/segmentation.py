@@ -891,14 +891,14 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
         p, q = edges[k], edges[k + 1]
         if q <= p:
             continue
-        integrated, bias = _integrate(x, times, p, q, before or side, after or side)
-        axis = int(np.argmax(np.abs(integrated)))
         mean = x[p:q].mean(axis=0)
-        gap = bool(np.any((gap_starts > p) & (gap_starts <= q)))
-        if k % 2 == 0 and gap:  # a log recorded only over each dwell: the settling between them not logged
+        if k % 2 == 0 and np.any((gap_starts > p) & (gap_starts <= q)):
+            # a log recorded only over each dwell: the settling between them not logged, nothing to integrate
             pieces.append(Span("move", p, q, mean, up=side.up, reason="a time gap inside: the turn cannot be "
                                                                        "integrated"))
             continue
+        integrated, bias = _integrate(x, times, p, q, before or side, after or side)
+        axis = int(np.argmax(np.abs(integrated)))
         if k % 2 == 0:  # around the steady turns
             if k == 0 and before is None:
                 where = "the log's start, in a turn"
@@ -934,15 +934,20 @@ def _motion_pieces(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: S
 def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | None, after: Span | None,
             gap_starts: np.ndarray, saturation: list[Saturation], turned: np.ndarray | None = None) -> Span:
     """Classify the motion ``[lo, hi)`` between the static spans *before* and *after* (either may be None), which
-    holds no steady turn (or cannot be split at one: :func:`_motion_pieces`). With the table's angle logged
-    (*turned*, :func:`_table_turned`), a motion over which the table turned has the table's angle as its
-    reference (:func:`_table_turn`)."""
+    holds no steady turn (or cannot be split at one: :func:`_motion_pieces`). The turn's reference angle is the
+    nearest whole number of quarter turns, or, with the table's angle logged (*turned*, :func:`_table_turned`) and
+    the table turned by more than :data:`TABLE_STILL`, the table's angle, signed as the gyros measured it, where
+    it and the gyros' integral agree within :data:`TABLE_AGREEMENT` (the reason of a move then says what the
+    table turned, and ``table_turned`` keeps it). The other tests of step 8 are the same for both."""
     mean = x[lo:hi].mean(axis=0)
     up = before.up if before is not None else (after.up if after is not None else "")
+    table = math.nan
 
     def move(reason: str, integrated: np.ndarray | None = None, axis: int = -1) -> Span:
+        if math.isfinite(table):
+            reason = f"the table turned {math.degrees(table):+.2f} deg by its column, but {reason}"
         return Span("move", lo, hi, mean, up=up, integrated=np.full(3, np.nan) if integrated is None else integrated,
-                    axis=axis, reason=reason)
+                    axis=axis, reason=reason, table_turned=table)
 
     if before is None or after is None:
         return move("no static span on both sides: the bias cannot be removed and no pose closes the motion")
@@ -955,70 +960,45 @@ def _motion(x: np.ndarray, times: np.ndarray, lo: int, hi: int, before: Span | N
     main = float(integrated[axis])
     off = float(np.hypot(*np.delete(integrated, axis)))
     if turned is not None and abs(float(turned[hi] - turned[lo])) > TABLE_STILL:
-        return _table_turn(move, float(turned[hi] - turned[lo]), integrated, axis, before, after)
-    if abs(main) < math.pi / 4:
+        table = float(turned[hi] - turned[lo])
+    by_table = math.isfinite(table)
+    if not by_table and abs(main) < math.pi / 4:
         return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: less than 45 deg", integrated, axis)
     if off > OFF_AXIS_FRACTION * abs(main):
-        return move(f"not about one body axis: the other axes turned {math.degrees(off):.1f} deg against "
+        whose = "the gyros' turn is " if by_table else ""
+        return move(f"{whose}not about one body axis: the other axes turned {math.degrees(off):.1f} deg against "
                     f"{math.degrees(main):+.1f} deg about {AXES[axis]}", integrated, axis)
-    nominal = (math.pi / 2) * round(main / (math.pi / 2))
-    if ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal) >= math.pi / 4:
-        return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: too far for the nearest whole number "
-                    "of quarter turns to be told (10 deg + 5 % of it passes half a quarter turn); give the turn's "
-                    "angle, or the table's rate over its steady part", integrated, axis)
-    if abs(main - nominal) > ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal):
-        return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: not near a whole number of quarter "
-                    "turns", integrated, axis)
+    if by_table:
+        if abs(abs(main) - abs(table)) > TABLE_AGREEMENT * abs(table):
+            return move(f"the gyros measured {math.degrees(main):+.2f} deg about {AXES[axis]}, more than "
+                        f"{TABLE_AGREEMENT:.0%} apart (the column in another unit, or the table not turning about "
+                        f"{AXES[axis]}?)", integrated, axis)
+        nominal = math.copysign(abs(table), main)
+    else:
+        nominal = (math.pi / 2) * round(main / (math.pi / 2))
+        if ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal) >= math.pi / 4:
+            return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: too far for the nearest whole "
+                        "number of quarter turns to be told (10 deg + 5 % of it passes half a quarter turn); give "
+                        "the turn's angle, or the table's rate over its steady part", integrated, axis)
+        if abs(main - nominal) > ANGLE_TOLERANCE_RAD + ANGLE_TOLERANCE_FRACTION * abs(nominal):
+            return move(f"turned {math.degrees(main):+.1f} deg about {AXES[axis]}: not near a whole number of "
+                        "quarter turns", integrated, axis)
     if before.up != after.up:
-        return move(f"the pose changed from {before.up} up to {after.up} up: no reference for the angle",
-                    integrated, axis)
+        why = "a turn about a horizontal axis, which the fit does not use" if by_table else "no reference for the angle"
+        return move(f"the pose changed from {before.up} up to {after.up} up: {why}", integrated, axis)
     g = before.mean[3:]
     vertical = _vertical(g, axis)
-    full_turns = abs(nominal) % (2 * math.pi) < 1e-9
+    if by_table:  # the table's angle is measured: a whole number of full turns within the hand's tolerance
+        full_turns = abs(math.remainder(nominal, 2.0 * math.pi)) <= ANGLE_TOLERANCE_RAD
+    else:
+        full_turns = abs(nominal) % (2 * math.pi) < 1e-9
     if not vertical and not full_turns:
-        return move(f"turned {math.degrees(main):+.1f} deg about the horizontal axis {AXES[axis]} without "
-                    "coming back to the same pose", integrated, axis)
+        turned_by = "it turned" if by_table else f"turned {math.degrees(main):+.1f} deg"
+        return move(f"{turned_by} about the horizontal axis {AXES[axis]} without coming back to the same pose",
+                    integrated, axis)
     expected = _rotate(g, axis, nominal)
     if float(np.dot(expected, after.mean[3:])) < math.cos(VERTICAL_AXIS_TOLERANCE) * float(
             np.linalg.norm(expected) * np.linalg.norm(after.mean[3:])):
         return move("the gravity direction after the turn does not match the turn", integrated, axis)
     return Span("rotation", lo, hi, mean, up=before.up, integrated=integrated, axis=axis, angle=nominal,
-                orientation="approximate" if vertical else "unknown")
-
-
-def _table_turn(move, table: float, integrated: np.ndarray, axis: int, before: Span, after: Span) -> Span:
-    """The motion between the static spans *before* and *after* over which the table's logged angle changed by
-    *table* (rad, its own sense), the gyros having integrated *integrated* (bias removed) with its largest
-    component about *axis*: a ``rotation`` by the table's angle, signed as the gyros measured it, where the two
-    agree within :data:`TABLE_AGREEMENT`, the turn is about one body axis, the unit ends in the pose it started
-    in, and the turn is about the vertical or a whole number of full turns (step 8, with the table's angle in
-    place of the nearest quarter turn); a ``move`` otherwise, with the table's angle kept (``table_turned``) and
-    *move* (``_motion``'s) giving the reason."""
-    main = float(integrated[axis])
-    off = float(np.hypot(*np.delete(integrated, axis)))
-    here = f"the table turned {math.degrees(table):+.2f} deg by its column"
-
-    def refused(reason: str) -> Span:
-        return dataclasses.replace(move(f"{here}, but {reason}", integrated, axis), table_turned=table)
-
-    if off > OFF_AXIS_FRACTION * abs(main):
-        return refused(f"the gyros' turn is not about one body axis: the other axes turned {math.degrees(off):.1f} "
-                       f"deg against {math.degrees(main):+.1f} deg about {AXES[axis]}")
-    if abs(abs(main) - abs(table)) > TABLE_AGREEMENT * abs(table):
-        return refused(f"the gyros measured {math.degrees(main):+.2f} deg about {AXES[axis]}, more than "
-                       f"{TABLE_AGREEMENT:.0%} apart (the column in another unit, or the table not turning about "
-                       f"{AXES[axis]}?)")
-    if before.up != after.up:
-        return refused(f"the pose changed from {before.up} up to {after.up} up: a turn about a horizontal axis, which "
-                       "the fit does not use")
-    nominal = math.copysign(abs(table), main)
-    g = before.mean[3:]
-    vertical = _vertical(g, axis)
-    if not vertical and abs(math.remainder(nominal, 2.0 * math.pi)) > ANGLE_TOLERANCE_RAD:
-        return refused(f"it turned about the horizontal axis {AXES[axis]} without coming back to the same pose")
-    expected = _rotate(g, axis, nominal)
-    if float(np.dot(expected, after.mean[3:])) < math.cos(VERTICAL_AXIS_TOLERANCE) * float(
-            np.linalg.norm(expected) * np.linalg.norm(after.mean[3:])):
-        return refused("the gravity direction after the turn does not match the turn")
-    return dataclasses.replace(move(""), kind="rotation", integrated=integrated, axis=axis, angle=nominal,
-                               orientation="approximate" if vertical else "unknown", table_turned=table)
+                orientation="approximate" if vertical else "unknown", table_turned=table)
