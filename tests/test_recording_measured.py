@@ -144,11 +144,14 @@ def test_csv_unknown_values_and_their_limits(tmp_path):
                                       1), encoding="utf-8")
     with pytest.raises(ValueError, match=r"angle_deg = nan and angle_rad = -6\.28.* disagree"):
         read_recording(path)
-    # a heading not known needs an orientation that says so
+    # a heading not known: a hand-placed pose, or a table's pose whose heading was not logged (static, rotation)
     table.write_text(original.replace("approximate", "known", 1), encoding="utf-8")
-    with pytest.raises(ValueError, match=r"segment 0.*heading = nan; a heading may be NaN \(not known\) only when "
-                                         "orientation is 'approximate' or 'unknown'"):
-        read_recording(path)
+    first = read_recording(path).schedule.segments[0]
+    assert first.test == "static" and first.orientation == "known" and not first.heading_known
+    # a JJF 2003 test's segment needs its heading, whatever its orientation says
+    with pytest.raises(ValueError, match=r"segment 'p'.*heading = nan; a heading may be NaN \(not known\) only when "
+                                         "orientation is 'approximate' or 'unknown', or in a 'static' or 'rotation'"):
+        Segment("p", "multi_position", 1, "+z", heading=math.nan)
     table.write_text(original.replace("approximate", "roughly", 1), encoding="utf-8")
     with pytest.raises(ValueError, match="orientation = 'roughly'; allowed: known, approximate, unknown"):
         read_recording(path)

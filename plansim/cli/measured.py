@@ -34,7 +34,7 @@ def _cmd_import(args) -> int:
                         latitude=args.latitude, height=args.height, full_scale=args.full_scale,
                         accel_log=args.accel_log, table_rate_column=args.table_rate_column,
                         table_rate_unit=args.table_rate_unit, table_angle_column=args.table_angle_column,
-                        table_angle_unit=args.table_angle_unit, **options)
+                        table_angle_unit=args.table_angle_unit, poses=args.poses, **options)
     with OutputSet() as staged:
         if args.plot is not None:  # drawn before the recording is written; committed once it is
             from plansim.report.plot import recording_figure
@@ -106,6 +106,11 @@ def _add_import_command(sub) -> None:
                         "and without --table-rate-column its rate gives each steady turn's")
     p.add_argument("--table-angle-unit", default="deg", metavar="UNIT",
                    help="unit of --table-angle-column (deg, rad, arcmin or arcsec; default deg)")
+    p.add_argument("--poses", default="hand", metavar="{hand,table}",
+                   help="how the poses were set: 'hand' (default; each pose's tilt is fitted) or 'table' (a table "
+                        "set each pose's up-axis to its grade, JJF 2003's positions, and turned the unit about the "
+                        "vertical: those poses and turns are known, their heading not logged, and plansim fit takes "
+                        "the table's position errors as Type B and identifies the cross-couplings)")
     p.add_argument("--temperature", type=float, default=None, metavar="DEGC",
                    help="the lab's temperature, for a log without a temperature column (default 20, noted as assumed)")
     p.add_argument("--latitude", type=float, default=None, metavar="DEG", help="site latitude (site_latitude_deg)")

@@ -255,7 +255,8 @@ def _segment_use(schedule: Schedule, recording=None) -> _Use:
             unused[k] = ("a turn with neither its rate nor its angle: nothing to fit it against (give the rate the "
                          "table held, or the angle turned, in the segment table)")
             continue
-        on_table = s.orientation == "known" and s.heading_known
+        # a table's turn; about the vertical its heading is only where it started, which the fit averages over
+        on_table = s.orientation == "known" and (s.heading_known or s.rate_axis[1] == s.up[1])
         if not on_table and (s.orientation == "unknown" or s.rate_axis[1] != s.up[1]):
             unused[k] = (f"a turn about a horizontal axis or from a pose not known ({s.orientation}): the specific "
                          "force turns with it along a path no recording holds; not fitted (docs/fitting.md)")

@@ -76,7 +76,14 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree", "frozen", "repeated_rows", "table_rate_disagrees", "table_rate_sense",
-                 "table_turning_at_rest", "table_turn_not_a_rotation")
+                 "table_turning_at_rest", "table_turn_not_a_rotation", "not_a_table_pose")
+#: how the log's poses were set (``--poses``): by hand (each pose's tilt a nuisance of the fit) or by a table that
+#: set each up-axis to its grade (JJF 2003's positions: one body axis up or down, turns about the vertical)
+POSES = ("hand", "table")
+#: with ``--poses table``, a static pose whose specific force is further than this from every body axis is not one
+#: of the table's axis-up positions: a MEMS unit's accelerometer misalignments (up to 1-2 %) and biases (up to about
+#: 50 mg) tilt its measured specific force by a few degrees at most, the table's own position error by arcseconds
+TABLE_POSE_TILT = math.radians(5.0)
 #: up to this many glitch rows (or repeated rows) are listed by line in the warning
 GLITCHES_LISTED = 10
 #: up to this many frozen stretches are listed in the warning
@@ -140,7 +147,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
                full_scale: str | None = None, accel_log: str | os.PathLike | None = None,
                table_rate_column: str | None = None, table_rate_unit: str = "deg/s",
-               table_angle_column: str | None = None, table_angle_unit: str = "deg") -> ImportResult:
+               table_angle_column: str | None = None, table_angle_unit: str = "deg", poses: str = "hand"
+               ) -> ImportResult:
     """Read a plain log and cut it into segments (see the module docstring and docs/measured-data.md).
 
     Parameters
@@ -181,6 +189,14 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         A log of one file only.
     table_angle_unit : str
         Unit of that column: one of :data:`plansim.units.KINDS` ``angle`` (``deg`` by default).
+    poses : str
+        ``--poses``, how the poses were set (:data:`POSES`): ``"hand"`` (default), each static pose's orientation
+        ``approximate`` (its tilt a nuisance of the fit); or ``"table"``, a table (or a fixture on it) set each
+        pose's up-axis to its grade and turned the unit about the vertical: each static pose within
+        :data:`TABLE_POSE_TILT` of a body axis, and each turn about the vertical, is ``known`` with its heading NaN
+        (not logged). The fit then takes the table's position errors as Type B inputs (its grade, ``--scenario``)
+        and no tilt, and identifies the accelerometers' and gyros' cross-couplings. A pose tilted further keeps its
+        hand-placed orientation, named in a warning (``not_a_table_pose``).
     temperature : float or None
         The lab's temperature, degC, for the segment table when the log has no temperature column
         (default 20 degC, noted in the attributes as assumed).
@@ -224,6 +240,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                          "--sample-rate HZ")
     if time_unit == "samples" and sample_rate is None:
         raise ValueError("--time-unit samples: a sample counter needs --sample-rate HZ")
+    if poses not in POSES:
+        raise ValueError(f"--poses {poses!r}; allowed: {', '.join(POSES)} (how the log's poses were set)")
     table_rate_factor = _table_factor("rate", table_rate_column, table_rate_unit, accel_log)
     table_angle_factor = _table_factor("angle", table_angle_column, table_angle_unit, accel_log)
     if temperature_column is not None and temperature is not None:
@@ -504,11 +522,23 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         seg_temperature = (float(np.mean(table.temperature[span.start:span.stop])) if table.temperature is not None
                            else segment_temperature)
         segments.append(_segment(span, counters[span.kind], timing.sample_rate, seg_temperature,
-                                 table_rates.get(k, math.nan)))
+                                 table_rates.get(k, math.nan), on_table=poses == "table"))
         details.append(_detail(span, table))
         if k in table_rates:
             details[-1]["table_rate_deg_s"] = math.degrees(table_rates[k])
+    if poses == "table":
+        apart = [(span, segment) for span, segment in zip(segmentation.spans, segments)
+                 if span.kind == "static" and segment.orientation != "known"]
+        if apart:
+            listed = "; ".join(f"lines {table.lines[span.start]}-{table.lines[span.stop - 1]} "
+                               f"({math.degrees(span.tilt):.1f} deg from {span.up})" for span, _ in apart[:6])
+            warnings.append(LogWarning("not_a_table_pose", f"--poses table: {len(apart)} of the {len(statics)} static "
+                                       f"pose(s) lie further than {math.degrees(TABLE_POSE_TILT):g} deg from every "
+                                       "body axis, so they are not one of the table's axis-up positions: each keeps a "
+                                       "hand-placed orientation (its tilt fitted); " + listed
+                                       + ("; …" if len(apart) > 6 else "")))
     schedule = Schedule(tuple(segments), procedure="imported", notes={"import": {
+        "poses": poses,
         "log": table.path.name,
         "accel_log": None if accel_log is None else Path(accel_log).name,
         "pairing": list(table.pairing),
@@ -558,6 +588,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "detector_min_static_s": segmentation.min_static / timing.sample_rate,
         "import_warnings": ", ".join(dict.fromkeys(w.name for w in warnings)) or "none",
         "heading": "not known for any segment: a plain log has no heading reference",
+        "poses": ("set by a table (--poses table): each axis-up pose and each turn about the vertical known to the "
+                  "table's grade, its heading not logged" if poses == "table"
+                  else "placed by hand (--poses hand): each pose's tilt is fitted"),
     }
     if table.time is not None:
         attrs.update({"sample_rate_estimated_hz": timing.estimated_rate, "time_jitter_rms_s": timing.jitter_rms,
@@ -693,13 +726,20 @@ def _rates_from_table(segmentation, table: LogTable, table_rate: np.ndarray, war
     return rates
 
 
-def _segment(span: Span, number: int, sample_rate: float, temperature: float, table_rate: float = math.nan
-             ) -> Segment:
+def _segment(span: Span, number: int, sample_rate: float, temperature: float, table_rate: float = math.nan,
+             on_table: bool = False) -> Segment:
+    """The segment-table row of *span*; *on_table* (``--poses table``): an axis-up pose within
+    :data:`TABLE_POSE_TILT`, and a turn about the vertical, are ``known`` (the table set the up-axis; the heading
+    stays NaN, not logged)."""
     common = dict(dwell=span.samples / sample_rate, settle=0.0, sample_rate=sample_rate, temperature=temperature)
     if span.kind == "static":
         held = f", held (gyros shaking {span.held:.3g}x their quiet noise)" if math.isfinite(span.held) else ""
-        return Segment(f"static {number}: {span.up} up, tilt {math.degrees(span.tilt):.1f} deg{held}", "static", 0,
-                       span.up, heading=math.nan, orientation=span.orientation, **common)
+        set_by_table = on_table and span.tilt <= TABLE_POSE_TILT
+        return Segment(f"static {number}: {span.up} up{' (table)' if set_by_table else ''}, tilt "
+                       f"{math.degrees(span.tilt):.1f} deg{held}", "static", 0, span.up, heading=math.nan,
+                       orientation="known" if set_by_table else span.orientation, **common)
+    # a turn about the vertical ("approximate") from a pose the table set
+    turn_orientation = "known" if on_table and span.orientation == "approximate" else span.orientation
     measured = math.degrees(float(span.integrated[span.axis])) if span.axis >= 0 else math.nan
     if span.kind == "rotation":
         if math.isfinite(span.steady_rate) and math.isfinite(table_rate):  # the table's rate from its column
@@ -715,7 +755,7 @@ def _segment(span: Span, number: int, sample_rate: float, temperature: float, ta
             label = (f"rotation {number}: {math.degrees(span.angle):+.0f} deg about +{AXES[span.axis]} (measured "
                      f"{measured:+.2f} deg)")
         return Segment(label, "rotation", span.axis, span.up, heading=math.nan, rate=table_rate,
-                       rate_axis=f"+{AXES[span.axis]}", angle=span.angle, orientation=span.orientation, **common)
+                       rate_axis=f"+{AXES[span.axis]}", angle=span.angle, orientation=turn_orientation, **common)
     about = f"turned {measured:+.1f} deg about {AXES[span.axis]}" if span.axis >= 0 else "not integrated"
     return Segment(f"move {number}: {about}", "move", 0, span.up or "+z", heading=math.nan, rate=math.nan,
                    orientation="unknown", **common)

@@ -78,8 +78,15 @@ def format_summary(result: ImportResult) -> str:
         rows = f"{table.lines[span.start]}-{table.lines[span.stop - 1]}"
         lines.append(f"  {k:3d}  {segment.test:8s}  {rows:>13s}  {span.samples / timing.sample_rate:7.2f} s  "
                      f"{segment.label}")
-    lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
-                 "approximate for the static poses")
+    statics = [s for s in rec.schedule.segments if s.test == "static"]
+    on_table = sum(s.orientation == "known" for s in statics)
+    if rec.schedule.notes.get("import", {}).get("poses") == "table":
+        lines.append(f"  poses: set by a table (--poses table): orientation = known for {on_table} of the "
+                     f"{len(statics)} static poses and for the turns about the vertical, to the table's grade; "
+                     "heading = nan (not logged)")
+    else:
+        lines.append("  heading: not known (a plain log has no heading reference): heading = nan, orientation = "
+                     "approximate for the static poses (placed by hand; --poses table if a table set them)")
     rotations = seg.of_kind("rotation")
     between = [r for r in rotations if not math.isfinite(r.steady_rate)]
     by_table = [r for r in between if math.isfinite(r.table_turned)]

@@ -14,8 +14,9 @@ about the vertical, counter-clockwise seen from above.
 Measured logs need more than a laboratory's table gives (docs/recording.md): a pose placed by hand is
 known only roughly or not at all (``orientation``), a turn may be known by its angle rather than its
 rate (``test = "rotation"``, ``angle``), and a rate may not have been logged. A value that is not known
-is NaN — ``heading`` (when ``orientation`` is not ``"known"``), ``rate`` and ``angle`` (of a
-``"rotation"``); infinity is never allowed.
+is NaN — ``heading`` (when ``orientation`` is not ``"known"``, or in a ``"static"`` or ``"rotation"`` segment
+whose up-axis a table set but whose heading was not logged), ``rate`` and ``angle`` (of a ``"rotation"``);
+infinity is never allowed.
 """
 
 from __future__ import annotations
@@ -88,7 +89,9 @@ class Segment:
     orientation : str
         One of :data:`ORIENTATIONS` (default ``"known"``): ``"approximate"`` means ``up``/``heading`` are the
         nearest nominal pose of a pose known only roughly (hand-placed); ``"unknown"`` means they are
-        placeholders.
+        placeholders. ``"known"`` with ``heading`` NaN (a ``"static"`` or ``"rotation"`` segment only): a table
+        set the up-axis, to its grade, but its heading about the vertical was not logged (``plansim import
+        --poses table``).
     angle : float
         Reference angle turned about ``rate_axis`` during a ``rotation`` segment, rad (signed like ``rate``);
         NaN (the default) when not known, and always NaN for the other tests.
@@ -118,8 +121,9 @@ class Segment:
         axis_vector(self.rate_axis, f"{where}: rate_axis")
         # which numbers may be NaN (= not known), and why
         may_be_unknown = {
-            "heading": (self.orientation != "known", "a heading may be NaN (not known) only when orientation is "
-                                                     "'approximate' or 'unknown'"),
+            "heading": (self.orientation != "known" or self.test in ("static", "rotation"),
+                        "a heading may be NaN (not known) only when orientation is 'approximate' or 'unknown', or in a "
+                        "'static' or 'rotation' segment (a table's pose whose heading was not logged)"),
             "rate": (self.test in ("rotation", "move"), "a rate may be NaN (not logged) only in a 'rotation' or "
                                                          "'move' segment"),
             "angle": (True, ""),
