@@ -136,6 +136,18 @@ WEAK_DIRECTION_U = UNINFORMATIVE_U["Kg"]
 #: this (the 99 % point of χ² with 1 degree of freedom): with poses near the six axes a half turn of the gyro
 #: triad about one axis maps every pose's gravity onto itself, and the moves cannot tell it from none
 SIGN_EVIDENCE = 6.63
+#: each of the many starts (signs, units, permutations) is run for at most this many evaluations, and only the best
+#: of them, where it has not converged, on to MAX_EVALUATIONS: a start that wanders (moves no Kg fits, a start far
+#: from the gyros' own) ran to MAX_EVALUATIONS every time, 13 s each on a 135 000-sample table log, 12 minutes over
+#: its 56 starts; on the Ferraris session every start that ends near the best converges in 10-30
+SCREEN_EVALUATIONS = 40
+#: moves whose residuals scatter, beyond their predicted noise, by more than this per component (rad) at the Kg that
+#: fits them best are left out: the gyros' integral over them does not agree with the change of gravity between the
+#: poses (a motion the log does not hold, the unit turned over inside a gap, a gyro read in another unit or order).
+#: A hand session's moves scatter by 0.25 deg (the Ferraris session); a scale factor is fitted, so what is left is
+#: not a MEMS gyro's scale error
+MOVES_SCATTER_LIMIT = math.radians(5.0)
+MAX_EVALUATIONS = 200
 
 
 def axes_permuted(Kg: np.ndarray) -> str:
@@ -623,18 +635,41 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
             near_one = best is not None and np.all(np.abs(np.diag(kg(best.x)) ** 2 - 1.0) <= FAR_OFF)
             if near_one and (2.0 * best.cost <= poor or index == PERMUTED_GROUP):
                 break
-            for start in np.atleast_3d(group).transpose(2, 0, 1) if np.ndim(group) == 3 else [group]:
+            many = len(groups) > 1 or np.ndim(group) == 3
+            for number, start in enumerate(np.atleast_3d(group).transpose(2, 0, 1) if np.ndim(group) == 3
+                                           else [group]):
                 z0 = np.linalg.lstsq(basis, (start - np.eye(3)).ravel(), rcond=None)[0]
-                result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                                       max_nfev=200)
-                plain = result if plain is None else plain  # the first start: every gyro as wired, K near +1
-                if result is not plain and np.any(np.abs(np.diag(kg(result.x))) > RUNAWAY):
+                try:
+                    result = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                                           max_nfev=SCREEN_EVALUATIONS if many else MAX_EVALUATIONS)
+                except np.linalg.LinAlgError:  # a step landed on a singular Kg: this start is lost, not the fit
+                    result = None
+                if index == 0 and number == 0:
+                    plain = result  # the first start: every gyro as wired, K near +1
+                if result is None or (result is not plain and np.any(np.abs(np.diag(kg(result.x))) > RUNAWAY)):
                     continue
                 if best is None or result.cost < best.cost:
                     best = result
+        if best is None:
+            raise MovesNotFitted("the moves between poses were left out: from every start, the search for the gyro "
+                                 "scale factors that fit them stepped onto a singular Kg — the angles the gyros "
+                                 "integrate over the moves do not agree with the change of gravity between the poses. "
+                                 "Check the gyros' --units, --columns and signs")
+
+        def polish(result):  # a start screened only (SCREEN_EVALUATIONS, not converged): on to the full budget
+            if result is None or result.status != 0 or result.nfev >= MAX_EVALUATIONS:
+                return result
+            try:
+                return least_squares(fun, result.x, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                                     max_nfev=MAX_EVALUATIONS - result.nfev)
+            except np.linalg.LinAlgError:
+                return result
+
+        # the best start, and the gyros as wired that the next rule compares it with
+        best, plain = (polish(best),) * 2 if best is plain else (polish(best), polish(plain))
         # a flipped pair of axes (a half turn of the gyro triad) that fits no better than the gyros as wired is not
         # taken: poses near the six axes cannot tell the two apart (each gravity direction is its own image)
-        if best is not plain and np.all(np.diag(kg(plain.x)) > 0) and \
+        if plain is not None and best is not plain and np.all(np.diag(kg(plain.x)) > 0) and \
                 2.0 * (plain.cost - best.cost) <= SIGN_EVIDENCE:
             best = plain
         return kg(best.x), W
@@ -694,6 +729,15 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
         if not more:
             break
         weak.update(more)
+    if math.sqrt(dark) > MOVES_SCATTER_LIMIT:
+        diagonal = ", ".join(f"{v:+.4g}" for v in np.diag(Kg))
+        raise MovesNotFitted(f"the moves between poses were left out: at the gyro scale factors that fit them best (Kg "
+                             f"diagonal {diagonal}) they still miss the change of gravity between the poses by "
+                             f"{math.degrees(math.sqrt(dark)):.3g} deg per component beyond their noise (more than "
+                             f"{math.degrees(MOVES_SCATTER_LIMIT):g} deg: a hand session's miss by a fraction of a "
+                             "degree) — the angles the gyros integrate over the moves do not agree with the poses. "
+                             "Check the gyros' --units, --columns and signs, and whether the moves hold motion the "
+                             "log does not (the unit turned over inside a time gap)")
     Vinv = _floored_inverse(V)
     Jz = jacobian @ basis
     information = Jz.T @ Vinv @ Jz
