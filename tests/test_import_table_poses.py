@@ -81,6 +81,7 @@ def test_a_table_log_imported_with_its_poses_set_by_the_table_fits_all_39_within
         imported = import_log(log, time_column="time", table_rate_column="table_dps", poses="table")
         fit, joint = _joint(imported.recording, scenario)
         assert len(fit.identified) == 39
+        assert not any("Were they placed by hand?" in note for note in fit.notes)  # honest table poses: no question
         hits.append(np.abs(joint.estimate - truth) <= np.array([coverage_factor(nu) for nu in joint.dof]) * joint.u)
     hits = np.concatenate(hits)
     assert abs(hits.mean() - 0.95) <= coverage_tolerance(hits.size, 0.95, 3.0), (hits.mean(), hits.size)
@@ -112,3 +113,35 @@ def test_a_pose_the_table_could_not_have_set_keeps_its_hand_placed_orientation(t
     assert tilt is not None and abs(float(tilt.group(1)) - 8.0) < 0.5, warned
     with pytest.raises(ValueError, match=r"--poses 'bench'; allowed: hand, table"):
         import_log(log, time_column="time", poses="bench")
+
+
+def test_poses_placed_by_hand_but_imported_as_set_by_a_table_are_questioned(tmp_path):
+    """A hand-held session of twelve poses near the six axes (each placed twice, 1.5 deg off its axis at random, a
+    consumer unit, plansim.simulate.hand_session) imported with ``--poses table``: the accelerometers scatter between
+    the repeats of one up-axis far beyond the table's grade (the repeated settings' verdict, a chi-square test at
+    0.5 % per channel), and `plansim fit` asks whether the poses were placed by hand. Imported as placed by hand, the
+    note is not given (no pose is said to be the table's)."""
+    from scipy.spatial.transform import Rotation
+
+    from plansim.fit.site import Site
+    from plansim.simulate.hand_session import consumer_unit, hand_session
+
+    rng = np.random.default_rng(5)
+    ups = [("y", 90.0), ("y", -90.0), ("x", -90.0), ("x", 90.0), ("x", 0.0), ("x", 180.0)]  # +x, -x, +y, -y, +z, -z
+    poses = []
+    for axis, angle in ups * 2:
+        off = Rotation.from_rotvec(np.radians(1.5) * np.append(rng.normal(size=2) / math.sqrt(2.0), 0.0))
+        poses.append((off * Rotation.from_euler(axis, angle, degrees=True)).as_matrix())
+    site = Site(math.radians(45.0), 100.0, earth_rate=False)
+    session = hand_session(consumer_unit(5), np.array(poses), seed=5, gravity=site.gravity, gyro_noise=8.7e-4,
+                           accel_noise=9.8e-3)
+    log = tmp_path / "hand.csv"
+    write_synthetic(log, session.time, session.samples)
+    as_table = import_log(log, time_column="time", poses="table")
+    known = [s for s in as_table.recording.schedule.segments if s.test == "static" and s.orientation == "known"]
+    assert len(known) >= 10, [s.label for s in as_table.recording.schedule.segments]
+    fit = fit_recording(as_table.recording, site)
+    asked = [n for n in fit.notes if "Were they placed by hand?" in n]
+    assert len(asked) == 1 and "re-import without --poses table" in asked[0], fit.notes
+    by_hand = fit_recording(import_log(log, time_column="time").recording, site)
+    assert not any("Were they placed by hand?" in n for n in by_hand.notes)
