@@ -138,8 +138,9 @@ WEAK_DIRECTION_U = UNINFORMATIVE_U["Kg"]
 SIGN_EVIDENCE = 6.63
 #: each of the many starts (signs, units, permutations) is run for at most this many evaluations, and only the best
 #: of them, where it has not converged, on to MAX_EVALUATIONS: a start that wanders (moves no Kg fits, a start far
-#: from the gyros' own) ran to MAX_EVALUATIONS every time, 13 s each on a 135 000-sample table log, 12 minutes over
-#: its 56 starts; on the Ferraris session every start that ends near the best converges in 10-30
+#: from the gyros' own) ran to MAX_EVALUATIONS every time, 13 s each on a 135 000-sample table log whose moves no Kg
+#: fits (its fit took 551 s, now 145 s); on the Ferraris session every start that ends near the best converges in
+#: 10-30
 SCREEN_EVALUATIONS = 40
 #: moves whose residuals scatter, beyond their predicted noise, by more than this per component (rad) at the Kg that
 #: fits them best are left out: the gyros' integral over them does not agree with the change of gravity between the
