@@ -22,6 +22,7 @@ import xarray as xr
 from plansim.cli import main
 from plansim.config.scenario import ErrorDistribution
 from plansim.fit import TABLE_1_TURNTABLE, Site, fit_recording, recording_noise, recording_noise_models, resolve_site
+from plansim.fit.between import SCATTER_MORE
 from plansim.fit.identify import identifiability
 from plansim.fit.model import MeanModel, nominal_parameters
 from plansim.fit.noise import (
@@ -1190,7 +1191,7 @@ def test_repeated_settings_show_table_errors_larger_than_the_stated_grade():
     site = resolve_site(scenario=scenario)
     stated = fit_recording(recording, site, TABLE_1_TURNTABLE)
     verdicts = {b.channel: b.verdict for b in stated.between}
-    assert all(verdicts[c] == "the data scatter more than predicted" for c in ("ax", "ay", "az")), verdicts
+    assert all(verdicts[c] == SCATTER_MORE for c in ("ax", "ay", "az")), verdicts
     true_grade = fit_recording(recording, site, coarse)
     assert sum(b.verdict == "consistent" for b in true_grade.between) >= 5
     # each accelerometer is horizontal in 2 of the 3 up-axes, where a tilt of u moves it by g·u

@@ -125,6 +125,11 @@ def between_segment_noise(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, 
 #: coordinate-ascent sweeps of :func:`_joint_between_variances`
 JOINT_BETWEEN_SWEEPS = 4
 
+#: the repeated settings' verdicts (:attr:`BetweenSegments.verdict`; a χ² test at CHI2_FLAG_PROBABILITY two-sided)
+SCATTER_MORE = "the data scatter more than predicted"
+SCATTER_LESS = "the data scatter less than predicted"
+SCATTER_CONSISTENT = "consistent"
+
 
 def _joint_between_variances(residual, C, R, rows, times, variance, taus) -> np.ndarray:
     """The between-segment variances of the channels that took one, re-estimated together: the restricted
@@ -248,11 +253,11 @@ def between_segments(schedule: Schedule, residual: np.ndarray, residual_cov: np.
         ratio = observed / expected if expected > 0 else math.inf
         upper = float(chdtrc(dof, dof * ratio)) if math.isfinite(ratio) else 0.0
         if upper < CHI2_FLAG_PROBABILITY / 2:
-            verdict = "the data scatter more than predicted"
+            verdict = SCATTER_MORE
         elif upper > 1 - CHI2_FLAG_PROBABILITY / 2:
-            verdict = "the data scatter less than predicted"
+            verdict = SCATTER_LESS
         else:
-            verdict = "consistent"
+            verdict = SCATTER_CONSISTENT
         observed, expected = max(observed, 0.0), max(expected, 0.0)  # quadratic forms, ≥ 0 but for rounding
         out.append(BetweenSegments(name, len(groups), dof, math.sqrt(observed / dof), math.sqrt(expected / dof),
                                    math.sqrt(noise_part / dof), math.sqrt(table_part / dof),

@@ -38,6 +38,7 @@ from plansim.config.scenario import ErrorDistribution, Turntable
 from plansim.estimate.jjf2003 import check_design, reduction_matrix
 from plansim.estimate.segmentation import APPROXIMATE_TILT, MAD_TO_SIGMA
 from plansim.fit.between import (
+    SCATTER_MORE,
     BetweenSegmentNoise,
     BetweenSegments,
     add_between_segment_noise,
@@ -434,7 +435,7 @@ def _table_poses_note(schedule: Schedule, between) -> list[str]:
     repeated settings' verdict, :func:`plansim.fit.between.between_segments`): they may have been placed by hand."""
     if not any(s.test == "static" and s.orientation == "known" and not s.heading_known for s in schedule.segments):
         return []
-    off = [b for b in between if b.channel in ("ax", "ay", "az") and b.verdict == "the data scatter more than predicted"
+    off = [b for b in between if b.channel in ("ax", "ay", "az") and b.verdict == SCATTER_MORE
            and b.observed_sd >= TABLE_POSES_SCATTER * b.predicted_sd]
     if not off:
         return []
