@@ -33,7 +33,7 @@ from plansim.fit.joint import recording_noise
 from plansim.fit.moves import KG_INDEX, KG_NAMES, _Moves, find_transitions, fit_moves
 from plansim.fit.site import Site
 from plansim.io.recording import Recording, read_recording
-from plansim.kernels.trajectory import integrate_rotation, trajectory_outputs
+from plansim.kernels.trajectory import integrate_rotation, rotate, trajectory_outputs
 from plansim.model.parameters import PARAMETER_INDEX
 from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
 
@@ -90,6 +90,18 @@ def test_the_integrated_rotation_and_its_sensitivities():
                 ends.append(e)
             # central differences are exact to O(h²·|∂³|) ~ 1e-12 here, rounding ~1e-16/h = 1e-10
             np.testing.assert_allclose(S[k][:, c], (ends[0] - ends[1]) / (2 * h), atol=3e-9)
+
+
+def test_the_rotation_alone_is_the_integrated_rotation_bit_for_bit():
+    """:func:`rotate` (the residual's forward pass) writes what :func:`integrate_rotation` writes, to the bit."""
+    rng = np.random.default_rng(4)
+    n = 500
+    rates, dt, start = rng.normal(size=(n, 3)), 0.01 + rng.uniform(0.0, 1e-3, n), np.array([0.3, -0.1, 0.95])
+    R, end = np.empty((3, 3)), np.empty(3)
+    R2, end2 = np.empty((3, 3)), np.empty(3)
+    integrate_rotation(rates, dt, start, R, end, np.empty((n, 3, 3)))
+    rotate(rates, dt, start, R2, end2)
+    assert np.array_equal(R, R2) and np.array_equal(end, end2)
 
 
 def test_trajectory_outputs_are_eq_1_and_2():
@@ -157,6 +169,30 @@ def test_zero_noise_through_the_whole_fit():
     fit = fit_recording(rec, SITE)
     assert set(("Kgxx", "Kgyy", "Kgzz")) <= set(fit.identified)
     np.testing.assert_allclose(fit.moves.method.estimate[KG_INDEX], s.theta[KG_INDEX], rtol=0, atol=1e-5)
+
+
+def test_the_moves_jacobian_in_kg_is_the_derivative_of_their_residual():
+    """The search's Jacobian (:meth:`_Moves.with_jacobian`, one (9, n)·(n, 3) product) against central differences
+    of the residual in each of Kg's 9 entries, at a Kg off the truth by 1e-2; and the same as the details' one."""
+    s, rec = session(5, noise=False)
+    fit = fit_recording(rec, SITE)
+    transitions, _ = find_transitions(rec)
+    used = list(fit.used)
+    pose_row = {k: used.index(k) for t in transitions for k in (t.before, t.after)}
+    model = _Moves(rec, transitions, pose_row, fit.observed, s.theta)
+    Kg = s.theta[KG_INDEX].reshape(3, 3) + 1e-2 * np.random.default_rng(3).normal(size=(3, 3))
+    h = 1e-6
+    for m in (0, len(transitions) - 1):
+        r, jac = model.with_jacobian(m, Kg, s.theta, fit.observed)
+        np.testing.assert_array_equal(r, model.one(m, Kg, s.theta, fit.observed))
+        np.testing.assert_array_equal(jac, model.one(m, Kg, s.theta, fit.observed, details=True)[1]["jac"])
+        for k in range(9):
+            up, down = Kg.copy(), Kg.copy()
+            up.flat[k] += h
+            down.flat[k] -= h
+            numeric = (model.one(m, up, s.theta, fit.observed) - model.one(m, down, s.theta, fit.observed)) / (2 * h)
+            # a residual of order 1 rad, smooth in Kg: central differences good to ~1e-10 (rounding 1e-16/h)
+            np.testing.assert_allclose(jac[:, k], numeric, rtol=0, atol=1e-8)
 
 
 def test_the_cross_couplings_are_relative_to_the_accelerometer_triad():
@@ -340,7 +376,9 @@ def test_a_hand_session_log_imported_and_fitted(tmp_path, capsys):
     rec = read_recording(rec_path)
     assert sum(seg.test == "static" for seg in rec.schedule.segments) == 20
     assert main(["fit", str(rec_path), "--json", "--out", str(tmp_path / "fit.nc")]) == 0
-    document = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    document = json.loads(captured.out)
+    assert captured.err == ""  # --json: no progress line
     assert len(document["moves"]["used"]) == 19 and {"Kgxx", "Kgyy", "Kgzz"} <= set(document["identified"])
     entries = {p["name"]: p for p in document["parameters"] if p["method"] == "gravity_sequence"}
     truth = s.theta
@@ -348,8 +386,14 @@ def test_a_hand_session_log_imported_and_fitted(tmp_path, capsys):
         # the unit's scale factor relative to the nominal 16.4 counts per deg/s the import divided by
         assert abs(entries[name]["estimate"] - truth[PARAMETER_INDEX[name]]) < 4 * entries[name]["u"], name
     assert main(["fit", str(rec_path)]) == 0
-    text = capsys.readouterr().out
+    captured = capsys.readouterr()
+    text = captured.out
     assert "Moves between poses (the gyros from the gravity sequence): 19 used" in text
+    # the moves' search says how far it is, on stderr, and ends its line
+    assert "plansim fit: the moves' search for the gyros' scale factors: 1 starts" in captured.err
+    assert captured.err.endswith("\n") and "Moves between poses" not in captured.err
+    assert main(["fit", str(rec_path), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
     import xarray as xr
 
     with xr.open_dataset(tmp_path / "fit.nc", engine="h5netcdf") as ds:

@@ -125,17 +125,35 @@ def _add_import_command(sub) -> None:
     p.set_defaults(func=_cmd_import)
 
 
+def _search_progress():
+    """A progress line for the moves' search, its clock started at the search's first start (not at the fit's)."""
+    from plansim.report.progress import stderr_progress
+
+    line = None
+
+    def report(done, total):
+        nonlocal line
+        if line is None:
+            line = stderr_progress("plansim fit: the moves' search for the gyros' scale factors", unit="starts")
+        line(done, total)
+
+    return report
+
+
 def _cmd_fit(args) -> int:
     from plansim.fit import fit_recording
     from plansim.fit.result import fit_dataset, fit_json
     from plansim.report.fit import fit_report
+    from plansim.report.progress import end_progress_line
 
     if args.out is not None:
         check_output_path(args.out, "--out", (".nc",))
     if args.plot is not None:
         check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
     recording, site, options = recording_and_fit_options(args)
-    result = fit_recording(recording, site, **options)
+    progress = None if (args.json or args.quiet) else _search_progress()
+    result = fit_recording(recording, site, progress=progress, **options)
+    end_progress_line()
     with OutputSet() as outputs:
         if args.out is not None:
             fit_dataset(result).to_netcdf(outputs.stage(args.out, "--out", (".nc",)), engine="h5netcdf")
@@ -195,6 +213,8 @@ def _add_fit_command(sub) -> None:
     p.add_argument("--plot", default=None, metavar="FIGURE",
                    help="also draw the residuals per channel, with ±2 sd of each, against the channel's reading and "
                         "against time (.png, .pdf or .svg)")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress on stderr (the moves' search; none with --json either)")
     p.set_defaults(func=_cmd_fit)
 
 

@@ -630,7 +630,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                   lever_arm=None, extra: dict | None = None,
                   between_noise: BetweenSegmentNoise | None = None, stated_white=None,
                   noise: NoiseEstimate | None = None, stated_step=None, moves: bool = True,
-                  held: HeldPriors | None = None, _judged: np.ndarray | None = None) -> FitResult:
+                  held: HeldPriors | None = None, progress=None, _judged: np.ndarray | None = None) -> FitResult:
     """Fit a recording: identifiability, the specification's estimators, the joint fit, noise, uncertainty.
 
     Parameters
@@ -678,6 +678,9 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         The Type B standard uncertainties of what the fit holds at nominal (a gyro's scale factor or
         cross-coupling, the accelerometers' shear, a g-sensitivity the moves need); default the data sheet's
         (:class:`~plansim.fit.identify.HeldPriors`), or a scenario's ``[reduction]`` (``scenario_fit_options``).
+    progress : callable, optional
+        ``progress(starts, None)`` after each start of the moves' search for the gyros' scale factors
+        (:func:`plansim.fit.moves.fit_moves`), which on a long log whose moves fit no Kg takes a minute or more.
 
     Returns
     -------
@@ -1010,7 +1013,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     if moves:
         transitions, unused_moves = find_transitions(recording)
         try:
-            move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise)
+            move_fit = fit_moves(recording, result, transitions, unused_moves, all_noise, progress=progress)
         except MovesNotFitted as why:  # the poses' fit stands without them; say why
             move_fit = None
             result = dataclasses.replace(result, notes=result.notes + (str(why),))

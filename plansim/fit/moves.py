@@ -83,7 +83,7 @@ from plansim.estimate.timebase import GAP_FACTOR
 from plansim.fit.between import BETWEEN_LR_THRESHOLD
 from plansim.fit.budget import Sources, chi2_verdict, propagate
 from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability
-from plansim.kernels.trajectory import integrate_rotation
+from plansim.kernels.trajectory import integrate_rotation, rotate
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
 
@@ -347,6 +347,7 @@ class _Moves:
         #: pairs (i, j) of Ka's cross-couplings the joint fit does not identify: the moves read Ka with their
         #: antisymmetric part (a rotation of the triad, which no pose fixes) removed, (Ka_ij + Ka_ji)/2 both
         self.symmetrise = tuple(symmetrise)
+        self._cache: dict = {}  # transition -> ((theta, means) bytes, _inputs), :meth:`_inputs`
         segments = recording.schedule.segments
         samples = np.asarray(recording.samples, dtype=float)
         time = np.asarray(recording.time, dtype=float)
@@ -388,8 +389,14 @@ class _Moves:
         f = Kinv @ (accel_mean - Ba)
         return f / np.linalg.norm(f)
 
-    def one(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray, details: bool = False):
-        """The residual (2,) of transition *m*; with *details* also the sensitivities (module docstring)."""
+    def _inputs(self, m: int, theta: np.ndarray, means: np.ndarray):
+        """What transition *m*'s residual takes that Kg does not change, at *theta* and *means*: the gyro outputs
+        less the bias and g-sensitivity (n, 3), and the unit gravity directions at both ends. Kept for the last
+        (theta, means) of each transition: the search for Kg evaluates them hundreds of times."""
+        key = (theta.tobytes(), means.tobytes())
+        cached = self._cache.get(m)
+        if cached is not None and cached[0] == key:
+            return cached[1]
         t = self.transitions[m]
         Kinv, Ba, G = self._accel_model(theta)
         before, after = means[self.pose_row[t.before]], means[self.pose_row[t.after]]
@@ -399,22 +406,45 @@ class _Moves:
         w = self.weight_before[m][:, None]
         bias = w * b_i[None, :] + (1.0 - w) * b_j[None, :]
         f_k = (self.accel[m] - Ba[None, :]) @ Kinv.T
+        value = (self.gyro[m] - bias - f_k @ G.T, u_i, u_j)
+        self._cache[m] = (key, value)
+        return value
+
+    def one(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray, details: bool = False):
+        """The residual (2,) of transition *m*; with *details* also the sensitivities (module docstring)."""
+        corrected, u_i, u_j = self._inputs(m, theta, means)
         M = np.linalg.inv(Kg)
-        rates = np.ascontiguousarray((self.gyro[m] - bias - f_k @ G.T) @ M.T)
-        n = rates.shape[0]
-        rotation, end, sens = np.empty((3, 3)), np.empty(3), np.empty((n, 3, 3))
-        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
+        rates = np.ascontiguousarray(corrected @ M.T)
+        rotation, end = np.empty((3, 3)), np.empty(3)
         E = self.basis[m]
-        r = E.T @ (end - u_j)
         if not details:
-            return r
+            rotate(rates, self.dt[m], u_i, rotation, end)
+            return E.T @ (end - u_j)
+        sens = np.empty((rates.shape[0], 3, 3))
+        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
+        r = E.T @ (end - u_j)
         SM = sens @ M  # (n, 3, 3): ∂end/∂(gyro output at k)
-        # ∂r/∂Kg_ab = −Eᵀ Σ_k (S_k M)[:, a] ω̂_k[b]
-        jac = -np.einsum("xi,kxa,kb->iab", E, SM, rates).reshape(2, 9)
         angle = float(np.linalg.norm(_log_rotation(rotation)))
         integral = np.sum(rates * np.asarray(self.dt[m], dtype=float)[:, None], axis=0)  # the turn, rad, body axes
-        return r, dict(jac=jac, SM=SM, S_sum=E.T @ sens.sum(axis=0), SM_sum=E.T @ SM.sum(axis=0), angle=angle,
-                       about_vertical=_about_vertical(integral, u_i))
+        return r, dict(jac=self._kg_jacobian(E, M, sens, rates), SM=SM, S_sum=E.T @ sens.sum(axis=0),
+                       SM_sum=E.T @ SM.sum(axis=0), angle=angle, about_vertical=_about_vertical(integral, u_i))
+
+    @staticmethod
+    def _kg_jacobian(E, M, sens, rates) -> np.ndarray:
+        """∂r/∂Kg (2, 9): ∂r/∂Kg_ab = −Eᵀ Σ_k (S_k M)[:, a] ω̂_k[b] = −Σ_xy E_xi M_ya A_xyb, A_xyb = Σ_k S_k,xy ω̂_k,b
+        (one (9, n)·(n, 3) product, not a sum over n of (3, 3, 3) terms)."""
+        A = (sens.reshape(sens.shape[0], 9).T @ rates).reshape(3, 3, 3)
+        return -np.einsum("xi,ya,xyb->iab", E, M, A).reshape(2, 9)
+
+    def with_jacobian(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray):
+        """The residual (2,) of transition *m* and its Jacobian in Kg (2, 9), without the other details."""
+        corrected, u_i, u_j = self._inputs(m, theta, means)
+        M = np.linalg.inv(Kg)
+        rates = np.ascontiguousarray(corrected @ M.T)
+        rotation, end, sens = np.empty((3, 3)), np.empty(3), np.empty((rates.shape[0], 3, 3))
+        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
+        E = self.basis[m]
+        return E.T @ (end - u_j), self._kg_jacobian(E, M, sens, rates)
 
     def residuals(self, Kg, theta, means) -> np.ndarray:
         return np.concatenate([self.one(m, Kg, theta, means) for m in range(len(self.transitions))])
@@ -466,13 +496,15 @@ def _dark_variance(residual: np.ndarray, V: np.ndarray, hat: np.ndarray, thresho
     return scale * math.exp(result.x) if 2.0 * gain > threshold else 0.0
 
 
-def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
+def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> MoveFit | None:
     """Kg from the transitions (module docstring), given the joint fit *fit* (its θ̂, gain and sources).
 
     *noise* is the recording's :class:`plansim.fit.noise.NoiseEstimate` (its channels' N, B, K and q). The
     inputs are kept, propagated and judged as the joint fit's are (:mod:`plansim.fit.budget`), and the noise between
     moves is taken at the joint fit's likelihood-ratio threshold (:data:`plansim.fit.between.BETWEEN_LR_THRESHOLD`).
-    Returns None when fewer than :data:`MIN_TRANSITIONS` transitions are usable.
+    Returns None when fewer than :data:`MIN_TRANSITIONS` transitions are usable. *progress*, if given, is called
+    as ``progress(starts, None)`` after each start of the search for Kg (a search does not know its length: the
+    later groups of starts are tried only where the earlier ones fail).
     """
     if len(transitions) < MIN_TRANSITIONS:
         return None
@@ -610,6 +642,8 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
                 sources.add(column, fit.held.g_sensitivity, math.inf, "held")
         return sources, jacobian, angles
 
+    tried = 0  # starts of the search, over every call of solve: the progress shown
+
     def solve(V, Kg_start):
         values, vectors = _floored_eigh(V)
         W = (vectors / np.sqrt(values)).T
@@ -622,7 +656,7 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
 
         def jac(z):
             Kg = kg(z)
-            J = np.vstack([moves.one(m, Kg, theta, means, details=True)[1]["jac"] for m in range(n_moves)])
+            J = np.vstack([moves.with_jacobian(m, Kg, theta, means)[1] for m in range(n_moves)])
             return W @ J @ basis
 
         best, plain = None, None
@@ -645,6 +679,10 @@ def fit_moves(recording, fit, transitions, unused, noise) -> MoveFit | None:
                                            max_nfev=SCREEN_EVALUATIONS if many else MAX_EVALUATIONS)
                 except np.linalg.LinAlgError:  # a step landed on a singular Kg: this start is lost, not the fit
                     result = None
+                nonlocal tried
+                tried += 1
+                if progress is not None:
+                    progress(tried, None)
                 if index == 0 and number == 0:
                     plain = result  # the first start: every gyro as wired, K near +1
                 if result is None or (result is not plain and np.any(np.abs(np.diag(kg(result.x))) > RUNAWAY)):

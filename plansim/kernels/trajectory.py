@@ -9,9 +9,10 @@ kernels serve it:
   other simulation (no effect beyond eq. (1)/(2), no lever arm): one model of the physics.
 - :func:`integrate_rotation` — the rotation a sequence of body rates integrates to, each rate held over
   its sample interval (a zero-order hold), and the first-order sensitivity of a rotated vector to every
-  rate. With the body frame at the start as reference and ``R = E_0·E_1·…·E_{n−1}``, E_k = exp([ω_k·dt_k]×)
-  (Rodrigues), a vector fixed in the world that reads ``v`` in the body at the start reads ``Rᵀ·v`` at
-  the end. Perturbing ω_k by δ gives E_k·exp([J_r(φ_k)·δ·dt_k]×) (J_r the right Jacobian of SO(3),
+  rate (:func:`rotate`: the rotation alone, for a residual that needs no Jacobian). With the body frame at
+  the start as reference and ``R = E_0·E_1·…·E_{n−1}``, E_k = exp([ω_k·dt_k]×) (Rodrigues), a vector
+  fixed in the world that reads ``v`` in the body at the start reads ``Rᵀ·v`` at the end. Perturbing
+  ω_k by δ gives E_k·exp([J_r(φ_k)·δ·dt_k]×) (J_r the right Jacobian of SO(3),
   φ_k = ω_k·dt_k), hence
 
       ∂(Rᵀv)/∂ω_k = dt_k · [Rᵀv]× · B_kᵀ · J_r(φ_k),   B_k = E_{k+1}·…·E_{n−1},
@@ -78,6 +79,45 @@ def _right_jacobian(p0, p1, p2, out):
     out[2, 1] = -c1 * p0 + c2 * p1 * p2
 
 
+@inline_jit
+def _compose(rotation, step, work):
+    """``rotation`` (3, 3) ← rotation·step, through ``work`` (3, 3)."""
+    for i in range(3):
+        for j in range(3):
+            work[i, j] = rotation[i, 0] * step[0, j] + rotation[i, 1] * step[1, j] + rotation[i, 2] * step[2, j]
+    for i in range(3):
+        for j in range(3):
+            rotation[i, j] = work[i, j]
+
+
+@inline_jit
+def _rotated(rotation, start, end):
+    """``end`` (3,) = rotationᵀ·start."""
+    for j in range(3):
+        end[j] = rotation[0, j] * start[0] + rotation[1, j] * start[1] + rotation[2, j] * start[2]
+
+
+@inline_jit
+def _identity(rotation):
+    for i in range(3):
+        for j in range(3):
+            rotation[i, j] = 1.0 if i == j else 0.0
+
+
+@jit
+def rotate(rates, dt, start, rotation, end):
+    """What :func:`integrate_rotation` writes to ``rotation`` and ``end``, bit for bit, without the sensitivities
+    (the forward pass alone: half the work, and no (n, 3, 3) buffer)."""
+    n = rates.shape[0]
+    step = np.empty((3, 3))
+    work = np.empty((3, 3))
+    _identity(rotation)
+    for k in range(n):
+        _exp_so3(rates[k, 0] * dt[k], rates[k, 1] * dt[k], rates[k, 2] * dt[k], step)
+        _compose(rotation, step, work)
+    _rotated(rotation, start, end)
+
+
 @jit
 def integrate_rotation(rates, dt, start, rotation, end, sensitivity):
     """Integrate body *rates* (n, 3), rad/s, each held over ``dt[k]`` s; write the rotation and sensitivities.
@@ -88,20 +128,11 @@ def integrate_rotation(rates, dt, start, rotation, end, sensitivity):
     n = rates.shape[0]
     steps = np.empty((n, 3, 3))
     work = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            rotation[i, j] = 1.0 if i == j else 0.0
+    _identity(rotation)
     for k in range(n):
         _exp_so3(rates[k, 0] * dt[k], rates[k, 1] * dt[k], rates[k, 2] * dt[k], steps[k])
-        for i in range(3):
-            for j in range(3):
-                work[i, j] = rotation[i, 0] * steps[k, 0, j] + rotation[i, 1] * steps[k, 1, j] \
-                    + rotation[i, 2] * steps[k, 2, j]
-        for i in range(3):
-            for j in range(3):
-                rotation[i, j] = work[i, j]
-    for j in range(3):
-        end[j] = rotation[0, j] * start[0] + rotation[1, j] * start[1] + rotation[2, j] * start[2]
+        _compose(rotation, steps[k], work)
+    _rotated(rotation, start, end)
     # [end]×
     cross = np.zeros((3, 3))
     cross[0, 1] = -end[2]
