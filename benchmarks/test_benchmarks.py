@@ -70,3 +70,52 @@ def test_bench_command_quick(capsys):
     assert figures["sweep_cells"] == 4 and figures["sweep_seconds"] > 0
     assert figures["diagnose_seconds"] > 0 and figures["diagnose_effect_seconds"] > 0
     assert figures["calibrations_per_s"] > 0 and figures["peak_rss_mb"] > 0 and figures["summary_peak_rss_mb"] > 0
+
+
+@pytest.fixture(scope="module")
+def move_rates():
+    """A 2000-sample move (20 s at 100 Hz) of body rates, rad/s, and its sample intervals."""
+    from plansim.kernels.trajectory import integrate_rotation
+
+    rng = np.random.default_rng(3)
+    rates, dt = rng.normal(size=(2000, 3)), np.full(2000, 0.01)
+    integrate_rotation(rates, dt, np.array([0.0, 0.0, 1.0]), np.empty((3, 3)), np.empty(3), np.empty((2000, 3, 3)))
+    return rates, dt
+
+
+def test_move_rotation_forward_only(benchmark, move_rates):
+    """One evaluation of a move's residual in the moves' search (``plansim.kernels.trajectory.rotate``)."""
+    from plansim.kernels.trajectory import rotate
+
+    rates, dt = move_rates
+    end = np.empty(3)
+    benchmark(rotate, rates, dt, np.array([0.0, 0.0, 1.0]), np.empty((3, 3)), end)
+    assert abs(np.linalg.norm(end) - 1.0) < 1e-12
+
+
+def test_move_rotation_with_sensitivities(benchmark, move_rates):
+    """The same with the sensitivities the Jacobian needs (``integrate_rotation``): about twice ``rotate``."""
+    from plansim.kernels.trajectory import integrate_rotation
+
+    rates, dt = move_rates
+    end, sensitivity = np.empty(3), np.empty((rates.shape[0], 3, 3))
+    benchmark(integrate_rotation, rates, dt, np.array([0.0, 0.0, 1.0]), np.empty((3, 3)), end, sensitivity)
+    assert abs(np.linalg.norm(end) - 1.0) < 1e-12 and np.isfinite(sensitivity).all()
+
+
+def test_fit_hand_session_with_moves(benchmark):
+    """``plansim fit`` of a simulated 30-pose hand-held session, the moves' search included."""
+    import math
+
+    from plansim.fit import fit_recording
+    from plansim.fit.site import Site
+    from plansim.io.recording import Recording
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    site = Site(math.radians(45.0), 100.0, earth_rate=False)
+    s = hand_session(consumer_unit(1000), spread_poses(30, seed=1000), seed=1000, gravity=site.gravity,
+                     gyro_noise=8.7e-4, accel_noise=9.8e-3)
+    recording = Recording(s.samples, s.schedule, {"source": "simulated"}, timestamps=s.time)
+    fit_recording(recording, site)  # warm up
+    result = benchmark.pedantic(fit_recording, args=(recording, site), rounds=3, iterations=1)
+    assert result.moves is not None and {"Kgxx", "Kgyy", "Kgzz"} <= set(result.identified)

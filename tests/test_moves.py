@@ -148,13 +148,18 @@ def _moves_given(rec, theta, fit):
     return fit_moves(rec, exact, transitions, unused, recording_noise(rec))
 
 
-def test_zero_noise_gives_kg_to_1e_9_with_the_units_own_accelerometer_model():
-    s, rec = session(5, noise=False)
+def _noise_free_moves(seed):
+    """A noise-free hand session, its fit, and the moves' residual model at the unit's own 39 parameters."""
+    s, rec = session(seed, noise=False)
     fit = fit_recording(rec, SITE)
     transitions, _ = find_transitions(rec)
     used = list(fit.used)
     pose_row = {k: used.index(k) for t in transitions for k in (t.before, t.after)}
-    model = _Moves(rec, transitions, pose_row, fit.observed, s.theta)
+    return s, rec, fit, _Moves(rec, transitions, pose_row, fit.observed, s.theta)
+
+
+def test_zero_noise_gives_kg_to_1e_9_with_the_units_own_accelerometer_model():
+    s, rec, fit, model = _noise_free_moves(5)
     assert np.abs(model.residuals(s.theta[KG_INDEX].reshape(3, 3), s.theta, fit.observed)).max() < 1e-12
     moves = _moves_given(rec, s.theta, fit)
     np.testing.assert_allclose(moves.method.estimate[KG_INDEX], s.theta[KG_INDEX], rtol=0, atol=1e-9)
@@ -174,15 +179,10 @@ def test_zero_noise_through_the_whole_fit():
 def test_the_moves_jacobian_in_kg_is_the_derivative_of_their_residual():
     """The search's Jacobian (:meth:`_Moves.with_jacobian`, one (9, n)·(n, 3) product) against central differences
     of the residual in each of Kg's 9 entries, at a Kg off the truth by 1e-2; and the same as the details' one."""
-    s, rec = session(5, noise=False)
-    fit = fit_recording(rec, SITE)
-    transitions, _ = find_transitions(rec)
-    used = list(fit.used)
-    pose_row = {k: used.index(k) for t in transitions for k in (t.before, t.after)}
-    model = _Moves(rec, transitions, pose_row, fit.observed, s.theta)
+    s, rec, fit, model = _noise_free_moves(5)
     Kg = s.theta[KG_INDEX].reshape(3, 3) + 1e-2 * np.random.default_rng(3).normal(size=(3, 3))
     h = 1e-6
-    for m in (0, len(transitions) - 1):
+    for m in (0, len(model.transitions) - 1):
         r, jac = model.with_jacobian(m, Kg, s.theta, fit.observed)
         np.testing.assert_array_equal(r, model.one(m, Kg, s.theta, fit.observed))
         np.testing.assert_array_equal(jac, model.one(m, Kg, s.theta, fit.observed, details=True)[1]["jac"])
