@@ -294,8 +294,10 @@ class MeanModel:
             earth_step = np.asarray(earth_step, dtype=float)
         else:
             earth_step = np.zeros(3)
-        hi = self.evaluate(self._at_angles(plus), self.gravity + gravity_step, earth + earth_step)
-        lo = self.evaluate(self._at_angles(minus), self.gravity - gravity_step, earth - earth_step)
+        # both sides turned in one call (row by row, as two calls would: the same numbers, half the calls' overhead)
+        turned = self._at_angles(np.stack([plus, minus]))
+        hi = self.evaluate(turned[:ANGLES], self.gravity + gravity_step, earth + earth_step)
+        lo = self.evaluate(turned[ANGLES:], self.gravity - gravity_step, earth - earth_step)
         return (hi - lo) / (2.0 * step)
 
     def segment_sensitivity(self, theta: np.ndarray, entry: int, tilts=None) -> np.ndarray:
