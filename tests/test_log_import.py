@@ -32,6 +32,7 @@ from plansim.io.recording import nominal_time, read_recording, write_recording
 from plansim.io.scenario_file import load_scenario
 from plansim.runner import simulate_and_record
 from plansim.schedule import Schedule, Segment
+from plansim.schedule.segments import TABLE_COLUMN_NOTES
 from plansim.units import STANDARD_GRAVITY
 
 REAL = Path(__file__).resolve().parents[2] / "shared/data/real/imucal-ferraris"
@@ -976,6 +977,9 @@ def test_a_table_rate_column_gives_each_steady_turn_its_rate(tmp_path, capsys):
     recording = read_recording(rec)
     steady = [s for s in recording.schedule.segments if s.test == "rotation"]
     assert [math.degrees(s.rate) for s in steady] == pytest.approx(rates, abs=1e-3)
+    # the recording says which table columns the log held, under the keys the fit reads
+    assert {key: recording.schedule.import_notes[key] for key in TABLE_COLUMN_NOTES} == {
+        "table_rate_column": "table_dps", "table_angle_column": None}
     assert main(["fit", str(rec), "--latitude", "40", "--height", "50", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["identified"] == ["Kgzz"]

@@ -64,7 +64,7 @@ from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.fit.solve import solve, weak_directions, whitening
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
-from plansim.schedule.segments import Schedule
+from plansim.schedule.segments import TABLE_COLUMN_NOTES, Schedule
 from plansim.units import STANDARD_GRAVITY, to_unit
 
 METHOD_SPEC = "jjf2003"
@@ -721,8 +721,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                                 "pose is placed by hand)")
         else:
             turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
-            logged = {key: value for key, value in schedule.notes.get("import", {}).items()
-                      if key in ("table_rate_column", "table_angle_column") and value}
+            logged = {key: value for key, value in schedule.import_notes.items()
+                      if key in TABLE_COLUMN_NOTES and value}
             if logged and any(s.is_rotating for s in used_schedule.segments):
                 # plansim import took the turns' angles from the table's column (docs/measured-data.md)
                 turntable_source = (f"none: the poses are placed by hand; the log holds the table's column "

@@ -54,7 +54,7 @@ from plansim.io.log_table import (
     read_log,
 )
 from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
-from plansim.schedule.segments import Schedule, Segment
+from plansim.schedule.segments import IMPORT_NOTES, Schedule, Segment
 from plansim.units import KINDS, STANDARD_GRAVITY
 
 #: a static span's mean specific force must be within this fraction of standard gravity (units check)
@@ -537,7 +537,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                        "body axis, so they are not one of the table's axis-up positions: each keeps a "
                                        "hand-placed orientation (its tilt fitted); " + listed
                                        + ("; …" if len(apart) > 6 else "")))
-    schedule = Schedule(tuple(segments), procedure="imported", notes={"import": {
+    schedule = Schedule(tuple(segments), procedure="imported", notes={IMPORT_NOTES: {
         "poses": poses,
         "log": table.path.name,
         "accel_log": None if accel_log is None else Path(accel_log).name,

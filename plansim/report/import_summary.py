@@ -18,7 +18,7 @@ def format_summary(result: ImportResult) -> str:
     rec = result.recording
     lines = [f"plansim import {table.path.name}: {rec.samples.shape[0]} samples"]
     unit_text = ", ".join(dict.fromkeys(result.units))
-    source = rec.schedule.notes.get("import", {}).get("units_source", "")
+    source = rec.schedule.import_notes.get("units_source", "")
     if source.startswith("the log's"):
         unit_text += f", as {source} writes them"
     if result.scale is not None:
@@ -80,7 +80,7 @@ def format_summary(result: ImportResult) -> str:
                      f"{segment.label}")
     statics = [s for s in rec.schedule.segments if s.test == "static"]
     on_table = sum(s.orientation == "known" for s in statics)
-    if rec.schedule.notes.get("import", {}).get("poses") == "table":
+    if rec.schedule.import_notes.get("poses") == "table":
         lines.append(f"  poses: set by a table (--poses table): orientation = known for {on_table} of the "
                      f"{len(statics)} static poses and for the turns about the vertical, to the table's grade; "
                      "heading = nan (not logged)")

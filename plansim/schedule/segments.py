@@ -186,6 +186,14 @@ class Segment:
         return asdict(self)
 
 
+#: the key of :attr:`Schedule.notes` under which ``plansim import`` records how it read the log
+#: (:func:`plansim.io.log_import.import_log` writes it; the fit and the import summary read it:
+#: :attr:`Schedule.import_notes`)
+IMPORT_NOTES = "import"
+#: … its entries naming the table's columns the log held (the column's name, or None)
+TABLE_COLUMN_NOTES = ("table_rate_column", "table_angle_column")
+
+
 @dataclass(frozen=True)
 class Schedule:
     """An ordered tuple of segments plus the name of the procedure that built it."""
@@ -193,6 +201,11 @@ class Schedule:
     segments: tuple[Segment, ...]
     procedure: str = "custom"
     notes: dict = field(default_factory=dict)
+
+    @property
+    def import_notes(self) -> dict:
+        """How ``plansim import`` read the log (``notes[IMPORT_NOTES]``); empty for a schedule it did not write."""
+        return self.notes.get(IMPORT_NOTES, {})
 
     def __post_init__(self):
         if not self.segments:
