@@ -478,8 +478,14 @@ def test_moves_that_identify_nothing_at_their_solution_are_left_out_with_the_rea
     what to check, not numpy's 'Singular matrix'; fit_recording notes it and keeps the poses' fit."""
     from plansim.fit.moves import MovesNotFitted, _solve_information
 
-    with pytest.raises(MovesNotFitted, match="--units"):
+    with pytest.raises(MovesNotFitted, match="--units") as raised:
         _solve_information(np.diag([1.0, 0.0]), np.eye(2), np.diag([-50.9, 7.1e4, 1.0]))
+    assert "(Kg diagonal -50.9, +7.1e+04, +1)" in str(raised.value)
+    # a search that ended near a permutation: its diagonal says nothing, the note shows the whole matrix
+    with pytest.raises(MovesNotFitted) as raised:
+        _solve_information(np.diag([1.0, 0.0]), np.eye(2), np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, 1.0],
+                                                                      [0.0, 0.98, 1e-3]]))
+    assert "(Kg = [[-1, +0, +0], [+0, +0, +1], [+0, +0.98, +0.001]])" in str(raised.value)
     assert np.allclose(_solve_information(np.diag([2.0, 4.0]), np.eye(2), np.eye(3)), np.diag([0.5, 0.25]))
 
 

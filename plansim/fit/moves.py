@@ -187,17 +187,25 @@ class MovesNotFitted(Exception):
     :func:`plansim.fit.fit_recording` notes it and goes on without them."""
 
 
+def _shown_kg(Kg: np.ndarray) -> str:
+    """*Kg* as a note shows it: its diagonal where the cross-couplings are small beside it (below 0.1 of the smallest
+    scale factor), else the whole matrix (a search that ended near a permutation, whose diagonal says nothing)."""
+    off = np.abs(Kg - np.diag(np.diag(Kg))).max()
+    if off <= 0.1 * np.abs(np.diag(Kg)).min():
+        return "Kg diagonal " + ", ".join(f"{v:+.4g}" for v in np.diag(Kg))
+    return "Kg = [" + ", ".join("[" + ", ".join(f"{v:+.4g}" for v in row) + "]" for row in Kg) + "]"
+
+
 def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarray) -> np.ndarray:
     """information⁻¹ · right, or :class:`MovesNotFitted` where the moves do not identify Kg at the solution *Kg*
     (information singular to working precision)."""
     values = np.linalg.eigvalsh(0.5 * (information + information.T))
     if not values.size or values.min() <= 1e-12 * max(values.max(), 1e-300):
-        diagonal = ", ".join(f"{v:+.4g}" for v in np.diag(Kg))
         raise MovesNotFitted(
-            "the moves between poses were left out: at the gyro scale factors that fit them best (Kg diagonal "
-            f"{diagonal}) they do not identify them — the angles the gyros integrate over the moves do not agree with "
-            "the change of gravity between the poses. Check the gyros' --units (deg/s or rad/s), --columns and "
-            "the axes' signs, and that the segment table's moves are whole turns between the poses")
+            "the moves between poses were left out: at the gyro scale factors that fit them best "
+            f"({_shown_kg(Kg)}) they do not identify them — the angles the gyros integrate over the moves do not "
+            "agree with the change of gravity between the poses. Check the gyros' --units (deg/s or rad/s), "
+            "--columns and the axes' signs, and that the segment table's moves are whole turns between the poses")
     return np.linalg.solve(information, right)
 
 
