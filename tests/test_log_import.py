@@ -204,6 +204,14 @@ def test_real_annotated_session_in_counts_with_its_labels_ignored():
     for span in statics:
         # 1 g, give or take this unit's accelerometer errors (a z scale error of about 2 % and 0.4 m/s^2 bias)
         assert np.linalg.norm(span.mean[3:]) == pytest.approx(9.80665, rel=0.07)
+    # the motions between the pasted sections are no motion the gyros saw: the moves are left out for what they are
+    # (a miss of the poses' change of gravity no Kg brings within MOVES_SCATTER_LIMIT: 13.6 deg), not fitted
+    from plansim.fit import fit_recording
+
+    fit = fit_recording(result.recording)
+    assert fit.moves is None
+    assert any("the moves between poses were left out" in note and "still miss the change of gravity" in note
+               for note in fit.notes), fit.notes
 
 
 def test_real_annotated_session_counter_runs_backwards(tmp_path):

@@ -489,6 +489,20 @@ def test_moves_that_identify_nothing_at_their_solution_are_left_out_with_the_rea
     assert np.allclose(_solve_information(np.diag([2.0, 4.0]), np.eye(2), np.eye(3)), np.diag([0.5, 0.25]))
 
 
+def test_a_start_that_ran_away_or_collapsed_is_not_taken():
+    """The search's plausibility rule: a scale factor beyond RUNAWAY, or a Kg with a gyro that reads no turn (its
+    smallest singular value below 1/RUNAWAY), is no gyro triad; units 180/π off and signed permutations are."""
+    from plansim.fit.moves import RUNAWAY, _implausible
+
+    assert not _implausible(np.eye(3)) and not _implausible(np.diag([-1.0, 1.0, 1.0]))
+    assert not _implausible(np.eye(3) * math.degrees(1.0)) and not _implausible(np.eye(3) / math.degrees(1.0))
+    assert not _implausible(np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]))
+    assert _implausible(np.diag([1.0, 1.0, 1.1 * RUNAWAY]))
+    assert _implausible(np.diag([-1.0, 4.4e-16, 1.0]))  # the best of a table log's search before the rule
+    assert _implausible(np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))  # two gyros as one
+    assert _implausible(np.full((3, 3), np.nan))
+
+
 def test_moves_that_no_scale_factor_brings_onto_the_poses_are_left_out_with_the_reason():
     """Each move's gyro samples scaled by its own factor (0.5-1.5 per axis: motion the gyros did not see as the
     accelerometers did, as where the unit was turned over inside a time gap, or a log stitched from two runs): no

@@ -124,6 +124,18 @@ POOR_FIT = 1e-3
 #: every move is a whole turn about one axis, no turn at all (Kg_ii → ∞) fits as well as the truth, and on a
 #: table's ±360° turns a start at 180/π ran to 2·10⁶ with a χ² below an unconverged start at 1
 RUNAWAY = 2.0 * max(UNIT_STARTS)
+
+
+def _implausible(Kg: np.ndarray) -> bool:
+    """Whether a start of the search ended where no gyro triad is: a scale factor beyond :data:`RUNAWAY` (it ran
+    away), or a Kg whose smallest singular value is below 1/RUNAWAY (it collapsed: a gyro, or a combination of
+    them, that reads no turn at all, as a start at a permutation projected onto the diagonal ends; a table log whose
+    moves fit no Kg gave such a Kg, with Kgyy = 4·10⁻¹⁶, as its best). Units read 180/π off still pass (their
+    singular values are 1/57.3 or 57.3), and so does a signed permutation (all 1)."""
+    if not np.all(np.isfinite(Kg)):
+        return True
+    return bool(np.any(np.abs(np.diag(Kg)) > RUNAWAY)
+                or np.linalg.svd(Kg, compute_uv=False).min() < 1.0 / RUNAWAY)
 #: a combination of Kg entries the moves determine no better than this standard uncertainty (dimensionless) at
 #: Kg = I, with the noise they predict and no between-move noise (the smallest u they could give), is not
 #: identified: a gyro's scale factor is within a few per cent of 1 and its cross-couplings within 1 %, so such a
@@ -693,7 +705,7 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
                     progress(tried, None)
                 if index == 0 and number == 0:
                     plain = result  # the first start: every gyro as wired, K near +1
-                if result is None or (result is not plain and np.any(np.abs(np.diag(kg(result.x))) > RUNAWAY)):
+                if result is None or (result is not plain and _implausible(kg(result.x))):
                     continue
                 if best is None or result.cost < best.cost:
                     best = result
@@ -764,6 +776,14 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
                 dark = _dark_variance(r, V, hat, BETWEEN_LR_THRESHOLD)
                 if dark == 0.0:
                     break
+        if math.sqrt(dark) > MOVES_SCATTER_LIMIT:  # before which entries they determine: they agree with no Kg
+            raise MovesNotFitted(f"the moves between poses were left out: at the gyro scale factors that fit them best "
+                                 f"({_shown_kg(Kg)}) they still miss the change of gravity between the poses by "
+                                 f"{math.degrees(math.sqrt(dark)):.3g} deg per component beyond their noise (more than "
+                                 f"{math.degrees(MOVES_SCATTER_LIMIT):g} deg: a hand session's miss by a fraction of a "
+                                 "degree) — the angles the gyros integrate over the moves do not agree with the poses. "
+                                 "Check the gyros' --units, --columns and signs, and whether the moves hold motion the "
+                                 "log does not (the unit turned over inside a time gap)")
         sources, jacobian, angles = build(Kg, dark)
         V = sources.covariance()
         # a combination the fitted moves, with their noise between moves, still determine only weakly (a cross-coupling
@@ -776,15 +796,6 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
         if not more:
             break
         weak.update(more)
-    if math.sqrt(dark) > MOVES_SCATTER_LIMIT:
-        diagonal = ", ".join(f"{v:+.4g}" for v in np.diag(Kg))
-        raise MovesNotFitted(f"the moves between poses were left out: at the gyro scale factors that fit them best (Kg "
-                             f"diagonal {diagonal}) they still miss the change of gravity between the poses by "
-                             f"{math.degrees(math.sqrt(dark)):.3g} deg per component beyond their noise (more than "
-                             f"{math.degrees(MOVES_SCATTER_LIMIT):g} deg: a hand session's miss by a fraction of a "
-                             "degree) — the angles the gyros integrate over the moves do not agree with the poses. "
-                             "Check the gyros' --units, --columns and signs, and whether the moves hold motion the "
-                             "log does not (the unit turned over inside a time gap)")
     Vinv = _floored_inverse(V)
     Jz = jacobian @ basis
     information = Jz.T @ Vinv @ Jz
