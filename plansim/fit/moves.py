@@ -136,6 +136,8 @@ def _implausible(Kg: np.ndarray) -> bool:
         return True
     return bool(np.any(np.abs(np.diag(Kg)) > RUNAWAY)
                 or np.linalg.svd(Kg, compute_uv=False).min() < 1.0 / RUNAWAY)
+
+
 #: a combination of Kg entries the moves determine no better than this standard uncertainty (dimensionless) at
 #: Kg = I, with the noise they predict and no between-move noise (the smallest u they could give), is not
 #: identified: a gyro's scale factor is within a few per cent of 1 and its cross-couplings within 1 %, so such a
