@@ -185,7 +185,7 @@ def axes_permuted(Kg: np.ndarray) -> str:
     order = [int(np.argmax(np.abs(P[a]))) for a in range(3)]  # gyro a reads the rotation about axis order[a]
     reads = ", ".join(f"g{'xyz'[a]} the rotation about {'xyz'[order[a]]}" for a in range(3) if order[a] != a)
     fix = ", ".join(f"g{'xyz'[b]} ← the column now read as g{'xyz'[order.index(b)]}" for b in range(3))
-    matrix = "[" + ", ".join("[" + ", ".join(f"{v:+.3f}" for v in row) + "]" for row in Kg) + "]"
+    matrix = _matrix_text(Kg, "+.3f")
     odd = sum(order[a] != a for a in range(3)) == 2  # one exchange of two axes: a mirror
     return ("they fit best with the gyros reading the accelerometers' axes in another order: " + reads
             + f" (Kg = {matrix}; the signs this search finds are not reliable). The log's gyro columns are in another "
@@ -201,13 +201,18 @@ class MovesNotFitted(Exception):
     :func:`plansim.fit.fit_recording` notes it and goes on without them."""
 
 
+def _matrix_text(Kg: np.ndarray, spec: str) -> str:
+    """*Kg* (3, 3) as a note prints it, row by row, each entry in the format *spec*."""
+    return "[" + ", ".join("[" + ", ".join(f"{v:{spec}}" for v in row) + "]" for row in Kg) + "]"
+
+
 def _shown_kg(Kg: np.ndarray) -> str:
     """*Kg* as a note shows it: its diagonal where the cross-couplings are small beside it (below 0.1 of the smallest
     scale factor), else the whole matrix (a search that ended near a permutation, whose diagonal says nothing)."""
     off = np.abs(Kg - np.diag(np.diag(Kg))).max()
     if off <= 0.1 * np.abs(np.diag(Kg)).min():
         return "Kg diagonal " + ", ".join(f"{v:+.4g}" for v in np.diag(Kg))
-    return "Kg = [" + ", ".join("[" + ", ".join(f"{v:+.4g}" for v in row) + "]" for row in Kg) + "]"
+    return "Kg = " + _matrix_text(Kg, "+.4g")
 
 
 def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarray) -> np.ndarray:
@@ -432,19 +437,29 @@ class _Moves:
         self._cache[m] = (key, value)
         return value
 
-    def one(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray, details: bool = False):
-        """The residual (2,) of transition *m*; with *details* also the sensitivities (module docstring)."""
+    def _rates(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray):
+        """M = Kg⁻¹, the body rates of transition *m* at *Kg* (n, 3), and the unit gravity directions at its ends."""
         corrected, u_i, u_j = self._inputs(m, theta, means)
         M = np.linalg.inv(Kg)
-        rates = np.ascontiguousarray(corrected @ M.T)
-        rotation, end = np.empty((3, 3)), np.empty(3)
+        return M, np.ascontiguousarray(corrected @ M.T), u_i, u_j
+
+    def _integrated(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray):
+        """The full pass of transition *m* (rotation and sensitivities): its residual (2,), M, the rates, the
+        rotation, the sensitivities (n, 3, 3) and the start's gravity direction."""
+        M, rates, u_i, u_j = self._rates(m, Kg, theta, means)
+        rotation, end, sens = np.empty((3, 3)), np.empty(3), np.empty((rates.shape[0], 3, 3))
+        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
+        return self.basis[m].T @ (end - u_j), M, rates, rotation, sens, u_i
+
+    def one(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray, details: bool = False):
+        """The residual (2,) of transition *m*; with *details* also the sensitivities (module docstring)."""
         E = self.basis[m]
-        if not details:
+        if not details:  # the forward pass alone
+            _, rates, u_i, u_j = self._rates(m, Kg, theta, means)
+            rotation, end = np.empty((3, 3)), np.empty(3)
             rotate(rates, self.dt[m], u_i, rotation, end)
             return E.T @ (end - u_j)
-        sens = np.empty((rates.shape[0], 3, 3))
-        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
-        r = E.T @ (end - u_j)
+        r, M, rates, rotation, sens, u_i = self._integrated(m, Kg, theta, means)
         SM = sens @ M  # (n, 3, 3): ∂end/∂(gyro output at k)
         angle = float(np.linalg.norm(_log_rotation(rotation)))
         integral = np.sum(rates * np.asarray(self.dt[m], dtype=float)[:, None], axis=0)  # the turn, rad, body axes
@@ -460,13 +475,8 @@ class _Moves:
 
     def with_jacobian(self, m: int, Kg: np.ndarray, theta: np.ndarray, means: np.ndarray):
         """The residual (2,) of transition *m* and its Jacobian in Kg (2, 9), without the other details."""
-        corrected, u_i, u_j = self._inputs(m, theta, means)
-        M = np.linalg.inv(Kg)
-        rates = np.ascontiguousarray(corrected @ M.T)
-        rotation, end, sens = np.empty((3, 3)), np.empty(3), np.empty((rates.shape[0], 3, 3))
-        integrate_rotation(rates, self.dt[m], u_i, rotation, end, sens)
-        E = self.basis[m]
-        return E.T @ (end - u_j), self._kg_jacobian(E, M, sens, rates)
+        r, M, rates, _, sens, _ = self._integrated(m, Kg, theta, means)
+        return r, self._kg_jacobian(self.basis[m], M, sens, rates)
 
     def residuals(self, Kg, theta, means) -> np.ndarray:
         return np.concatenate([self.one(m, Kg, theta, means) for m in range(len(self.transitions))])
