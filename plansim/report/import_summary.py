@@ -78,9 +78,9 @@ def format_summary(result: ImportResult) -> str:
         rows = f"{table.lines[span.start]}-{table.lines[span.stop - 1]}"
         lines.append(f"  {k:3d}  {segment.test:8s}  {rows:>13s}  {span.samples / timing.sample_rate:7.2f} s  "
                      f"{segment.label}")
-    statics = [s for s in rec.schedule.segments if s.test == "static"]
-    on_table = sum(s.orientation == "known" for s in statics)
     if rec.schedule.import_notes.get("poses") == "table":
+        statics = [s for s in rec.schedule.segments if s.test == "static"]
+        on_table = sum(s.orientation == "known" for s in statics)
         lines.append(f"  poses: set by a table (--poses table): orientation = known for {on_table} of the "
                      f"{len(statics)} static poses and for the turns about the vertical, to the table's grade; "
                      "heading = nan (not logged)")
