@@ -205,13 +205,13 @@ def diagnose_seconds(rounds: int = 3, seed: int = 5) -> tuple[float, float]:
     effect it selects, s."""
     import dataclasses
 
-    from plansim.diagnose.procedure import diagnose
-    from plansim.fit import resolve_site, scenario_fit_options
+    from plansim.diagnose.procedure import diagnose, scenario_diagnose_options
+    from plansim.fit import resolve_site
     from plansim.io.scenario_file import load_scenario
     from plansim.runner import simulate_and_record
 
     scenario = load_scenario(SCENARIO)
-    site, options = resolve_site(scenario=scenario), scenario_fit_options(scenario)
+    site, options = resolve_site(scenario=scenario), scenario_diagnose_options(scenario)
     asymmetry = np.array(scenario.effects.gyro_asymmetry, dtype=float) + np.array([1e-3, 0.0, 0.0])
     with_effect = dataclasses.replace(scenario, effects=dataclasses.replace(scenario.effects,
                                                                             gyro_asymmetry=asymmetry))

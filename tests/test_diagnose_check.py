@@ -17,6 +17,7 @@ from plansim.checks.diagnose_check import (
 )
 from plansim.cli import main
 from plansim.io.scenario_file import load_scenario
+from plansim.simulate.arguments import bias_instability_sigma
 
 
 def test_seeds_depend_on_the_case_not_the_order():
@@ -119,8 +120,8 @@ def test_a_recording_whose_diagnosis_fails_is_listed_and_the_check_goes_on(tmp_p
 
 def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(monkeypatch):
     """--effects names only the check's cases; each recording is diagnosed with the options plansim diagnose
-    --scenario gives (plansim.fit.scenario_fit_options: the stated noise included), from the scenario as the lab
-    states it, never the injected one."""
+    --scenario gives (plansim.diagnose.procedure.scenario_diagnose_options: the stated noise included), from the
+    scenario as the lab states it, never the injected one."""
     from plansim.checks import diagnose_check
     from plansim.fit import scenario_fit_options
 
@@ -145,6 +146,10 @@ def test_the_effects_to_run_are_checked_and_the_fit_is_told_what_the_lab_knows(m
     got = seen[0]
     assert set(got) >= set(expected)
     assert np.array_equal(got["stated_white"], expected["stated_white"]) and got["turntable"] == expected["turntable"]
+    # and the slow noise the lab states (2 deg/h over 100 s), as plansim simulates it, to test the means against
+    stated = got["stated_slow"]
+    assert stated.correlation_time == 100.0
+    assert np.allclose(stated.bias_instability_sigma[:3], bias_instability_sigma(scenario.noise.gyro_bias_instability))
 
 
 @pytest.mark.slow

@@ -19,8 +19,8 @@ import sys
 import numpy as np
 
 from plansim import load_scenario, simulate_and_record
-from plansim.diagnose.procedure import diagnose
-from plansim.fit import resolve_site, scenario_fit_options
+from plansim.diagnose.procedure import diagnose, scenario_diagnose_options
+from plansim.fit import resolve_site
 from plansim.report.diagnose import diagnose_report
 
 
@@ -29,7 +29,7 @@ def main(asymmetry: float, seed: int) -> None:
     effects = dataclasses.replace(lab.effects, gyro_asymmetry=np.array([asymmetry, 0.0, 0.0]))
     unit = dataclasses.replace(lab, effects=effects)  # what the unit does
     recording = simulate_and_record(unit, seed=seed, trial=0)
-    result = diagnose(recording, resolve_site(scenario=lab), **scenario_fit_options(lab))
+    result = diagnose(recording, resolve_site(scenario=lab), **scenario_diagnose_options(lab))
     print(diagnose_report(result))
     print(f"\ninjected: gyro_scale_asymmetry x = {asymmetry:g}; named: {', '.join(result.selected) or 'nothing'}")
 

@@ -46,9 +46,9 @@ import numpy as np
 from scipy.stats import binom
 
 from plansim.config import parse_scenario
-from plansim.diagnose.procedure import diagnose
+from plansim.diagnose.procedure import diagnose, scenario_diagnose_options
 from plansim.diagnose.scores import noncentrality
-from plansim.fit import resolve_site, scenario_fit_options
+from plansim.fit import resolve_site
 from plansim.io.recording_data import segment_first_samples
 from plansim.io.scenario_file import apply_overrides
 from plansim.kernels.layout import ACQ_FULL_SCALE, ACQ_RANGE, ACQ_STEP
@@ -166,10 +166,11 @@ def _acquire(scenario, samples: np.ndarray) -> np.ndarray:
 
 def _run(scenario, recording, truth, alpha, null_draws, seed):
     """Diagnose *recording* as ``plansim diagnose REC --scenario`` would with the check's (un-injected) *scenario*:
-    its site and fit options (:func:`plansim.fit.scenario_fit_options`: turntable, reduction, known lever arms,
-    stated noise) — what the lab knows, never what was injected."""
+    its site and options (:func:`plansim.diagnose.procedure.scenario_diagnose_options`: turntable, reduction, known
+    lever arms, stated noise, the stated slow noise the segment means are tested against) — what the lab knows,
+    never what was injected."""
     d = diagnose(recording, resolve_site(scenario=scenario), alpha=alpha, null_draws=null_draws, seed=seed,
-                 **scenario_fit_options(scenario))
+                 **scenario_diagnose_options(scenario))
     z = {}
     for label, fit in (("before", d.before), ("after", d.after)):
         m = fit.joint

@@ -25,7 +25,7 @@ def _cmd_diagnose(args) -> int:
         check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
     if args.learned is not None:
         check_output_path(args.learned, "--learned", (".toml",))
-    recording, site, options = recording_and_fit_options(args)
+    recording, site, options = recording_and_fit_options(args, diagnosis=True)
     result = diagnose(recording, site, alpha=args.alpha, seed=args.seed, null_draws=args.null_draws, **options)
     with OutputSet() as outputs:
         if args.plot is not None:

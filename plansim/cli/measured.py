@@ -174,10 +174,12 @@ def _cmd_fit(args) -> int:
     return 0
 
 
-def recording_and_fit_options(args):
+def recording_and_fit_options(args, diagnosis: bool = False):
     """The recording, the site and the fit's options from a command's RECORDING, --latitude/--height and
     --scenario (its turntable grade, reduction, known lever arms and stated noise), as ``plansim fit`` and
+    (*diagnosis*: with the stated slow noise, :func:`plansim.diagnose.procedure.scenario_diagnose_options`)
     ``plansim diagnose`` take them."""
+    from plansim.diagnose.procedure import scenario_diagnose_options
     from plansim.fit import resolve_site, scenario_fit_options
     from plansim.io.recording import read_recording
     from plansim.io.scenario_file import load_scenario
@@ -185,7 +187,7 @@ def recording_and_fit_options(args):
     scenario = load_scenario(args.scenario) if args.scenario is not None else None
     recording = read_recording(args.recording)
     site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
-    return recording, site, scenario_fit_options(scenario)
+    return recording, site, (scenario_diagnose_options if diagnosis else scenario_fit_options)(scenario)
 
 
 def add_site_and_scenario_options(p) -> None:

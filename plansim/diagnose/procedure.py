@@ -11,19 +11,21 @@
    and within the segments at rest: trend, step, periodic component, burst of noise, a noisier segment, a transient
    from the start, against a null simulated from the recording's own noise
    (:func:`plansim.diagnose.within.within_segment_tests`); each at α/4 (:data:`SEGMENT_LEVEL_SHARE`,
-   :data:`WITHIN_SHARE`), so that "something is unexplained" keeps the level α/2.
+   :data:`WITHIN_SHARE`). Where the lab states its unit's noise (``stated_slow``), the segment means are also
+   tested against that statement (:mod:`plansim.diagnose.stated`), at α/20 (:data:`STATED_NOISE_SHARE`): the noise
+   the other tests weigh the residual against is estimated from the same recording, and takes up a slow effect.
 3. **Candidates** (:mod:`plansim.diagnose.catalogue`): identifiability first, then likelihood-ratio tests with the
-   family-wise error over the catalogue held at α/2 (:data:`SELECTION_SHARE`) by the simulated min-p null
+   family-wise error over the catalogue held at 0.45α (:data:`SELECTION_SHARE`) by the simulated min-p null
    (:func:`plansim.diagnose.scores.score_candidates`). The selections and the unexplained residual share α
    (Bonferroni over the two families): on a recording the base model describes, the probability that the
    diagnosis reports *anything* — a selection, a lack of fit or a within-segment finding — is ≤ α.
-4. **Closed testing** (Marcus, Peritz & Gabriel 1976): of the candidates whose adjusted p-value is below α/2, the
+4. **Closed testing** (Marcus, Peritz & Gabriel 1976): of the candidates whose adjusted p-value is below 0.45α, the
    one whose strongest single component explains the most of the whitened residual (its one-degree-of-freedom
    score, :mod:`plansim.diagnose.scores` "Attribution") is added to the model — its
    identifiable components as extra unknowns fitted jointly with θ
    (``fit_recording(extra=…)``) — and the remaining candidates are scored again against the new fit; the
    procedure stops when none is significant. Each step tests the intersection hypothesis of the candidates
-   still out with a min-p test at level α/2, so the family-wise error of the selections stays ≤ α/2 (the
+   still out with a min-p test at level 0.45α, so the family-wise error of the selections stays ≤ 0.45α (the
    step-down procedure of Westfall & Young 1993 is a shortcut of the closed test).
 5. **What remains**: the lack of fit of the final model (the omnibus and the largest step in one channel's level
    between segments adjacent in time) and the within-segment findings; if flagged, where (channels and segments,
@@ -54,6 +56,7 @@ from plansim.diagnose.scores import (
     score_candidates,
     undithered_channels,
 )
+from plansim.diagnose.stated import StatedNoiseTest, stated_noise_test
 from plansim.diagnose.within import within_segment_tests
 from plansim.fit import fit_recording, recording_noise_models
 from plansim.fit.noise import UNITS_SI, channel_kind
@@ -61,13 +64,16 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_NAMES, PARAMETERS
 
 #: Shares of ``alpha``, the false-alarm rate of the whole diagnosis (Bonferroni: they sum to 1). The selections (the
-#: closed test over the catalogue) get half; "something is unexplained" gets the other half, split between the
-#: segment-level lack of fit and the within-segment tests. Before the split each family held α by itself and the
-#: union did not: 18 of 200 jjf2003 null recordings reported something at α = 0.05 (selections 10 of 200) —
-#: docs/closing-the-loop.md, "Figures".
-SELECTION_SHARE = 0.5
+#: closed test over the catalogue) get 0.45 (half until 2026-12-01); "something is unexplained" gets the rest,
+#: split between the segment-level lack of fit, the within-segment tests and the test against the stated noise.
+#: Before the split each family held α by itself and the union did not: 18 of 200 jjf2003 null recordings reported
+#: something at α = 0.05 (selections 10 of 200) — docs/closing-the-loop.md, "Figures".
+SELECTION_SHARE = 0.45
 SEGMENT_LEVEL_SHARE = 0.25
 WITHIN_SHARE = 0.25
+#: the segment means against the noise the lab states for its unit (:mod:`plansim.diagnose.stated`; only with a
+#: stated noise, ``plansim diagnose --scenario``): a twentieth of α, taken from the selections' half
+STATED_NOISE_SHARE = 0.05
 
 #: |z| of a segment's residual (in units of its predicted sd) above which it is listed as where a residual sits
 WHERE_Z = 3.0
@@ -101,6 +107,10 @@ class Diagnosis:
     #: in every repetition of the recording, so the tests on them hold their level over a population of units,
     #: not over the noise (docs/closing-the-loop.md, "Undithered channels")
     undithered: tuple[str, ...] = ()
+    #: the base and the final model's segment means against the slow noise the lab states for its unit
+    #: (:mod:`plansim.diagnose.stated`); None without a statement (``stated_slow``)
+    stated_noise: StatedNoiseTest | None = None
+    stated_noise_after: StatedNoiseTest | None = None
 
 
 def _rms_per_channel(fit) -> dict:
@@ -355,7 +365,8 @@ def _adds_rank(fit, columns: list, column: np.ndarray) -> bool:
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed: int = 0,
              null_draws: int = NULL_DRAWS, lever_arm=None, reference_gravity=None, omega_squared_sign: str = "model",
-             turntable_source: str = "", stated_white=None, stated_step=None, held=None) -> Diagnosis:
+             turntable_source: str = "", stated_white=None, stated_step=None, held=None,
+             stated_slow=None) -> Diagnosis:
     """Diagnose a recording (module docstring).
 
     Parameters
@@ -363,6 +374,10 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     recording : plansim.io.recording.Recording
     site, turntable, lever_arm, reference_gravity, omega_squared_sign, turntable_source, stated_white, stated_step, held
         As :func:`plansim.fit.fit_recording`.
+    stated_slow : plansim.fit.noise.StatedSlowNoise, optional
+        The slow noise the lab states for its unit (:func:`plansim.fit.noise.stated_slow_noise` of its scenario):
+        the segment means are tested against it too (:mod:`plansim.diagnose.stated`), at
+        ``STATED_NOISE_SHARE * alpha``. Without it, that test is not run and its share of α is unused.
     alpha : float
         False-alarm rate of the whole diagnosis (0 < alpha < 1): on a recording the base model describes, the
         probability of reporting anything. The selections run at ``SELECTION_SHARE * alpha``, the segment-level and
@@ -500,6 +515,14 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     lof_after_fit = fit_recording(recording, **lof_options, extra=extra) if selected else lof_before
     lof_null, local_null = coupled_null_residuals((lof_after_fit, after), null_draws, seed + 1000)
     lof_after = lack_of_fit(lof_after_fit, alpha=a_segment, null=lof_null, local=(after, local_null))
+    durations = np.array([segments[k].samples / segments[k].sample_rate for k in before.used], dtype=float)
+    stated_before = stated_after = None
+    if stated_slow is not None:
+        excluded = undithered_channels(before)
+        stated_before = stated_noise_test(lof_before, stated_slow, durations, alpha=level["stated_noise"],
+                                          excluded=excluded)
+        stated_after = stated_before if not selected else stated_noise_test(
+            lof_after_fit, stated_slow, durations, alpha=level["stated_noise"], excluded=excluded)
     sizes = {}
     if after.extra is not None:
         for effect in selected:
@@ -518,7 +541,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     step = pattern[2] if pattern[1] == "step" else None
     change = pattern[2] if pattern[1] == "change" else None
     outlier = pattern[2] if pattern[1] == "outlier" else None
-    unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged),
+    stated_flagged = stated_after is not None and stated_after.flagged
+    unexplained = {"flagged": bool(lof_after.flagged or within.any_flagged or stated_flagged),
                    "where": _where(lof_after_fit, lof_after) if lof_after.flagged else [],
                    "step": None if step is None else {**step, "unit": UNITS_SI[channel_kind(
                        CHANNELS.index(step["channel"]))]["mean"]},
@@ -527,14 +551,30 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                    "outlier": None if outlier is None else {**outlier, "unit": UNITS_SI[channel_kind(
                        CHANNELS.index(outlier["channel"]))]["mean"]},
                    "within_segments": [dict(item) for item in within.flagged],
-                   "excess_scatter": _excess_scatter(after)}
+                   "excess_scatter": _excess_scatter(after),
+                   "stated_noise": stated_after.flagged_channels() if stated_flagged else []}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
     return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=within,
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,
                      holdout=hold, steps=tuple(steps),
                      information={"before": _information(before), "after": _information(after)}, alpha=alpha,
                      attribution=tuple(attribution), not_named=tuple(not_named),
-                     undithered=tuple(CHANNELS[c] for c in sorted(undithered_channels(before))))
+                     undithered=tuple(CHANNELS[c] for c in sorted(undithered_channels(before))),
+                     stated_noise=stated_before, stated_noise_after=stated_after)
+
+
+def scenario_diagnose_options(scenario) -> dict:
+    """The diagnosis's options a lab's scenario gives (:func:`diagnose` keywords): the fit's
+    (:func:`plansim.fit.scenario_fit_options`) and the slow noise it states for the unit (``stated_slow``,
+    :func:`plansim.fit.noise.stated_slow_noise`), against which the segment means are tested
+    (:mod:`plansim.diagnose.stated`). *scenario* None gives none."""
+    from plansim.fit import scenario_fit_options
+    from plansim.fit.noise import stated_slow_noise
+
+    options = scenario_fit_options(scenario)
+    if scenario is not None:
+        options["stated_slow"] = stated_slow_noise(scenario)
+    return options
 
 
 def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict | None:
@@ -569,7 +609,7 @@ def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict
 def levels(alpha: float) -> dict:
     """The level each family of tests runs at, for a diagnosis at false-alarm rate ``alpha`` (the shares above)."""
     return {"selections": alpha * SELECTION_SHARE, "lack_of_fit": alpha * SEGMENT_LEVEL_SHARE,
-            "within_segment": alpha * WITHIN_SHARE}
+            "within_segment": alpha * WITHIN_SHARE, "stated_noise": alpha * STATED_NOISE_SHARE}
 
 
 def _number(value):
@@ -629,6 +669,8 @@ def diagnosis_json(d: Diagnosis) -> dict:
             "not_named": [{k: (_number(v) if isinstance(v, float) else v) for k, v in item.items() if k != "where"}
                           for item in d.not_named],
             "undithered_channels": list(d.undithered),
+            "stated_noise": None if d.stated_noise is None else d.stated_noise.as_json(),
+            "stated_noise_after": None if d.stated_noise_after is None else d.stated_noise_after.as_json(),
             "within_segment": {"alpha": d.within.alpha, "draws": d.within.draws,
                                "segments_tested": len(d.within.segments),
                                "smallest_adjusted_p_value": d.within.smallest_adjusted_p(),

@@ -800,6 +800,85 @@ def stated_white_noise(scenario) -> np.ndarray:
     return np.where(stated > 0, stated, np.nan)
 
 
+def allan_slow_variance(channel: ChannelNoise, duration: float) -> float:
+    """The variance that a channel's slow noise, as its Allan fit gives it, adds to the mean of a segment of
+    *duration* s: (2 ln 2/π)·B² + K²·T/3 (the bias-instability floor and the rate random walk over the segment;
+    IEEE Std 952-1997 Annex C); 0 where the channel's noise was not estimated."""
+    if math.isnan(channel.white):
+        return 0.0
+    return float(np.nan_to_num(FLICKER_VARIANCE * channel.bias_instability**2
+                               + channel.rate_random_walk**2 * duration / 3.0))
+
+
+@dataclass(frozen=True)
+class StatedSlowNoise:
+    """The slow noise a lab states for its unit (a scenario's ``[mimu.noise]``), per channel gx gy gz ax ay az, SI,
+    as plansim simulates it: a first-order Gauss–Markov bias instability (stationary σ from the stated B,
+    :func:`plansim.simulate.arguments.bias_instability_sigma`, correlation time ``correlation_time``), a
+    Gauss–Markov drift (σ, ``markov_correlation_time``) and a rate random walk K from the recording's start."""
+
+    bias_instability_sigma: np.ndarray  # (6,) rad/s, m/s²
+    correlation_time: float  # s
+    markov_sigma: np.ndarray  # (6,) rad/s, m/s²
+    markov_correlation_time: float  # s
+    rate_random_walk: np.ndarray  # (6,) rad/s/√s, m/s²/√s
+    source: str = ""
+
+    def mean_covariance(self, c: int, times: np.ndarray, durations: np.ndarray) -> np.ndarray:
+        """(S, S) covariance of channel *c*'s stated slow noise averaged over segments of *durations* (s) centred at
+        *times* (s from the recording's start; segments that do not overlap). A Gauss–Markov process of σ, τ averaged
+        over T: variance σ²·2(τ/T)²(T/τ − 1 + e^{−T/τ}), and between two segments σ²·e^{−|Δt|/τ}·g(T_s)·g(T_r),
+        g(T) = sinh(T/2τ)/(T/2τ); a random walk K·W(t): K²·(t_s − T_s/2 + T_s/3) on the diagonal and K² times the
+        earlier segment's middle time off it."""
+        t = np.asarray(times, dtype=float)
+        T = np.maximum(np.asarray(durations, dtype=float), 1e-12)
+        out = np.zeros((t.size, t.size))
+        for sigma, tau in ((self.bias_instability_sigma[c], self.correlation_time),
+                           (self.markov_sigma[c], self.markov_correlation_time)):
+            if not sigma > 0 or not tau > 0:
+                continue
+            x = T / tau
+            g = np.where(x > 1e-6, np.sinh(0.5 * x) / np.maximum(0.5 * x, 1e-300), 1.0)
+            block = np.exp(-np.abs(t[:, None] - t[None, :]) / tau) * np.outer(g, g)
+            np.fill_diagonal(block, np.where(x > 1e-6, 2.0 * (x - 1.0 + np.exp(-x)) / np.maximum(x, 1e-300) ** 2,
+                                             1.0))
+            out += sigma**2 * block
+        K = self.rate_random_walk[c]
+        if K > 0:
+            earlier = np.minimum(t[:, None], t[None, :])
+            out += K**2 * earlier
+            out[np.diag_indices(t.size)] += K**2 * (-T / 2.0 + T / 3.0)
+        return out
+
+    def describe(self, c: int) -> str:
+        """The statement for channel *c* in words (deg/h or µg; the random walk in SI)."""
+        from plansim.units import to_unit
+
+        kind, unit = ("angular_rate", "deg/h") if channel_kind(c) == "gyro" else ("acceleration", "ug")
+        parts = [f"{what} σ {float(to_unit(sigma, kind, unit)):.3g} {unit} over {tau:g} s"
+                 for what, sigma, tau in (("bias instability", self.bias_instability_sigma[c], self.correlation_time),
+                                          ("drift", self.markov_sigma[c], self.markov_correlation_time)) if sigma > 0]
+        if self.rate_random_walk[c] > 0:
+            parts.append(f"random walk {self.rate_random_walk[c]:.3g} {UNITS_SI[channel_kind(c)]['rate_random_walk']}")
+        return ", ".join(parts) if parts else "no slow noise"
+
+
+def stated_slow_noise(scenario) -> StatedSlowNoise:
+    """The slow noise *scenario* states for its unit (:class:`StatedSlowNoise`; zeros where it states none)."""
+    from plansim.simulate.arguments import bias_instability_sigma
+
+    n = scenario.noise
+
+    def both(gyro, accel) -> np.ndarray:
+        return np.concatenate([np.broadcast_to(gyro, 3), np.broadcast_to(accel, 3)]).astype(float)
+
+    return StatedSlowNoise(bias_instability_sigma(both(n.gyro_bias_instability, n.accel_bias_instability)),
+                           float(n.bias_instability_correlation_time),
+                           both(n.gyro_markov_sigma, n.accel_markov_sigma), float(n.markov_correlation_time),
+                           both(n.gyro_rate_random_walk, n.accel_acceleration_random_walk),
+                           source=f"scenario {scenario.name!r}, [mimu.noise]")
+
+
 #: a static segment whose scatter exceeds the others' at this upper-tail probability (F test, forward search) is
 #: "noisier than the others": a pose held by hand, a knock; its mean takes its own scatter (:func:`estimate_noise`)
 NOISIER_PROBABILITY = 1e-3
@@ -1073,7 +1152,7 @@ def _mean_variance(shared: _Shared, conditional: bool) -> NoiseEstimate:
                     white, white_dof = own, max(within_dof[k], 1)
                 if shaken[k, c]:  # a pose that shook: its own scatter, of which the white model knows nothing
                     white, white_dof = max(own, white), max(within_dof[k], 1)
-                slow = FLICKER_VARIANCE * ch.bias_instability**2 + ch.rate_random_walk**2 * duration / 3.0
+                slow = allan_slow_variance(ch, duration)
             own_quantisation = 0.0
             if ch.quantisation_step > 0:
                 if (s.is_rotating and (not s.rate_known or channel_kind(c) == "gyro")) or sigma_before[c] is None \

@@ -58,6 +58,25 @@ def _within_lines(d) -> list[str]:
     return lines
 
 
+def _stated_lines(d) -> list[str]:
+    """The final model's segment means against the slow noise the lab states (plansim.diagnose.stated)."""
+    test = d.stated_noise_after
+    if test is None:
+        return []
+    head = (f"the slow noise stated in {test.source}, up to {test.margin:g} times in s.d.; level {test.level:g}, "
+            f"Bonferroni over {len(test.channels)} channel(s)")
+    if not test.flagged:
+        return [f"The segment means are within the noise the lab states ({head}; p = {_p(test.p_value)})."]
+    lines = [f"SCATTER BEYOND THE STATED NOISE ({head}; p = {_p(test.p_value)}): an effect the model lacks, or a "
+             "unit noisier than stated; the lack-of-fit tests above weigh the residual against noise estimated from "
+             "this recording, which takes both up"]
+    for item in test.flagged_channels():
+        lines.append(f"  {item['channel']}: its segment means scatter {item['sd_ratio']:.3g} times (s.d.) what the "
+                     f"statement allows (chi2 {item['statistic']:.4g} on {item['dof']} dof, p = {_p(item['p_value'])}; "
+                     f"stated: {item['stated']})")
+    return lines
+
+
 def diagnose_report(d) -> str:
     """The whole report of a :class:`plansim.diagnose.procedure.Diagnosis` as text."""
     lines = ["plansim diagnose — closing the loop (docs/closing-the-loop.md)", ""]
@@ -150,6 +169,7 @@ def diagnose_report(d) -> str:
                      "than its grade" + ("; a turn by hand whose angle in the segment table is not what the hand "
                                          "turned: the fit takes it as exact" if d.before.hand_axes else "")
                      + ") or noise the segments cannot show")
+    lines += _stated_lines(d)
     lines += _within_lines(d)
     if d.undithered:
         lines.append(f"Note: the segment means of {', '.join(d.undithered)} are mostly a quantiser's error that the "
