@@ -38,7 +38,7 @@ def test_a_small_null_run_and_its_report(tmp_path, capsys):
     assert "binomial_99_upper_count" in data["null"]
     # which family fired: a recording that raised an alarm fired at least one, one that did not fired none
     fired = data["null"]["by_family"]
-    assert set(fired) == {"selection", "lack_of_fit", "unexplained_segment_level", "within_segment"}
+    assert set(fired) == {"selection", "lack_of_fit", "unexplained_segment_level", "within_segment", "stated_noise"}
     assert (sum(fired.values()) > 0) == (data["null"]["false_alarms"] > 0)
     assert sum(data["null"]["falsely_selected"].values()) >= fired["selection"]
     # the parameters' errors per group of eq. (1)/(2), pooled: on one recording whose 39 parameters all have a u,

@@ -130,17 +130,20 @@ def _attempt(report: CheckReport, case: str, index: int, scenario, recording, tr
 
 def _alarm(d) -> bool:
     """The diagnosis says something is there: an effect selected, the base model's lack of fit, or anything
-    unexplained after the refit (segment level or within segments): any of :func:`_families`."""
+    unexplained after the refit (segment level, within segments, beyond the stated noise): any of
+    :func:`_families`."""
     return any(_families(d).values())
 
 
 def _families(d) -> dict[str, bool]:
     """Which family of tests fired on a diagnosis (a recording can fire several): a selection, the base model's
-    segment-level lack of fit, the final model's, a within-segment finding — so that a false-alarm rate above α
-    says which share of α (plansim.diagnose.procedure.SELECTION_SHARE …) runs hot."""
+    segment-level lack of fit, the final model's, a within-segment finding, the final model's means beyond the
+    stated noise — so that a false-alarm rate above α says which share of α
+    (plansim.diagnose.procedure.SELECTION_SHARE …) runs hot."""
     return {"selection": bool(d.selected), "lack_of_fit": bool(d.lack_of_fit.flagged),
             "unexplained_segment_level": bool(d.lack_of_fit_after.flagged),
-            "within_segment": bool(d.within.any_flagged)}
+            "within_segment": bool(d.within.any_flagged),
+            "stated_noise": bool(d.stated_noise_after is not None and d.stated_noise_after.flagged)}
 
 
 def _without_quantiser(scenario):
@@ -243,7 +246,8 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
 
     # the null
     alarms, selections, z_before, each_before = 0, 0, [], []
-    by_family = {"selection": 0, "lack_of_fit": 0, "unexplained_segment_level": 0, "within_segment": 0}
+    by_family = {"selection": 0, "lack_of_fit": 0, "unexplained_segment_level": 0, "within_segment": 0,
+                 "stated_noise": 0}
     falsely_selected: dict[str, int] = {}
     reference = None
     ran = 0
