@@ -236,6 +236,19 @@ def _excess_scatter(fit) -> list[dict]:
     return out
 
 
+def _partial_matches(extra: dict, stated: StatedNoiseTest) -> list[dict]:
+    """The selected effects whose columns act on a channel that still scatters beyond the stated noise after the
+    refit: the name may fit only part of what is there (an effect outside the catalogue whose signature shares a
+    part with the named one). Each ``{effect, channels}``, in the order of selection."""
+    flagged = {CHANNELS.index(item["channel"]) for item in stated.flagged_channels()}
+    out: dict[str, set] = {}
+    for name, column in extra.items():
+        touched = flagged & {c for c in range(6) if np.any(np.asarray(column)[:, c])}
+        if touched:
+            out.setdefault(name.split("[")[0], set()).update(touched)
+    return [{"effect": effect, "channels": [CHANNELS[c] for c in sorted(channels)]} for effect, channels in out.items()]
+
+
 def _where(fit, lof: LackOfFit) -> list[dict]:
     """Where a remaining residual sits: the channels whose own lack of fit is significant (p below
     :data:`WHERE_LEVEL` over the number of channels tested, Bonferroni: at 0.05 each, one of five channels the
@@ -552,7 +565,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                        CHANNELS.index(outlier["channel"]))]["mean"]},
                    "within_segments": [dict(item) for item in within.flagged],
                    "excess_scatter": _excess_scatter(after),
-                   "stated_noise": stated_after.flagged_channels() if stated_flagged else []}
+                   "stated_noise": stated_after.flagged_channels() if stated_flagged else [],
+                   "partial_match": _partial_matches(extra, stated_after) if stated_flagged else []}
     hold = {"before": holdout(before), "after": holdout(after) if selected else holdout(before)}
     return Diagnosis(before=before, after=after, lack_of_fit=lof, lack_of_fit_after=lof_after, within=within,
                      candidates=first, selected=tuple(selected), sizes=sizes, unexplained=unexplained,

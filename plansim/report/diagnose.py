@@ -74,6 +74,10 @@ def _stated_lines(d) -> list[str]:
         lines.append(f"  {item['channel']}: its segment means scatter {item['sd_ratio']:.3g} times (s.d.) what the "
                      f"statement allows (chi2 {item['statistic']:.4g} on {item['dof']} dof, p = {_p(item['p_value'])}; "
                      f"stated: {item['stated']})")
+    for item in d.unexplained.get("partial_match", []):
+        lines.append(f"  {item['effect']}, named above, acts on {', '.join(item['channels'])} and leaves it beyond the "
+                     "stated noise: the name may fit only part of what is there (an effect outside the catalogue "
+                     "that shares part of its signature)")
     return lines
 
 
