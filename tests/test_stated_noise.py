@@ -105,6 +105,7 @@ def test_a_slow_disturbance_the_recordings_own_noise_takes_up_is_beyond_the_stat
     assert d.unexplained["flagged"] and d.unexplained["stated_noise"][0]["channel"] == "gx"
     report = diagnose_report(d)
     assert "SCATTER BEYOND THE STATED NOISE" in report and "gx: its segment means scatter" in report
+    assert "Nothing unexplained remains" not in report
     out = diagnosis_json(d)
     assert out["stated_noise_after"]["flagged"] and out["levels"]["stated_noise"] == pytest.approx(0.0025)
     quiet = diagnose(null, site, null_draws=200, seed=22, **options).stated_noise_after

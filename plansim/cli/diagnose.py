@@ -66,7 +66,8 @@ def add_commands(sub) -> None:
         description="Fit a recording, test its residual for the effects of a catalogue (identifiability first; "
                     "likelihood-ratio tests with the family-wise false-alarm rate held at alpha by a null simulated "
                     "from the fitted model), add the significant ones by closed testing, and report what remains and "
-                    "the error before and after (docs/closing-the-loop.md)")
+                    "the error before and after (docs/closing-the-loop.md). With --scenario, the segment means are "
+                    "also tested against the slow noise it states for the unit")
     p.add_argument("recording", help="recording file (.nc, or the samples .csv beside its .segments.csv)")
     add_site_and_scenario_options(p)
     p.add_argument("--alpha", type=float, default=0.05, help="family-wise false-alarm rate (default 0.05)")

@@ -149,6 +149,9 @@ def diagnose_report(d) -> str:
     elif excess:
         lines.append(f"No lack of fit is flagged at segment level (p = {_p(after.p_value)}), but the tests cannot "
                      "see a slow effect here:")
+    elif d.stated_noise_after is not None and d.stated_noise_after.flagged:
+        lines.append(f"The lack of fit, weighed against the noise estimated from this recording, flags nothing at "
+                     f"segment level (p = {_p(after.p_value)}); against the stated noise:")
     else:
         lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
     for item in excess:
