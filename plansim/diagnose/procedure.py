@@ -28,7 +28,9 @@
    still out with a min-p test at level 0.45α, so the family-wise error of the selections stays ≤ 0.45α (the
    step-down procedure of Westfall & Young 1993 is a shortcut of the closed test).
 5. **What remains**: the lack of fit of the final model (the omnibus and the largest step in one channel's level
-   between segments adjacent in time) and the within-segment findings; if flagged, where (channels and segments,
+   between segments adjacent in time), its segment means against the stated noise (the channels beyond it, and a
+   selected effect that acts on one of them: a possible partial match) and the within-segment findings; if
+   flagged, where (channels and segments,
    or the step's channel, place and size) and the pattern (a trend's slope, a step's time and size, a periodic
    component's frequency and amplitude, a burst's stretch), never named after a candidate.
 6. **Before and after**: residual r.m.s. per channel and χ²/dof, every parameter before and after with u, which
