@@ -143,7 +143,7 @@ def _families(d) -> dict[str, bool]:
     return {"selection": bool(d.selected), "lack_of_fit": bool(d.lack_of_fit.flagged),
             "unexplained_segment_level": bool(d.lack_of_fit_after.flagged),
             "within_segment": bool(d.within.any_flagged),
-            "stated_noise": bool(d.stated_noise_after is not None and d.stated_noise_after.flagged)}
+            "stated_noise": bool(d.unexplained["stated_noise"])}
 
 
 def _without_quantiser(scenario):

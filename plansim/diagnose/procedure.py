@@ -530,14 +530,14 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     lof_after_fit = fit_recording(recording, **lof_options, extra=extra) if selected else lof_before
     lof_null, local_null = coupled_null_residuals((lof_after_fit, after), null_draws, seed + 1000)
     lof_after = lack_of_fit(lof_after_fit, alpha=a_segment, null=lof_null, local=(after, local_null))
-    durations = np.array([segments[k].samples / segments[k].sample_rate for k in before.used], dtype=float)
+    undithered = undithered_channels(before)
     stated_before = stated_after = None
     if stated_slow is not None:
-        excluded = undithered_channels(before)
+        durations = [segments[k].samples / segments[k].sample_rate for k in before.used]
         stated_before = stated_noise_test(lof_before, stated_slow, durations, alpha=level["stated_noise"],
-                                          excluded=excluded)
+                                          excluded=undithered)
         stated_after = stated_before if not selected else stated_noise_test(
-            lof_after_fit, stated_slow, durations, alpha=level["stated_noise"], excluded=excluded)
+            lof_after_fit, stated_slow, durations, alpha=level["stated_noise"], excluded=undithered)
     sizes = {}
     if after.extra is not None:
         for effect in selected:
@@ -575,7 +575,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
                      holdout=hold, steps=tuple(steps),
                      information={"before": _information(before), "after": _information(after)}, alpha=alpha,
                      attribution=tuple(attribution), not_named=tuple(not_named),
-                     undithered=tuple(CHANNELS[c] for c in sorted(undithered_channels(before))),
+                     undithered=tuple(CHANNELS[c] for c in sorted(undithered)),
                      stated_noise=stated_before, stated_noise_after=stated_after)
 
 

@@ -124,7 +124,8 @@ def stated_noise_test(fit, stated: StatedSlowNoise, durations, *, alpha: float, 
         if c in excluded or np.count_nonzero(rows[:, c]) < 2:
             continue
         idx = np.flatnonzero(rows[:, c]) * 6 + c
-        values, vectors = np.linalg.eigh(0.5 * (C0[np.ix_(idx, idx)] + C0[np.ix_(idx, idx)].T))
+        block = C0[np.ix_(idx, idx)]
+        values, vectors = np.linalg.eigh(0.5 * (block + block.T))
         keep = values > 1e-9 * max(values.max(), 1e-300)
         if not np.any(keep):
             continue

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from plansim.kernels.layout import CHANNELS
+from plansim.units import to_unit
 
 #: flicker floor of the Allan variance per unit B²: σ_A² = (2 ln 2/π)·B² (IEEE Std 952, C.1)
 FLICKER_VARIANCE = 2.0 * math.log(2.0) / math.pi
@@ -852,8 +853,6 @@ class StatedSlowNoise:
 
     def describe(self, c: int) -> str:
         """The statement for channel *c* in words (deg/h or µg; the random walk in SI)."""
-        from plansim.units import to_unit
-
         kind, unit = ("angular_rate", "deg/h") if channel_kind(c) == "gyro" else ("acceleration", "ug")
         parts = [f"{what} σ {float(to_unit(sigma, kind, unit)):.3g} {unit} over {tau:g} s"
                  for what, sigma, tau in (("bias instability", self.bias_instability_sigma[c], self.correlation_time),

@@ -149,7 +149,7 @@ def diagnose_report(d) -> str:
     elif excess:
         lines.append(f"No lack of fit is flagged at segment level (p = {_p(after.p_value)}), but the tests cannot "
                      "see a slow effect here:")
-    elif d.stated_noise_after is not None and d.stated_noise_after.flagged:
+    elif d.unexplained.get("stated_noise"):
         lines.append(f"The lack of fit, weighed against the noise estimated from this recording, flags nothing at "
                      f"segment level (p = {_p(after.p_value)}); against the stated noise:")
     else:
