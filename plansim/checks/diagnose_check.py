@@ -135,15 +135,18 @@ def _alarm(d) -> bool:
     return any(_families(d).values())
 
 
+#: the families of tests a diagnosis reports on (:func:`_families`), in the order the null's ``by_family`` lists them
+FAMILIES = ("selection", "lack_of_fit", "unexplained_segment_level", "within_segment", "stated_noise")
+
+
 def _families(d) -> dict[str, bool]:
     """Which family of tests fired on a diagnosis (a recording can fire several): a selection, the base model's
     segment-level lack of fit, the final model's, a within-segment finding, the final model's means beyond the
     stated noise — so that a false-alarm rate above α says which share of α
     (plansim.diagnose.procedure.SELECTION_SHARE …) runs hot."""
-    return {"selection": bool(d.selected), "lack_of_fit": bool(d.lack_of_fit.flagged),
-            "unexplained_segment_level": bool(d.lack_of_fit_after.flagged),
-            "within_segment": bool(d.within.any_flagged),
-            "stated_noise": bool(d.unexplained["stated_noise"])}
+    fired = (bool(d.selected), bool(d.lack_of_fit.flagged), bool(d.lack_of_fit_after.flagged),
+             bool(d.within.any_flagged), bool(d.unexplained["stated_noise"]))
+    return dict(zip(FAMILIES, fired, strict=True))
 
 
 def _without_quantiser(scenario):
@@ -246,8 +249,7 @@ def run_diagnose_check(scenario, *, null: int = 100, per_effect: int = 10, sizes
 
     # the null
     alarms, selections, z_before, each_before = 0, 0, [], []
-    by_family = {"selection": 0, "lack_of_fit": 0, "unexplained_segment_level": 0, "within_segment": 0,
-                 "stated_noise": 0}
+    by_family = dict.fromkeys(FAMILIES, 0)
     falsely_selected: dict[str, int] = {}
     reference = None
     ran = 0

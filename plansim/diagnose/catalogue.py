@@ -48,6 +48,19 @@ EFFECTS = ("gyro_scale_asymmetry", "gyro_scale_nonlinearity", "gyro_g2_sensitivi
 AXES = "xyz"
 
 
+def column_name(effect: str, component: str) -> str:
+    """The name of one component's column in a refit's extra parameters: ``effect[component]``."""
+    return f"{effect}[{component}]"
+
+
+def split_column_name(name: str) -> tuple[str, str]:
+    """(effect, component) of a column named by :func:`column_name`."""
+    effect, bracket, rest = name.partition("[")
+    if not bracket or not rest.endswith("]"):
+        raise ValueError(f"name = {name!r}: a candidate column is named 'effect[component]'")
+    return effect, rest[:-1]
+
+
 @dataclass(frozen=True)
 class Signature:
     """One candidate effect's signature in the segment means of a fit."""

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from plansim.diagnose.catalogue import signatures
+from plansim.diagnose.catalogue import column_name, signatures, split_column_name
 from plansim.diagnose.scores import (
     NULL_DRAWS,
     CandidateScore,
@@ -247,7 +247,7 @@ def _partial_matches(extra: dict, stated: StatedNoiseTest) -> list[dict]:
     for name, column in extra.items():
         touched = flagged & {c for c in range(6) if np.any(np.asarray(column)[:, c])}
         if touched:
-            out.setdefault(name.split("[")[0], set()).update(touched)
+            out.setdefault(split_column_name(name)[0], set()).update(touched)
     return [{"effect": effect, "channels": [CHANNELS[c] for c in sorted(channels)]} for effect, channels in out.items()]
 
 
@@ -499,7 +499,7 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         best_extra = dict(extra)
         for j, component in enumerate(signature.components):
             if best.usable[j] and _adds_rank(current, list(best_extra.values()), signature.columns[:, :, j]):
-                best_extra[f"{best.effect}[{component}]"] = signature.columns[:, :, j]
+                best_extra[column_name(best.effect, component)] = signature.columns[:, :, j]
         best_fit = fit_recording(recording, **options, extra=best_extra)
         extra = best_extra
         selected.append(best.effect)
@@ -508,8 +508,8 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         # solution and refit (a Gauss–Newton step on the product of the effect and θ), twice
         for _ in range(2):
             now = {s.effect: s for s in signatures(current)}
-            extra = {name: now[name.split("[")[0]].columns[:, :, now[name.split("[")[0]].components.index(
-                name.split("[")[1][:-1])] for name in extra}
+            extra = {name: now[effect].columns[:, :, now[effect].components.index(component)]
+                     for name, (effect, component) in ((n, split_column_name(n)) for n in extra)}
             current = fit_recording(recording, **options, extra=extra)
         # the model with the effect is the next step's null hypothesis: its between-segment noise is estimated
         # anew under it (held from the base model, it would keep the variance the effect itself had put there,
@@ -541,10 +541,9 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
     sizes = {}
     if after.extra is not None:
         for effect in selected:
-            names = [n for n in after.extra_names if n.startswith(effect + "[")]
-            idx = [after.extra_names.index(n) for n in names]
+            idx = [i for i, n in enumerate(after.extra_names) if split_column_name(n)[0] == effect]
             unit = by_effect[effect].unit
-            sizes[effect] = {"components": [n[len(effect) + 1:-1] for n in names],
+            sizes[effect] = {"components": [split_column_name(after.extra_names[i])[1] for i in idx],
                              "value": [float(after.extra.estimate[i]) for i in idx],
                              "u": [float(after.extra.u[i]) for i in idx], "unit": unit}
     # where it sits: the step, the change of a parameter or the odd segment, whichever has the smallest p, when it is
