@@ -6,13 +6,13 @@ import json
 import os
 
 from plansim.cli.common import COMMANDS
-from plansim.cli.measured import add_site_and_scenario_options, recording_and_fit_options
+from plansim.cli.measured import add_site_and_scenario_options, recording_site_and_scenario
 from plansim.io.files import OutputSet, check_output_path
 from plansim.report.plot import FIGURE_SUFFIXES
 
 
 def _cmd_diagnose(args) -> int:
-    from plansim.diagnose.procedure import diagnose, diagnosis_json
+    from plansim.diagnose.procedure import diagnose, diagnosis_json, scenario_diagnose_options
     from plansim.report.diagnose import diagnose_report
 
     if not 0 < args.alpha < 1:
@@ -25,7 +25,8 @@ def _cmd_diagnose(args) -> int:
         check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
     if args.learned is not None:
         check_output_path(args.learned, "--learned", (".toml",))
-    recording, site, options = recording_and_fit_options(args, diagnosis=True)
+    recording, site, scenario = recording_site_and_scenario(args)
+    options = scenario_diagnose_options(scenario)
     result = diagnose(recording, site, alpha=args.alpha, seed=args.seed, null_draws=args.null_draws, **options)
     with OutputSet() as outputs:
         if args.plot is not None:

@@ -141,7 +141,7 @@ def _search_progress():
 
 
 def _cmd_fit(args) -> int:
-    from plansim.fit import fit_recording
+    from plansim.fit import fit_recording, scenario_fit_options
     from plansim.fit.result import fit_dataset, fit_json
     from plansim.report.fit import fit_report
     from plansim.report.progress import end_progress_line
@@ -150,7 +150,8 @@ def _cmd_fit(args) -> int:
         check_output_path(args.out, "--out", (".nc",))
     if args.plot is not None:
         check_output_path(args.plot, "--plot", FIGURE_SUFFIXES)
-    recording, site, options = recording_and_fit_options(args)
+    recording, site, scenario = recording_site_and_scenario(args)
+    options = scenario_fit_options(scenario)
     progress = None if (args.json or args.quiet) else _search_progress()
     result = fit_recording(recording, site, progress=progress, **options)
     end_progress_line()
@@ -174,20 +175,18 @@ def _cmd_fit(args) -> int:
     return 0
 
 
-def recording_and_fit_options(args, diagnosis: bool = False):
-    """The recording, the site and the fit's options from a command's RECORDING, --latitude/--height and
-    --scenario (its turntable grade, reduction, known lever arms and stated noise), as ``plansim fit`` and
-    (*diagnosis*: with the stated slow noise, :func:`plansim.diagnose.procedure.scenario_diagnose_options`)
-    ``plansim diagnose`` take them."""
-    from plansim.diagnose.procedure import scenario_diagnose_options
-    from plansim.fit import resolve_site, scenario_fit_options
+def recording_site_and_scenario(args):
+    """The recording, the site and the lab's scenario (None without --scenario) from a command's RECORDING,
+    --latitude/--height and --scenario, as ``plansim fit`` and ``plansim diagnose`` take them; each command
+    takes its options from the scenario (:func:`plansim.fit.scenario_fit_options`,
+    :func:`plansim.diagnose.procedure.scenario_diagnose_options`)."""
+    from plansim.fit import resolve_site
     from plansim.io.recording import read_recording
     from plansim.io.scenario_file import load_scenario
 
     scenario = load_scenario(args.scenario) if args.scenario is not None else None
     recording = read_recording(args.recording)
-    site = resolve_site(args.latitude, args.height, recording.attrs, scenario)
-    return recording, site, (scenario_diagnose_options if diagnosis else scenario_fit_options)(scenario)
+    return recording, resolve_site(args.latitude, args.height, recording.attrs, scenario), scenario
 
 
 def add_site_and_scenario_options(p) -> None:
