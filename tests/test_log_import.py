@@ -572,6 +572,36 @@ def test_a_steady_turn_about_the_vertical_with_no_rest_is_warned_of(tmp_path):
     assert "rest_turning_about_vertical" not in {w.name for w in import_log(log, time_column="time").warnings}
 
 
+def test_a_gyro_offset_every_pose_reads_is_not_a_turn_about_one_poses_vertical(tmp_path):
+    """Found on a real hand session (imu_tk's Xsens test log, its gyros in raw counts less 32768: a zero-rate
+    offset of 3.7 deg/s that one of its 39 poses had within 6 deg of its vertical). A simulated 12-pose session
+    whose gyro bias, 3.7 deg/s, points along its fourth pose's vertical: every other pose reads the same output,
+    so it is the bias, and the import does not warn of a turn about that pose's vertical. The one-pose logs of
+    test_a_steady_turn_about_the_vertical_with_no_rest_is_warned_of still are."""
+    from plansim.model.parameters import PARAMETER_INDEX
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    theta = consumer_unit(3)
+    poses = spread_poses(12, seed=3)
+    up = poses[3].T @ np.array([0.0, 0.0, 1.0])  # the fourth pose's vertical in the body frame
+    for i, axis in enumerate("xyz"):
+        theta[PARAMETER_INDEX[f"Bg{axis}"]] = math.radians(3.7) * up[i]
+    s = hand_session(theta, poses, seed=3, gyro_noise=8.7e-4, accel_noise=9.8e-3)
+    log = tmp_path / "hand.csv"
+    write_synthetic(log, s.time, s.samples)
+    result = import_log(log, time_column="time")
+    statics = [seg for seg in result.recording.schedule.segments if seg.test == "static"]
+    assert len(statics) == 12
+    assert "rest_turning_about_vertical" not in {w.name for w in result.warnings}
+    # the same output in one pose alone is still warned of: nothing else reads it
+    lone = s.samples[: int(s.time.searchsorted(4.0))]
+    lone = lone.copy()
+    lone[:, :3] = np.radians(3.7) * (lone[:, 3:] / np.linalg.norm(lone[:, 3:], axis=1, keepdims=True))
+    lone[:, :3] += 8.7e-4 * np.random.default_rng(4).standard_normal((lone.shape[0], 3))
+    write_synthetic(log, s.time[: lone.shape[0]], lone)
+    assert "rest_turning_about_vertical" in {w.name for w in import_log(log, time_column="time").warnings}
+
+
 def test_rows_dropped_here_and_there_are_not_gaps(tmp_path):
     """A wireless IMU loses a row now and then: 5 % of the rows dropped at random (at most two in a row kept that
     way) made every stretch hold a gap, and the log could not be imported at all. They are a named warning now; the

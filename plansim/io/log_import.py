@@ -95,6 +95,10 @@ SATURATION_EPISODE_WINDOWS = 1
 #: :data:`VERTICAL_TURN_CONE`) is warned of as possibly a steady turn about the vertical: the one turn that leaves
 #: the accelerometers steady, which the detector (step 6) can tell from rest only against a rest elsewhere in the log
 VERTICAL_TURN_RATE = math.radians(1.0)
+#: a static pose's gyro output that a rest in another pose (its vertical further than twice
+#: :data:`VERTICAL_TURN_CONE` from this one's) reads too, to within this (rad/s), is the gyros' bias, not a turn
+#: about this pose's vertical: such a turn would add its rate along this vertical alone. Half the warning's rate
+VERTICAL_TURN_SHARED = 0.5 * VERTICAL_TURN_RATE
 #: half-angle of the cone about the specific force within which such a gyro output counts as along it. A bias of
 #: random direction falls in it by chance 1 − cos 10° = 1.5 % of the time
 VERTICAL_TURN_CONE = math.radians(10.0)
@@ -487,7 +491,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         rate, force = span.mean[:3], span.mean[3:]
         magnitude = float(np.linalg.norm(rate))
         along = abs(float(np.dot(rate, force))) / max(magnitude * float(np.linalg.norm(force)), 1e-300)
-        if magnitude >= VERTICAL_TURN_RATE and along >= math.cos(VERTICAL_TURN_CONE):
+        if magnitude >= VERTICAL_TURN_RATE and along >= math.cos(VERTICAL_TURN_CONE) \
+                and not _read_in_another_pose(span, statics):
             warnings.append(LogWarning("rest_turning_about_vertical", f"the static span on lines "
                                        f"{table.lines[span.start]}-{table.lines[span.stop - 1]} reads "
                                        f"{math.degrees(magnitude):.3g} deg/s on its gyros, within "
@@ -621,6 +626,22 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     correlation = tuple(np.asarray(channel.autocorrelation) for channel in noise.channels)
     return ImportResult(recording, table, timing, segmentation, unit_names, counts_per_unit, tuple(warnings),
                         zero_counts, tuple(CHANNELS[c] for c in range(6) if signs[c] < 0), correlation)
+
+
+def _read_in_another_pose(span: Span, statics: list[Span]) -> bool:
+    """Whether a rest in another pose (its specific force more than twice :data:`VERTICAL_TURN_CONE` from
+    *span*'s) reads *span*'s gyro output to within :data:`VERTICAL_TURN_SHARED`: then that output is the gyros'
+    bias, which every pose reads, and not a turn about *span*'s vertical. A hand session whose gyros read their raw
+    zero-rate offset (imu_tk's Xsens log: 3.7 deg/s) has a pose whose vertical falls near that offset by chance."""
+    force = span.mean[3:] / max(float(np.linalg.norm(span.mean[3:])), 1e-300)
+    for other in statics:
+        if other is span:
+            continue
+        direction = other.mean[3:] / max(float(np.linalg.norm(other.mean[3:])), 1e-300)
+        apart = float(np.dot(force, direction)) < math.cos(2.0 * VERTICAL_TURN_CONE)
+        if apart and float(np.linalg.norm(other.mean[:3] - span.mean[:3])) < VERTICAL_TURN_SHARED:
+            return True
+    return False
 
 
 def _saturation_episodes(saturation, apart: int) -> list[list]:
