@@ -155,6 +155,47 @@ def test_delivery_stamps_are_not_read_as_dropped_samples_and_a_real_gap_still_is
     assert not report.delivery and report.sample_times is None and [k for k, _ in report.gaps] == [12000]
 
 
+def test_delivery_stamps_of_a_host_that_starts_late_and_drains_a_buffer_stay_in_time_order():
+    """Found on a real MPU-6050 log (github.com/sunsided/sensor-fusion, 100 Hz read through a host that stamps each
+    row as it arrives, 1-3 ms apart within a read): its first 12 rows were stamped at once, the next 18 at once
+    0.25 s later, then one read every 10-55 ms. Read as breaks, the two first reads were each placed on their own
+    stamps' mean, and the second overlapped the rest of the log ("time decreases at sample 30" in a log whose time
+    never decreases). Over those steps the placed clocks miss no sample: the host read late a buffer the sensor had
+    filled since before the log's start, and the stretches are one. Simulated the same way: no gap, the samples'
+    times strictly increasing, the rate within 0.1 % and every time within 0.5 s of the truth. A real gap of 2 s
+    (200 samples missing) is still found."""
+    rng = np.random.default_rng(12)
+    n = 6000
+    true = (np.arange(n) - 30) / 100.0 + 0.07  # 30 rows buffered before the log started
+
+    def reads(rows_at, first):
+        stamps, k, now = np.empty(n), first, float(true[first])
+        while k < n:
+            now += rng.uniform(0.010, 0.055)
+            ready = int(np.searchsorted(true, now, side="right"))
+            if ready <= k:
+                continue
+            stamps[k:ready] = now + np.cumsum(rng.uniform(1e-3, 3e-3, ready - k))
+            k = ready
+        stamps[:first] = rows_at
+        return stamps
+
+    early = np.concatenate([0.008 + np.cumsum(rng.uniform(1e-3, 3e-3, 12)),
+                            0.26 + np.cumsum(rng.uniform(1e-3, 3e-3, 18))])
+    stamps = np.maximum.accumulate(reads(early, 30))
+    report = analyse_time(stamps, n)
+    assert report.delivery and report.gaps == () and report.missing_samples == 0
+    assert np.all(np.diff(report.sample_times) > 0)
+    assert report.sample_rate == pytest.approx(100.0, rel=1e-3)
+    assert np.max(np.abs(report.sample_times - true)) < 0.5
+    later = stamps.copy()
+    first = int(np.flatnonzero(np.diff(stamps) > 0.008)[200]) + 1  # the first row of a read
+    later[first:] += 2.0
+    report = analyse_time(later, n)
+    assert [k for k, _ in report.gaps] == [first] and np.all(np.diff(report.sample_times) > 0)
+    assert abs(report.missing_samples - 200) <= 10
+
+
 def test_a_steady_turn_between_two_rests_is_a_rotation_with_its_rate_and_no_angle():
     """A table holding -90 deg/s for 4 s about z (up): its steady part is a rotation with its measured rate and no
     angle (step 9: the table's rate is the reference), the few samples where the windows straddle the rest and the

@@ -159,18 +159,27 @@ def analyse_time(time: np.ndarray | None, samples: int, sample_rate: float | Non
         # number, common to the stretches (a burst's stamp is late by up to the burst, at either end of the log:
         # the steps' mean would carry that over the log's length), each stretch placed on its stamps' mean
         t = np.asarray(time, dtype=np.float64)
-        edges = [0, *(int(k) + 1 for k in np.flatnonzero(gap)), samples]
-        stretches = list(zip(edges[:-1], edges[1:]))
-        centred = [(np.arange(b - a) - (b - a - 1) / 2.0, t[a:b] - np.mean(t[a:b])) for a, b in stretches]
-        slope = sum(float(k @ y) for k, y in centred) / sum(float(k @ k) for k, _ in centred)
-        if slope > 0:
-            estimated = 1.0 / slope
-            nominal = estimated if sample_rate is None else float(sample_rate)
-            period = 1.0 / nominal
-        sample_times = np.empty_like(t)
-        for a, b in stretches:
-            offset = np.arange(b - a) * period
-            sample_times[a:b] = np.mean(t[a:b] - offset) + offset
+        while True:
+            edges = [0, *(int(k) + 1 for k in np.flatnonzero(gap)), samples]
+            stretches = list(zip(edges[:-1], edges[1:]))
+            centred = [(np.arange(b - a) - (b - a - 1) / 2.0, t[a:b] - np.mean(t[a:b])) for a, b in stretches]
+            slope = sum(float(k @ y) for k, y in centred) / sum(float(k @ k) for k, _ in centred)
+            if slope > 0:
+                estimated = 1.0 / slope
+                nominal = estimated if sample_rate is None else float(sample_rate)
+                period = 1.0 / nominal
+            sample_times = np.empty_like(t)
+            for a, b in stretches:
+                offset = np.arange(b - a) * period
+                sample_times[a:b] = np.mean(t[a:b] - offset) + offset
+            # a long step between stamps over which the placed clocks miss no sample is a delivery that stalled
+            # (a host that starts reading late, then drains the sensor's buffer), not a break: the stretches on
+            # either side are one, placed together (a short burst placed on its own stamps' mean can otherwise
+            # overlap its neighbour: a sensor-fusion logger's MPU-6050 log did, 2026-12-01)
+            stalled = gap & (np.diff(sample_times) < GAP_FACTOR * period)
+            if not np.any(stalled):
+                break
+            gap &= ~stalled
         # a break's length between the placed stretches, not between two late or early stamps
         dt = np.where(gap, np.diff(sample_times), dt)
     breaks = [(int(k) + 1, float(dt[k]), max(round(dt[k] * nominal) - 1, 1)) for k in np.flatnonzero(gap)]
