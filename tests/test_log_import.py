@@ -793,6 +793,18 @@ def test_an_offset_in_counts_is_subtracted_before_the_scale(tmp_path, capsys):
     assert main(["import", str(tmp_path / "signed.csv"), "--out", str(tmp_path / "neg.nc"), "--time", "time",
                  "--units", "deg/s,g", "--scale", "-16.4,-2048"]) == 2
     assert "--scale '-16.4,-2048': '-16.4' for channel gx; expected a positive number" in capsys.readouterr().err
+    # so is a --columns list whose first channel is reversed (the sensor-fusion MPU-6050 logs': -gyro_x first)
+    write_synthetic(tmp_path / "reversed.csv", t, counts * np.r_[-1.0, 1, 1, 1, 1, 1])
+    assert main(["import", str(tmp_path / "reversed.csv"), "--out", str(tmp_path / "rev.nc"), "--time", "time",
+                 "--units", "deg/s,g", "--scale", "16.4,2048", "--columns", "-gx,gy,gz,ax,ay,az"]) == 0
+    capsys.readouterr()
+    np.testing.assert_allclose(read_recording(tmp_path / "rev.nc").samples, signed.recording.samples, rtol=0,
+                               atol=1e-12)
+    # an option after --columns is still an option
+    with pytest.raises(SystemExit) as stop:
+        main(["import", str(tmp_path / "reversed.csv"), "--out", str(tmp_path / "rev2.nc"), "--columns", "--time",
+              "time"])
+    assert stop.value.code == 2 and "--columns: expected one argument" in capsys.readouterr().err
 
 
 def test_simulated_recording_times_are_the_nominal_ones():

@@ -61,16 +61,28 @@ def build_parser() -> argparse.ArgumentParser:
 
 #: options whose value is a comma-separated list of numbers that may start with a minus sign
 SIGNED_LIST_OPTIONS = ("--scale", "--offset")
+#: options whose value is a comma-separated list of column names, each of which a leading minus sign reverses
+SIGNED_NAME_OPTIONS = ("--columns",)
+
+
+def _signed_value(option: str, value: str) -> bool:
+    """Whether *value*, after *option*, is that option's list starting with a minus sign, not another option."""
+    if value[:1] != "-" or value[:2] == "--":
+        return False
+    if option in SIGNED_LIST_OPTIONS:
+        return value[1:2].isdigit() or value[1:2] == "."
+    return option in SIGNED_NAME_OPTIONS and "," in value
 
 
 def _join_signed_lists(argv: list[str]) -> list[str]:
-    """``--scale -16.4,-2048`` as ``--scale=-16.4,-2048``: argparse takes a value that starts with "-" and is not one
-    plain negative number for an option, and says only "expected one argument"."""
+    """``--scale -16.4,-2048`` as ``--scale=-16.4,-2048``, ``--columns -gyr_x,gyr_y,…`` as ``--columns=-gyr_x,…``:
+    argparse takes a value that starts with "-" and is not one plain negative number for an option, and says only
+    "expected one argument"."""
     out: list[str] = []
     k = 0
     while k < len(argv):
         value = argv[k + 1] if k + 1 < len(argv) else ""
-        if argv[k] in SIGNED_LIST_OPTIONS and value[:1] == "-" and (value[1:2].isdigit() or value[1:2] == "."):
+        if _signed_value(argv[k], value):
             out.append(f"{argv[k]}={value}")
             k += 2
             continue
