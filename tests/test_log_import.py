@@ -321,8 +321,9 @@ def test_import_plot_shades_each_segment_and_draws_the_samples_in_their_units(tm
 def test_the_summary_says_when_the_noise_is_correlated_from_sample_to_sample(tmp_path, capsys):
     """The per-sample noise of the quiet stretch understates a segment mean's where the part's filter correlates
     neighbouring samples. The same log with its noise through a first-order filter (pole 0.6: rho_1 = 0.6) is
-    said to be correlated in every channel, with its lag-one autocorrelation, as plansim fit reads it; the white
-    one is not."""
+    said to be correlated in every channel, with its lag-one autocorrelation, as plansim fit reads it, and a mean's
+    variance about 4 times the white figure's; the white one is not. Noise whose neighbours cancel in part is said
+    to make the per-sample figures overstate a mean's noise, not understate it."""
     from scipy.signal import lfilter
 
     t, x = synthetic_log(seed=4, seconds_rest=30.0)  # 30 s rest, a 2 s turn, 30 s rest at 100 Hz
@@ -330,15 +331,33 @@ def test_the_summary_says_when_the_noise_is_correlated_from_sample_to_sample(tmp
     for rest in (slice(0, 3000), slice(3200, None)):  # each rest's noise through the filter, its variance kept
         level = x[rest].mean(axis=0)
         filtered[rest] = level + lfilter([math.sqrt(1.0 - 0.6**2)], [1.0, -0.6], x[rest] - level, axis=0)
-    for name, samples, said in (("white", x, False), ("filtered", filtered, True)):
+    # noise whose neighbours partly cancel (w_k - 0.4 w_k-1, scaled: rho_1 = -0.34) makes a mean's noise smaller
+    # than the per-sample figure says (found on a real MPU-6050 log, where the summary said "understate")
+    cancelling = x.copy()
+    for rest in (slice(0, 3000), slice(3200, None)):
+        level = x[rest].mean(axis=0)
+        cancelling[rest] = level + lfilter([1.0, -0.4], [1.0], x[rest] - level, axis=0) / math.sqrt(1.16)
+    for name, samples, said in (("white", x, False), ("filtered", filtered, True), ("cancelling", cancelling, True)):
         log = tmp_path / f"{name}.csv"
         write_synthetic(log, t, samples)
         assert main(["import", str(log), "--out", str(tmp_path / f"{name}.nc"), "--time", "time"]) == 0
         out = capsys.readouterr().out
         assert ("noise correlated from one sample to the next in gx gy gz ax ay az" in out) is said, out
-        if said:
+        if name == "filtered":
             rho = [float(v) for v in re.findall(r"lag-one autocorrelation ([0-9.]+) to ([0-9.]+)", out)[0]]
             assert 0.5 < rho[0] <= rho[1] < 0.7  # 6000 samples: a standard error of 0.013
+            assert "the per-sample figures above understate a segment mean's noise" in out
+            # 1 + 2 sum rho of a first-order filter: (1 + 0.6) / (1 - 0.6) = 4
+            low, high = (float(v) for v in re.findall(r"its variance ([0-9.]+) to ([0-9.]+) times theirs", out)[0])
+            assert 3.0 < low <= high < 5.0
+        if name == "cancelling":
+            rho = [float(v) for v in re.findall(r"lag-one autocorrelation (-[0-9.]+) to (-[0-9.]+)", out)[0]]
+            assert -0.4 < rho[0] <= rho[1] < -0.28
+            assert "negative: neighbouring samples partly cancel" in out
+            assert "the per-sample figures above overstate a segment mean's noise" in out
+            # 1 + 2 rho_1 = 1 - 0.69 = 0.31
+            low, high = (float(v) for v in re.findall(r"its variance ([0-9.]+) to ([0-9.]+) times theirs", out)[0])
+            assert 0.2 < low <= high < 0.45
 
 
 def test_a_temperature_column_becomes_the_temperature_channel(tmp_path):

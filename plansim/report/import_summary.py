@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from plansim.io.log_import import ImportResult, table_source
 from plansim.io.recording_data import CHANNELS
 
@@ -61,11 +63,19 @@ def format_summary(result: ImportResult) -> str:
     if correlated:
         first = [float(rho[0]) for _, rho in correlated]
         lags = [len(rho) for _, rho in correlated]
+        # a long mean's variance is (1 + 2 Σ ρ_k) times the white-noise figure from the per-sample sd
+        factors = [1.0 + 2.0 * float(np.sum(rho)) for _, rho in correlated]
+        cause = ("the part's own low-pass filter, or a log resampled by its host" if min(first) > 0 else
+                 "negative: neighbouring samples partly cancel" if max(first) < 0 else
+                 "positive: the part's low-pass filter or a resampling host; negative: neighbours partly cancel")
+        verb = ("understate" if min(factors) > 1 else "overstate" if max(factors) < 1 else
+                "understate or overstate")
         lines.append(f"  noise correlated from one sample to the next in {' '.join(n for n, _ in correlated)} (lag-one "
                      f"autocorrelation {min(first):.2g} to {max(first):.2g}, over {min(lags)} to {max(lags)} "
                      "sample(s), pooled over the static poses of the channel's quiet scatter, as plansim fit reads it: "
-                     "the part's own low-pass filter, or a log resampled by its host): the per-sample figures above "
-                     "understate a segment mean's noise; plansim fit models the correlation (docs/fitting.md)")
+                     f"{cause}): the per-sample figures above {verb} a segment mean's noise (its variance "
+                     f"{min(factors):.2g} to {max(factors):.2g} times theirs, 1 + 2 sum of the autocorrelations); "
+                     "plansim fit models the correlation (docs/fitting.md)")
     rate = " ".join(f"{math.degrees(v):.3g}" for v in seg.rate_threshold)
     lines.append(f"  at rest: variance ratios <= {seg.variance_threshold[0]:.3g} (accelerometers), "
                  f"{seg.variance_threshold[1]:.3g} (gyros) over {seg.window} samples "
