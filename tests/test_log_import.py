@@ -621,6 +621,42 @@ def test_a_gyro_offset_every_pose_reads_is_not_a_turn_about_one_poses_vertical(t
     assert "rest_turning_about_vertical" in {w.name for w in import_log(log, time_column="time").warnings}
 
 
+def test_rests_shorter_than_the_detectors_are_warned_of_with_the_options_that_find_them(tmp_path):
+    """Found on a real ROS2 hand session (GetOverMassif/imu_tk, data1): its rests last about a second, the
+    detector's --min-static is 1 s, and the import found 4 poses and 3 moves of 12-45 s holding 25 visible rests,
+    with no word of them. A simulated session of 16 poses held 0.9 s each: with no rest long enough the error says
+    what to try; started with 5 s at rest, as a session is, the warning ``short_rests`` counts the quiet stretches
+    inside the motion and gives the options to import again with, which find the 16 poses. The same session with
+    5 s rests is not warned of."""
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    theta, poses = consumer_unit(6), spread_poses(16, seed=6)
+    short = hand_session(theta, poses, rest=0.9, seed=6, gyro_noise=8.7e-4, accel_noise=9.8e-3)
+    log = tmp_path / "short.csv"
+    write_synthetic(log, short.time, short.samples)
+    # no rest long enough at all: the error says so, and what to try
+    with pytest.raises(ValueError, match=r"quiet stretches are shorter than that: if the log's rests are, try "
+                                         r"--min-static 0.5 --window 0.25"):
+        import_log(log, time_column="time")
+    # the log started with the unit at rest for 5 s, as a session does: that pose is found, the rest are not
+    rng = np.random.default_rng(6)
+    first = short.samples[:90].mean(axis=0) + rng.normal(size=(500, 6)) * np.r_[[8.7e-4] * 3, [9.8e-3] * 3]
+    samples = np.vstack([first, short.samples])
+    write_synthetic(log, np.arange(samples.shape[0]) / 100.0, samples)
+    result = import_log(log, time_column="time")
+    statics = sum(seg.test == "static" for seg in result.recording.schedule.segments)
+    message = {w.name: w.message for w in result.warnings}["short_rests"]
+    found = int(re.search(r"the motion holds (\d+) quiet stretches", message).group(1))
+    assert found >= max(3, statics) and statics < 16
+    assert "Import again with --min-static 0.5 --window 0.25" in message
+    again = import_log(log, time_column="time", min_static=0.5, window=0.25)
+    assert sum(seg.test == "static" for seg in again.recording.schedule.segments) == 16  # 5 s and 0.9 s: one pose
+    assert "short_rests" not in {w.name for w in again.warnings}
+    usual = hand_session(theta, poses, rest=5.0, seed=6, gyro_noise=8.7e-4, accel_noise=9.8e-3)
+    write_synthetic(log, usual.time, usual.samples)
+    assert "short_rests" not in {w.name for w in import_log(log, time_column="time").warnings}
+
+
 def test_rows_dropped_here_and_there_are_not_gaps(tmp_path):
     """A wireless IMU loses a row now and then: 5 % of the rows dropped at random (at most two in a row kept that
     way) made every stretch hold a gap, and the log could not be imported at all. They are a named warning now; the

@@ -906,3 +906,23 @@ def test_a_scenario_states_the_priors_of_what_the_fit_holds(tmp_path):
         assert abs(estimate - Kg[1, 1]) < 3.3 * u[name], (name, estimate, Kg[1, 1], u[name])
     assert 8.0 < u["sheet"] / u["lab"] < 12.0, u
     assert any("scenario 'lab'" in note for note in fit.notes)
+
+
+def test_moves_that_identify_no_scale_factor_are_left_out_saying_why(tmp_path, capsys):
+    """Found on a real ROS2 session (GetOverMassif/imu_tk, data1): its import found 4 poses and 3 long moves, all
+    about one body axis, and ``plansim fit`` said nothing of them: Kg was "not excited" as if no move were there.
+    Four poses turned about body y by hand: the moves identify Kg only in combinations, so they are left out, and a
+    note says so, with the rank and the axis they turn about; the poses' fit stands."""
+    rng = np.random.default_rng(5)
+    poses = np.array([(Rotation.from_euler("z", rng.uniform(0, 360), degrees=True)
+                       * Rotation.from_euler("x", 90.0, degrees=True)
+                       * Rotation.from_euler("y", angle + rng.normal(0.0, 3.0), degrees=True)).as_matrix()
+                      for angle in (0.0, 90.0, 180.0, 270.0)])
+    theta = unit(5)
+    s = hand_session(theta, poses, seed=5, gravity=SITE.gravity, gyro_noise=GYRO_NOISE, accel_noise=ACCEL_NOISE)
+    recording = Recording(s.samples, s.schedule, {"source": "simulated"}, timestamps=s.time)
+    result = fit_recording(recording, SITE)
+    assert result.moves is None and not result.identifiability.mask[KG_INDEX].any()
+    note = next(n for n in result.notes if "moves between poses were left out" in n)
+    assert "the 3 moves between poses were left out: together they identify no single entry" in note
+    assert "turn mostly about y" in note and "rank" in note

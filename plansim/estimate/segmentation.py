@@ -182,6 +182,11 @@ MAD_TO_SIGMA = 1.482602218505602
 AXES = ("x", "y", "z")
 
 
+#: a log with no static span but at least this many quiet stretches shorter than ``min_static`` (and at least half
+#: a window long) is told, in the error, to try a shorter ``--min-static`` and ``--window``
+SHORT_QUIET_HINT = 3
+
+
 @dataclass(frozen=True)
 class NoiseFloor:
     """The log's own noise, measured in its quietest stretch ``[start, stop)``.
@@ -286,6 +291,9 @@ class Segmentation:
     steady_turns: tuple[tuple[int, int], ...]
     glitches: tuple[int, ...] = ()
     frozen: tuple[Frozen, ...] = ()
+    #: quiet runs at least half a window long but shorter than ``min_static``, within motion: rests too short for
+    #: the detector (a hand that paused for a second), which a shorter ``--min-static`` and ``--window`` would take
+    short_quiet: tuple[tuple[int, int], ...] = ()
 
     def of_kind(self, kind: str) -> list[Span]:
         return [span for span in self.spans if span.kind == kind]
@@ -564,12 +572,18 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         static_runs = _merge_same_pose(sorted(static_runs + held), x, w)
         held = [run for run in static_runs if any(run[0] <= a and b <= run[1] for a, b in held)]
     if not static_runs:
-        longest = max((b - a for a, b in _runs(quiet_mask)), default=0)
+        quiet_runs = _runs(quiet_mask)
+        longest = max((b - a for a, b in quiet_runs), default=0)
+        why = (": quiet, but not one pose at rest (its gravity turns, or its gyros read a steady turn)"
+               if longest >= n_min else "")
+        short = sum(w // 2 <= b - a < n_min for a, b in quiet_runs)
+        hint = (f"; {short} quiet stretches are shorter than that: if the log's rests are, try --min-static "
+                f"{min_static / 2:.3g} --window {w / sample_rate / 2:.3g}" if short >= SHORT_QUIET_HINT else "")
         raise ValueError(f"too few static samples: no span at rest of at least {min_static:g} s ({n_min} samples) "
                          f"was found; the longest quiet stretch has {longest} samples ({longest / sample_rate:.3g} "
-                         f"s). Quiet: summed variance ratios <= {variance_threshold[0]:.3g} (accelerometers) and "
-                         f"{variance_threshold[1]:.3g} (gyros) over windows of {w} samples "
-                         "and the gyro output within the rest threshold (docs/measured-data.md)")
+                         f"s){why}. Quiet: summed variance ratios <= {variance_threshold[0]:.3g} (accelerometers) "
+                         f"and {variance_threshold[1]:.3g} (gyros) over windows of {w} samples "
+                         f"and the gyro output within the rest threshold{hint} (docs/measured-data.md)")
 
     # 4c. frozen stretches: one value repeated for longer than the channel's noise at rest allows
     frozen = frozen_runs(logged, static_runs, step)
@@ -626,8 +640,13 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         if span is not None:
             spans.append(span)
         previous = span
+    in_motion = np.zeros(n, dtype=bool)
+    for span in spans:
+        if span.kind != "static":
+            in_motion[span.start:span.stop] = True
+    short_quiet = tuple((a, b) for a, b in _runs(quiet_mask) if w // 2 <= b - a < n_min and in_motion[a:b].all())
     return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
-                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()), tuple(frozen))
+                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()), tuple(frozen), short_quiet)
 
 
 def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span | None) -> bool:

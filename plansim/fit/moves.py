@@ -569,8 +569,15 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
                              "the turns' angles can, in the joint fit)")
     ident = identifiability(design, what="the moves between poses")
     kg_mask = ident.mask[KG_INDEX]
-    if not kg_mask.any():
-        return None
+    if not kg_mask.any():  # the poses' fit stands; say why the moves add nothing
+        samples = np.asarray(recording.samples, dtype=float)
+        axes = ", ".join(sorted({"xyz"[int(np.argmax(np.abs(samples[t.start:t.stop, :3].sum(axis=0))))]
+                                 for t in transitions}))
+        raise MovesNotFitted(f"the {n_moves} moves between poses were left out: together they identify no single "
+                             f"entry of the gyros' scale factors Kg (rank {ident.rank} of the 9, in combinations "
+                             f"only; they turn mostly about {axes}). More moves, about each of the three axes, would "
+                             "(a hand session whose rests are too short for the import leaves them inside its moves: "
+                             "its short_rests warning)")
     basis = ident.basis[KG_INDEX]  # (9, rank): Kg = I + basis·z
 
     S = means.shape[0]

@@ -76,7 +76,14 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree", "frozen", "repeated_rows", "table_rate_disagrees", "table_rate_sense",
-                 "table_turning_at_rest", "table_turn_not_a_rotation", "not_a_table_pose")
+                 "table_turning_at_rest", "table_turn_not_a_rotation", "not_a_table_pose", "short_rests")
+#: the quiet stretches within motion too short for a static span (``Segmentation.short_quiet``) are warned of
+#: (``short_rests``) where there are at least this many and at least as many as the static poses found: a hand
+#: session whose rests are shorter than ``--min-static`` (imu_tk's ROS2 session "data1" of GetOverMassif/imu_tk:
+#: 25 such stretches beside 4 poses, where 39 to 23 real sessions found 0-6 beside 20-39 poses); up to
+#: SHORT_RESTS_LISTED are listed by line
+SHORT_RESTS_MIN = 3
+SHORT_RESTS_LISTED = 6
 #: how the log's poses were set (``--poses``): by hand (each pose's tilt a nuisance of the fit) or by a table that
 #: set each up-axis to its grade (JJF 2003's positions: one body axis up or down, turns about the vertical)
 POSES = ("hand", "table")
@@ -508,6 +515,20 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                 "quiet and hold one pose while the gyros shake (up to "
                                                 f"{max(span.held for span in held):.3g} times their quiet noise); the "
                                                 "fit gives such a pose's means their own scatter"))
+    short = segmentation.short_quiet
+    if len(short) >= max(SHORT_RESTS_MIN, len(statics)):
+        rate = timing.sample_rate
+        # a quiet run of the moving variance is about a window shorter than the rest that holds it
+        lengths = [(b - a + segmentation.window) / rate for a, b in short]
+        listed = ", ".join(f"{table.lines[a]}-{table.lines[b - 1]}" for a, b in short[:SHORT_RESTS_LISTED])
+        more = f" and {len(short) - SHORT_RESTS_LISTED} more" if len(short) > SHORT_RESTS_LISTED else ""
+        window_s, min_static_s = segmentation.window / rate, segmentation.min_static / rate
+        warnings.append(LogWarning("short_rests", f"the motion holds {len(short)} quiet stretches of about "
+                                                  f"{min(lengths):.2g}-{max(lengths):.2g} s (lines {listed}{more}), "
+                                                  f"as many as the {len(statics)} static pose(s) found or more: "
+                                                  f"rests shorter than --min-static {min_static_s:.3g} s? Import "
+                                                  f"again with --min-static {min_static_s / 2:.3g} --window "
+                                                  f"{window_s / 2:.3g} (docs/measured-data.md)"))
     for span in segmentation.spans:
         if span.kind == "move" and span.reason.startswith("no static span"):
             warnings.append(LogWarning("unclosed_motion", f"lines {table.lines[span.start]}-"
