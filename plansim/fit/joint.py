@@ -72,6 +72,25 @@ METHOD_JOINT = "joint_wls"
 
 
 @dataclass(frozen=True)
+class AccelShear:
+    """One pair of the accelerometers' cross-couplings (Ka_ij, Ka_ji) with poses placed by hand: their symmetric
+    part (Ka_ij + Ka_ji)/2, a shear of the triad (its antisymmetric part is a rotation of the triad, which the
+    poses' tilts take up whole). ``determined``: the poses' tilts (second order) let the fit estimate it, and
+    ``estimate`` ± ``u`` is that estimate; otherwise it is held at 0 with ``u`` its Type B standard uncertainty
+    (a bound from the fitted tilts, or the data sheet's). Dimensionless."""
+
+    first: str
+    second: str
+    estimate: float
+    u: float
+    determined: bool
+
+    @property
+    def name(self) -> str:
+        return f"({self.first} + {self.second})/2"
+
+
+@dataclass(frozen=True)
 class FitResult:
     """Everything :func:`fit_recording` found. Arrays over the used segments unless said otherwise."""
 
@@ -133,6 +152,9 @@ class FitResult:
     held_sources: object = field(default=None, repr=False)
     #: the gyros from the moves between poses (:func:`plansim.fit.moves.fit_moves`); None without two usable moves
     moves: object = None
+    #: with poses placed by hand, the accelerometer triad's shear: the symmetric part of each pair of Ka's
+    #: cross-couplings that the nominal point leaves to the tilts (:class:`AccelShear`)
+    shear: tuple = ()
     #: the Type B standard uncertainties of what the fit (and the moves) hold at nominal
     held: HeldPriors = field(default_factory=HeldPriors)
     #: with the data sheet as a prior (where the data leave a direction to it, :func:`solve`): the joint
@@ -468,6 +490,43 @@ def _held_cross_couplings(ident: Identifiability, J: np.ndarray) -> list[tuple[i
         if float(np.linalg.norm(scaled - within)) > NULL_TOLERANCE * size:
             out.append((i, j))
     return out
+
+
+def _accel_shear(ident: Identifiability, mask, theta, gain, sources: Sources, held: list, bound: list, J,
+                 prior=None) -> tuple[AccelShear, ...]:
+    """The accelerometer triad's shear with poses placed by hand (:class:`AccelShear`): for each pair of Ka's
+    cross-couplings neither of which the recording identifies, its symmetric part (Ka_ij + Ka_ji)/2. Where that
+    combination is estimable (in the row space of the design, as poses spread over the sphere make it: a tilt
+    and a shear move the means alike only at axis-aligned poses) it is θ̂'s, with u propagated through the gain
+    from the inputs (and the data sheet's prior, *prior* = (gain on it, u)), the Type B that holds the other
+    pairs included but not its own; otherwise it is held at 0 with its Type B u (*bound*, the pairs *held*)."""
+    held_u = {pair: u for pair, u in zip(held, bound)}
+    out = []
+    for x, y in ("xy", "xz", "yz"):
+        a, b = PARAMETER_INDEX[f"Ka{x}{y}"], PARAMETER_INDEX[f"Ka{y}{x}"]
+        if mask[a] or mask[b]:
+            continue
+        c = np.zeros(ident.scale.size)
+        c[[a, b]] = 0.5
+        scaled = np.divide(c, ident.scale, out=np.zeros_like(c), where=ident.scale > 0)
+        within = ident.row_space.T @ (ident.row_space @ scaled)
+        estimable = bool(np.all(ident.scale[[a, b]] > 0)) and \
+            float(np.linalg.norm(scaled - within)) <= NULL_TOLERANCE * float(np.linalg.norm(scaled))
+        if estimable:
+            others = Sources(sources.size)
+            for pair, u in held_u.items():
+                if pair != (a, b):
+                    others.add(J[:, pair[0]] + J[:, pair[1]], u, math.inf, "held")
+            row = (c[:len(PARAMETER_NAMES)] @ gain)[None, :]
+            prior_gain, prior_u = (None, None) if prior is None else \
+                ((c[:len(PARAMETER_NAMES)] @ prior[0])[None, :], prior[1])
+            u = propagate("shear", row, sources.joined(others), np.array([True]), prior_gain=prior_gain,
+                          prior_u=prior_u).u[0]
+            out.append(AccelShear(PARAMETER_NAMES[a], PARAMETER_NAMES[b], 0.5 * float(theta[a] + theta[b]),
+                                  float(u), True))
+        elif (a, b) in held_u:
+            out.append(AccelShear(PARAMETER_NAMES[a], PARAMETER_NAMES[b], 0.0, float(held_u[(a, b)]), False))
+    return tuple(out)
 
 
 def _held_bound(model: MeanModel, theta, tilts, rows, W, nominal_rank: int, rank: int,
@@ -925,6 +984,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     joint = propagate(METHOD_JOINT, gain, every_source, mask,
                       prior_gain=None if prior_gains is None else prior_gains[0], prior_u=limits)
     joint = Method(METHOD_JOINT, np.where(mask, theta, math.nan), joint.u, joint.dof, joint.contributions)
+    shear = _accel_shear(ident, mask, theta, gain, sources, held_cross, bound, J,
+                         None if prior_gains is None else (prior_gains[0], limits)) if model.n_tilts else ()
     residual = m - fitted.ravel()
     project = np.eye(len(m)) - hat
     residual_cov = project @ V @ project.T + held_by_prior
@@ -992,7 +1053,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      segment_times=times, basis=step_basis, extra=extra_method,
                      extra_names=tuple(extra), covariance_predicted=V_predicted, between_noise=slow,
                      gain=gain, sources=sources, held_sources=held_sources, held=priors,
-                     prior_gain=None if prior_gains is None else prior_gains[0], data_sheet_conflict=conflict)
+                     prior_gain=None if prior_gains is None else prior_gains[0], data_sheet_conflict=conflict,
+                     shear=shear)
     if _judged is None and model.placed.any():
         # a pose's tilt as the import read it carries the accelerometers' biases (0.5 m/s² tilts the raw specific
         # force by 3°): judged again from this fit's tilts, a component no cross-coupling the shear's prior allows

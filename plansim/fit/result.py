@@ -18,7 +18,7 @@ from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
 
 JSON_KEYS = ("identified", "not_identified", "weakly_determined", "site", "turntable", "parameters", "noise",
-             "residuals", "chi2_dof", "moves", "data_sheet_conflict", "notes")
+             "residuals", "chi2_dof", "moves", "accelerometer_shear", "data_sheet_conflict", "notes")
 
 
 def _number(value: float):
@@ -78,6 +78,9 @@ def fit_json(result: FitResult) -> dict:
                      "ratio": _number(result.chi2 / result.chi2_dof) if result.chi2_dof > 0 else None,
                      "verdict": result.chi2_verdict},
         "moves": _moves_json(result.moves),
+        "accelerometer_shear": [{"name": item.name, "pair": [item.first, item.second],
+                                 "estimate": _number(item.estimate), "u": _number(item.u), "unit": "1",
+                                 "determined": item.determined} for item in result.shear],
         "data_sheet_conflict": [{"group": group, "statistic": _number(entry["statistic"]), "dof": int(entry["dof"]),
                                  "p_value": _number(entry["p_value"]), "contradicted": entry["contradicted"],
                                  "data_alone": [{"name": name, "unit": PARAMETERS[PARAMETER_INDEX[name]].si_unit,

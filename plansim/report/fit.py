@@ -97,6 +97,15 @@ def fit_report(result, residuals: bool = True) -> str:
         lines.append("moves: the gyros from the moves between poses (the gravity sequence, Tedaldi et al. 2014; "
                      "below)" + ("; ~ = relative to the accelerometer triad (the frame where Ka is symmetric), not "
                                  "the case" if moves.relative else ""))
+    if result.shear:
+        lines += ["", "Accelerometer triad's shear (poses placed by hand): the symmetric part of each pair of Ka's "
+                      "cross-couplings; the antisymmetric part is a rotation of the triad, which no hand-placed pose "
+                      "fixes"]
+        for item in result.shear:
+            lines.append(f"  {item.name:18s} {_g(item.estimate, 6):>12s} u {_g(item.u, 3):>9s}"
+                         if item.determined else
+                         f"  {item.name:18s} held at 0, u {_g(item.u, 3)} (Type B: the poses, near their axes, do "
+                         "not determine it)")
     budget = result.joint.contributions
     if budget:
         lines.append("The joint fit's u comes from these kinds of input: " + ", ".join(budget)
