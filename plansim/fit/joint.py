@@ -492,6 +492,16 @@ def _held_cross_couplings(ident: Identifiability, J: np.ndarray) -> list[tuple[i
     return out
 
 
+def _segments_verdict(chi2: float, dof: int) -> str:
+    """The χ²/dof verdict of the segment means (:func:`plansim.fit.budget.chi2_verdict`), with where to go next
+    when it flags residuals larger than predicted."""
+    verdict = chi2_verdict(chi2, dof)
+    if verdict.startswith("the residuals are larger"):
+        verdict += (" (plansim diagnose tests the residuals against a simulated null that holds the noise "
+                    "between segments, and names an effect where one explains them)")
+    return verdict
+
+
 def _accel_shear(ident: Identifiability, mask, theta, gain, sources: Sources, held: list, bound: list, J,
                  prior=None) -> tuple[AccelShear, ...]:
     """The accelerometer triad's shear with poses placed by hand (:class:`AccelShear`): for each pair of Ka's
@@ -1046,7 +1056,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      unused=unused, labels=tuple(s.label for s in used_schedule.segments), observed=observed,
                      fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
                      spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,
-                     chi2_verdict=chi2_verdict(chi2, chi2_dof), between=between,
+                     chi2_verdict=_segments_verdict(chi2, chi2_dof), between=between,
                      attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes,
                      model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
                      covariance=V, whitening=W, design=design, rows=rows,

@@ -211,6 +211,9 @@ def diagnose_report(d) -> str:
         info = d.information[label]
         lines.append(f"chi2/dof {label}: {_g(ratio, 4)} (AIC {_g(info['aic'], 5)}, BIC {_g(info['bic'], 5)}: "
                      "information only)")
+    lines.append("chi2/dof: against the predicted noise without the noise between segments, every static segment "
+                 "at its channel's noise (plansim fit gives a segment that scatters more its own scatter, so its "
+                 "chi2/dof differs where segments scatter unequally); the lack of fit above is the test")
     skipped, partial = d.holdout["before"]["skipped"], d.holdout["before"]["partial"]
     lines.append(f"held out: {d.holdout['after']['scheme']}" + (
         f"; {partial} of {d.before.observed.shape[0]} segments held out in part (a pose placed by hand, or the only "
