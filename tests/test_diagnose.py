@@ -835,3 +835,23 @@ def test_the_held_out_error_is_the_deletion_prediction_error_also_for_a_segment_
         values = np.append(whole[:, c], expected[c]) if c < 4 else whole[:, c]
         assert result["rms"][name] == pytest.approx(float(np.sqrt(np.mean(values ** 2))),
                                                     abs=0.05 * float(np.max(np.abs(expected))))
+
+
+def test_a_recording_the_base_model_fits_exactly_says_nothing_could_be_tested(tmp_path, capsys):
+    """One static pose (a real 10-minute MPU-6050 rest, imported without its time column, is one segment): the
+    base model fits its six means exactly, no degrees of freedom are left, and the report had read "Nothing
+    unexplained remains at segment level (p = 1)". It says the lack of fit is not testable instead."""
+    rng = np.random.default_rng(2)
+    x = rng.normal(size=(6000, 6)) * np.r_[[1e-3] * 3, [1e-2] * 3]
+    x[:, 5] += 9.81
+    x[:, :3] += np.radians([0.3, -0.2, 0.1])
+    log = tmp_path / "rest.csv"
+    np.savetxt(log, np.column_stack([np.arange(6000) / 100.0, x]), delimiter=",", header="time,gx,gy,gz,ax,ay,az",
+               comments="", fmt="%.9g")
+    assert main(["import", str(log), "--out", str(tmp_path / "rest.nc"), "--time", "time"]) == 0
+    capsys.readouterr()
+    assert main(["diagnose", str(tmp_path / "rest.nc"), "--null-draws", "50"]) == 0
+    out = capsys.readouterr().out
+    assert "not testable: the base model fits the 6 fitted means (segments × channels) exactly" in out
+    assert "Nothing at segment level could be tested (no degrees of freedom)." in out
+    assert "Nothing unexplained remains at segment level" not in out

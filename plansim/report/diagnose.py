@@ -88,6 +88,10 @@ def diagnose_report(d) -> str:
     lines.append(f"Lack of fit of the base model (segment means, simulated null): statistic {_g(lof.statistic, 5)}, "
                  f"p = {_p(lof.p_value)} -> {'FLAGGED' if lof.flagged else 'not flagged'} at "
                  f"{levels(d.alpha)['lack_of_fit']:g} (alpha = {d.alpha:g} for the whole diagnosis)")
+    if lof.dof <= 0:
+        lines.append(f"  not testable: the base model fits the {int(d.before.rows.sum())} fitted means (segments × "
+                     "channels) exactly (no degrees of freedom left), so nothing at segment level can show; more "
+                     "poses, or repeats of one, would leave some")
     if d.selected:
         lines.append(f"Found (closed testing, family-wise level {levels(d.alpha)['selections']:g}):")
         for effect in d.selected:
@@ -153,7 +157,8 @@ def diagnose_report(d) -> str:
         lines.append(f"The lack of fit, weighed against the noise estimated from this recording, flags nothing at "
                      f"segment level (p = {_p(after.p_value)}); against the stated noise:")
     else:
-        lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)}).")
+        lines.append(f"Nothing unexplained remains at segment level (p = {_p(after.p_value)})."
+                     if after.dof > 0 else "Nothing at segment level could be tested (no degrees of freedom).")
     for item in excess:
         unit, factor = _display_unit(item["channel"])
         lines.append(f"  EXCESS SCATTER in {item['channel']}: its segment means scatter {item['ratio']:.3g} times what "
