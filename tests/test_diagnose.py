@@ -855,3 +855,27 @@ def test_a_recording_the_base_model_fits_exactly_says_nothing_could_be_tested(tm
     assert "not testable: the base model fits the 6 fitted means (segments × channels) exactly" in out
     assert "Nothing at segment level could be tested (no degrees of freedom)." in out
     assert "Nothing unexplained remains at segment level" not in out
+
+
+def test_the_within_segment_findings_are_summed_up_and_a_held_poses_scatter_is_said_to_be_expected():
+    """A real hand session (five MPU-9150 sessions of github.com/mikoff/imu-calib) gave 97 within-segment findings,
+    of which the report lists 12: it now sums them up by test and channel first, and says how many of the
+    'noisier' ones are in poses the import found held by hand."""
+    from types import SimpleNamespace
+
+    from plansim.report.diagnose import _within_lines
+
+    def finding(test, channel, segment, held=False):
+        label = f"static {segment}: +z up, tilt 1.0 deg" + (", held (gyros shaking 9x their quiet noise)" if held
+                                                            else "")
+        return {"test": test, "channel": channel, "segment": segment, "label": label, "adjusted_p_value": 0.001,
+                "std": 1e-3, "slope": 1e-4, "size": 1e-3, "at_s": 1.0, "frequency_hz": 5.0, "amplitude": 1e-3,
+                "time_constant_s": 1.0, "from_s": 0.0, "to_s": 1.0}
+
+    flagged = [finding("scatter", "gx", 2, held=True), finding("scatter", "gy", 2, held=True),
+               finding("scatter", "ax", 4), finding("burst", "ax", 4), finding("periodic", "az", 6)]
+    within = SimpleNamespace(flagged=flagged, segments=list(range(10)), alpha=0.0125,
+                             smallest_adjusted_p=lambda: 0.001)
+    lines = _within_lines(SimpleNamespace(within=within))
+    assert lines[1] == "  5 finding(s) in 3 segment(s): periodic 1, burst 1, scatter 3; gx 1, gy 1, ax 2, az 1"
+    assert lines[2].startswith("  2 of the 'noisier' findings are in poses the import found held by hand")

@@ -35,6 +35,15 @@ def _within_lines(d) -> list[str]:
                 f"(smallest adjusted p = {_p(w.smallest_adjusted_p())}, level {w.alpha:g})."]
     lines = [f"UNEXPLAINED within segments (level {w.alpha:g}, family-wise over {len(w.segments)} segments, "
              f"6 channels and {len(TESTS)} tests): not named after any catalogue effect"]
+    by_test = {test: sum(item["test"] == test for item in w.flagged) for test in TESTS}
+    by_channel = {c: n for c in CHANNELS if (n := sum(item["channel"] == c for item in w.flagged))}
+    lines.append(f"  {len(w.flagged)} finding(s) in {len({item['segment'] for item in w.flagged})} segment(s): "
+                 + ", ".join(f"{test} {n}" for test, n in by_test.items() if n) + "; "
+                 + ", ".join(f"{c} {n}" for c, n in by_channel.items()))
+    held = [item for item in w.flagged if item["test"] == "scatter" and ", held (" in item["label"]]
+    if held:
+        lines.append(f"  {len(held)} of the 'noisier' findings are in poses the import found held by hand "
+                     "(held_pose): a hand that shakes, as expected")
     for item in w.flagged[:12]:
         unit, factor = _display_unit(item["channel"])
         test = item["test"]
