@@ -1538,3 +1538,35 @@ def test_a_turn_fitted_by_its_rate_must_hold_it():
     why = _unsteady(ramped)
     assert why is not None and "not steady" in why and "trim the segment" in why
     assert _unsteady(-ramped) is not None  # either sense of turn
+
+
+def test_a_moves_fit_far_from_a_units_scale_factors_is_not_read_as_a_reversed_axis():
+    """Found on real logs (a BMI160 tumble logged at 3.4 Hz with no time column; a phone's 35 s hand session): the
+    moves' fit landed on Kgxx = -2.03 with Kgyx = -0.86, or Kgyy = -0.91 with Kgyx = -0.39, and the note told the
+    user to reverse a column of good data. A negative scale factor is a reversed axis only where the block is a
+    signed identity within REVERSAL_TOLERANCE; otherwise the note says the moves were not integrated as made, and
+    to check the sample rate, not to reverse anything. A clean reversal (diag(1, -1, 1)) is still named."""
+    from plansim.fit.identify import REVERSAL_TOLERANCE, reversed_axis_notes
+
+    def estimate(**entries):
+        theta = np.full(len(PARAMETER_NAMES), math.nan)
+        for a in "xyz":
+            for b in "xyz":
+                theta[PARAMETER_INDEX[f"Kg{a}{b}"]] = 1.0 if a == b else 0.01
+        for name, v in entries.items():
+            theta[PARAMETER_INDEX[name]] = v
+        return theta
+
+    astray = reversed_axis_notes(None, estimate(Kgxx=-2.03, Kgyx=-0.86, Kgyy=-0.99))
+    assert len(astray) == 1 and "Kgxx = -2.03" in astray[0] and "Kgyx = -0.86" in astray[0]
+    assert "--sample-rate" in astray[0] and "do not reverse a column" in astray[0]
+    assert "reverse it with a leading '-'" not in astray[0]
+    cross = reversed_axis_notes(None, estimate(Kgyy=-0.908, Kgyx=-0.39))
+    assert len(cross) == 1 and "far from a unit's scale factors" in cross[0]
+    clean = reversed_axis_notes(None, estimate(Kgyy=-1.0 + REVERSAL_TOLERANCE / 2))
+    assert len(clean) == 1 and "the y gyro reads opposite" in clean[0] and "reverse it with a leading '-'" in clean[0]
+    joint = np.full(len(PARAMETER_NAMES), math.nan)
+    joint[PARAMETER_INDEX["Kaxx"]] = -0.33
+    assert reversed_axis_notes(joint, None) == [
+        "Kaxx = -0.33 (joint WLS): negative, but far from −1: not a reversed axis; check the units, --scale and the "
+        "segment table's turns and poses"]

@@ -360,6 +360,26 @@ def describe_conflict(entry: dict) -> str:
     return text
 
 
+#: a scale factor within this of ±1 and cross-couplings within this of 0 are a unit's, read with its axes' signs as
+#: logged: only then is a negative scale factor a reversed axis (a MEMS unit's scale errors are a few %, its
+#: cross-couplings 1-2 %; a moves' fit that went astray — a log sampled too slowly for its moves, a wrong sample
+#: rate — lands anywhere: Kgxx = -2.03 with Kgyx = -0.86, or Kgyy = -0.33, on a real 3 Hz tumble log)
+REVERSAL_TOLERANCE = 0.2
+
+
+def _like_signed_identity(estimate, prefix: str) -> bool:
+    """Whether the 3×3 block *prefix* (``"Kg"``, ``"Ka"``) of the (39,) *estimate* is a signed identity within
+    :data:`REVERSAL_TOLERANCE` (entries not estimated, NaN, are not held against it)."""
+    if estimate is None:
+        return False
+    for a in "xyz":
+        for b in "xyz":
+            v = float(estimate[PARAMETER_INDEX[f"{prefix}{a}{b}"]])
+            if math.isfinite(v) and abs((abs(v) - 1.0) if a == b else v) > REVERSAL_TOLERANCE:
+                return False
+    return True
+
+
 def reversed_axis_notes(joint, moves=None) -> list[str]:
     """What a negative diagonal scale factor says: an axis the log has the other way round.
 
@@ -390,6 +410,17 @@ def reversed_axis_notes(joint, moves=None) -> list[str]:
 
     gyro_moves = {a: value(moves, f"Kg{a}{a}") for a in "xyz"}
     negative = [a for a, v in gyro_moves.items() if v < 0.0]
+    if negative and not _like_signed_identity(moves, "Kg"):
+        shown = ", ".join(f"{name} = {value(moves, name):.3g}" for name in
+                          [f"Kg{a}{b}" for a in "xyz" for b in "xyz"] if math.isfinite(value(moves, name))
+                          and (name[2] == name[3] or abs(value(moves, name)) > REVERSAL_TOLERANCE))
+        notes.append(f"{shown} (moves): far from a unit's scale factors, reversed axis or not (each within "
+                     f"{REVERSAL_TOLERANCE:g} of ±1, cross-couplings within {REVERSAL_TOLERANCE:g}): the moves were "
+                     "not integrated as they were made. Check the sample rate (without a time column, --sample-rate: "
+                     "a rate off by a factor scales every turn by it), the gyro units and --scale, and that the "
+                     "moves are slow for the sample rate (a hand's turn needs tens of samples); do not reverse a "
+                     "column on this evidence")
+        negative = []
     if negative:
         shown = ", ".join(f"Kg{a}{a} = {gyro_moves[a]:.4g}" for a in negative)
         if len(negative) == 2:
@@ -411,7 +442,10 @@ def reversed_axis_notes(joint, moves=None) -> list[str]:
                              "as turned the other way; check them against what was done")
     for name in ("Kgxx", "Kgyy", "Kgzz", "Kaxx", "Kayy", "Kazz"):
         v = value(joint, name)
-        if v < 0.0 and not (name.startswith("Kg") and gyro_moves[name[2]] < 0.0):
+        if v < 0.0 and abs(v + 1.0) > REVERSAL_TOLERANCE:
+            notes.append(f"{name} = {v:.4g} (joint WLS): negative, but far from −1: not a reversed axis; check the "
+                         "units, --scale and the segment table's turns and poses")
+        elif v < 0.0 and not (name.startswith("Kg") and gyro_moves[name[2]] < 0.0):
             sensor = "gyro" if name.startswith("Kg") else "accelerometer"
             notes.append(f"{name} = {v:.4g} (joint WLS): the {name[2]} {sensor} reads the segment table's turns or "
                          "poses with the opposite sign; a sensor's axes are built parallel, so the table's sign or "
