@@ -657,6 +657,45 @@ def test_rests_shorter_than_the_detectors_are_warned_of_with_the_options_that_fi
     assert "short_rests" not in {w.name for w in import_log(log, time_column="time").warnings}
 
 
+def test_rest_variance_keeps_a_pose_noisier_than_the_quiet_stretch(tmp_path, capsys):
+    """Found on a real BMI160 six-position tumble (a ground-station log): its -x pose, 45 s with the gyros as quiet
+    as elsewhere and its means steady, has an ay noise 13 times the quietest stretch's, so the rest detector (a
+    window's variance at most 4 times the quiet stretch's per channel) cut it into a 0.9 s pose and moves. Two poses
+    of 30 s, the second's ay noise 10 times the first's: by default the second is lost; with --rest-variance 150
+    both are found, each whole, and the recording's notes keep the factor."""
+    rng = np.random.default_rng(9)
+    fs, n = 100.0, 3000
+    first = rng.normal(size=(n, 6)) * np.r_[[1e-3] * 3, [1e-2] * 3]
+    first[:, 5] += 9.81
+    second = rng.normal(size=(n, 6)) * np.r_[[1e-3] * 3, 1e-2, 1e-1, 1e-2]
+    second[:, 3] += 9.81  # +x up
+    phase = np.arange(200) / 200
+    turn = rng.normal(size=(200, 6)) * np.r_[[1e-3] * 3, [1e-2] * 3]
+    turn[:, 1] += -math.pi / 2 * fs / 200 * (1 - np.cos(2 * math.pi * phase))  # -90 deg about y: +z up to +x up
+    angle = -math.pi / 2 * (phase - np.sin(2 * math.pi * phase) / (2 * math.pi))
+    turn[:, 3] += -9.81 * np.sin(angle)
+    turn[:, 5] += 9.81 * np.cos(angle)
+    x = np.vstack([first, turn, second])
+    log = tmp_path / "noisy.csv"
+    write_synthetic(log, np.arange(x.shape[0]) / fs, x)
+
+    def statics(*options):
+        assert main(["import", str(log), "--out", str(tmp_path / "r.nc"), "--time", "time", *options]) == 0
+        capsys.readouterr()
+        recording = read_recording(tmp_path / "r.nc")
+        return recording, [s for s in recording.schedule.segments if s.test == "static"]
+
+    _, default = statics()
+    assert not any(s.up == "+x" and s.samples > 2000 for s in default)
+    recording, wider = statics("--rest-variance", "150")
+    assert [s.up for s in wider] == ["+z", "+x"] and all(s.samples > 2500 for s in wider)
+    assert recording.attrs["detector_rest_variance"] == 150.0
+    assert recording.schedule.notes["import"]["detector"]["rest_variance"] == 150.0
+    assert main(["import", str(log), "--out", str(tmp_path / "bad.nc"), "--time", "time", "--rest-variance",
+                 "0.5"]) == 2
+    assert "--rest-variance 0.5: expected a number >= 1" in capsys.readouterr().err
+
+
 def test_rows_dropped_here_and_there_are_not_gaps(tmp_path):
     """A wireless IMU loses a row now and then: 5 % of the rows dropped at random (at most two in a row kept that
     way) made every stretch hold a gap, and the log could not be imported at all. They are a named warning now; the

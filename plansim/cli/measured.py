@@ -27,7 +27,8 @@ def _cmd_import(args) -> int:
                                    for out in outputs):
             raise ValueError(f"--out {args.out!r} would overwrite the log {log!r}; write the recording elsewhere")
     columns = None if args.columns is None else tuple(name.strip() for name in args.columns.split(","))
-    options = {name: getattr(args, name) for name in ("window", "min_static") if getattr(args, name) is not None}
+    options = {name: getattr(args, name) for name in ("window", "min_static", "rest_variance")
+               if getattr(args, name) is not None}
     result = import_log(args.log, columns=columns, time_column=args.time, time_unit=args.time_unit,
                         units=args.units, scale=args.scale, offset=args.offset, sample_rate=args.sample_rate,
                         temperature_column=args.temperature_column, temperature=args.temperature,
@@ -119,6 +120,9 @@ def _add_import_command(sub) -> None:
                    help="window of the rest detector (default 0.5 s)")
     p.add_argument("--min-static", type=float, default=None, metavar="S",
                    help="shortest static pose kept (default 1 s)")
+    p.add_argument("--rest-variance", type=float, default=None, metavar="FACTOR",
+                   help="how many times the quiet stretch's variance a rest's may reach, per channel (default 4): "
+                        "raise it for a log whose poses are noisier than its quietest stretch")
     p.add_argument("--plot", default=None, metavar="FIGURE",
                    help="also draw the samples against time with the segments found shaded and numbered as in the "
                         "segment table (.png, .pdf or .svg), to review it by eye")

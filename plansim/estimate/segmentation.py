@@ -378,7 +378,8 @@ def _quiet_stretch(ratio: np.ndarray, length: int, blocked: np.ndarray) -> int:
 def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float, *,
                 window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
                 gap_starts: np.ndarray | None = None, full_scale: np.ndarray | None = None,
-                table_rate: np.ndarray | None = None, table_angle: np.ndarray | None = None) -> Segmentation:
+                table_rate: np.ndarray | None = None, table_angle: np.ndarray | None = None,
+                variance_factor: float = VARIANCE_FACTOR) -> Segmentation:
     """Find the static spans of a log and classify the motion between them (see the module docstring).
 
     Parameters
@@ -393,6 +394,10 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         Window of the moving statistics, s (at least MIN_WINDOW_SAMPLES samples are used).
     min_static : float
         Shortest static span, s.
+    variance_factor : float
+        A window is quiet where each group's summed variance ratio is at most ``variance_factor`` × 3
+        (:data:`VARIANCE_FACTOR` by default; ``plansim import --rest-variance``): raise it for a log whose poses
+        are noisier than its quietest stretch.
     gap_starts : (G,) int array or None
         Samples that follow a gap in the time axis (:func:`plansim.estimate.timebase.analyse_time`); windows do not
         reach across them.
@@ -429,6 +434,9 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     for name, value in (("window", window), ("min_static", min_static)):
         if not (value > 0 and math.isfinite(value)):
             raise ValueError(f"{name} = {value!r} s; expected a positive number of seconds")
+    if not (variance_factor >= 1.0 and math.isfinite(variance_factor)):
+        raise ValueError(f"variance_factor = {variance_factor!r}; expected a number >= 1 (a rest's variance over its "
+                         "window may reach this many times the quiet stretch's, per channel)")
     if full_scale is not None:
         full_scale = np.asarray(full_scale, dtype=np.float64)
         if full_scale.shape != (6,) or not np.all(np.isnan(full_scale) | ((full_scale > 0) & np.isfinite(full_scale))):
@@ -507,7 +515,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         ratio = np.sum(var[:, group] / sigma[group] ** 2, axis=1)
         in_quiet = ratio[quiet]
         spread = MAD_TO_SIGMA * np.median(np.abs(in_quiet - np.median(in_quiet)))
-        thresholds.append((ratio, max(VARIANCE_FACTOR * 3.0, float(np.median(in_quiet) + SPREAD_FACTOR * spread))))
+        thresholds.append((ratio, max(variance_factor * 3.0, float(np.median(in_quiet) + SPREAD_FACTOR * spread))))
     quiet_mask = ~near_gap
     for ratio, threshold in thresholds:
         quiet_mask &= ratio <= threshold
@@ -574,8 +582,9 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     if not static_runs:
         quiet_runs = _runs(quiet_mask)
         longest = max((b - a for a, b in quiet_runs), default=0)
-        why = (": quiet, but not one pose at rest (its gravity turns, or its gyros read a steady turn)"
-               if longest >= n_min else "")
+        why = (": quiet, but not taken for a rest (its gravity turns, its gyros read a steady turn, or the quietest "
+               f"stretch the noise is measured over, {QUIET_WINDOWS} windows of {w / sample_rate:.3g} s, holds motion "
+               f"besides: a shorter --window, e.g. {w / sample_rate / 2:.3g}, may find it)" if longest >= n_min else "")
         short = sum(w // 2 <= b - a < n_min for a, b in quiet_runs)
         hint = (f"; {short} quiet stretches are shorter than that: if the log's rests are, try --min-static "
                 f"{min_static / 2:.3g} --window {w / sample_rate / 2:.3g}" if short >= SHORT_QUIET_HINT else "")

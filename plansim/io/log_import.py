@@ -35,6 +35,7 @@ from plansim.estimate.segmentation import (
     DEFAULT_WINDOW,
     FULL_SCALE_MARGIN,
     TABLE_AGREEMENT,
+    VARIANCE_FACTOR,
     Segmentation,
     Span,
     segment_log,
@@ -156,6 +157,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                offset: str | None = None, sample_rate: float | None = None, temperature_column: str | None = None,
                temperature: float | None = None, latitude: float | None = None, height: float | None = None,
                window: float = DEFAULT_WINDOW, min_static: float = DEFAULT_MIN_STATIC,
+               rest_variance: float = VARIANCE_FACTOR,
                full_scale: str | None = None, accel_log: str | os.PathLike | None = None,
                table_rate_column: str | None = None, table_rate_unit: str = "deg/s",
                table_angle_column: str | None = None, table_angle_unit: str = "deg", poses: str = "hand"
@@ -215,6 +217,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         The site, deg and m, written as ``site_latitude_deg`` and ``site_height_m``.
     window, min_static : float
         The detector's window and shortest static span, s.
+    rest_variance : float
+        How many times the quiet stretch's variance a rest's may reach, per channel (``--rest-variance``; default
+        :data:`plansim.estimate.segmentation.VARIANCE_FACTOR`, 4): raise it for a log whose poses are noisier than
+        its quietest stretch (a pose on a vibrating bench, noise that depends on the pose).
     full_scale : str or None
         ``--full-scale``: each channel's full scale (the largest magnitude it reads) in ``units``, two or six
         entries; a sample within :data:`plansim.estimate.segmentation.FULL_SCALE_MARGIN` of it is at the rail.
@@ -258,6 +264,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if temperature_column is not None and temperature is not None:
         raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
                          "temperature)")
+    if isinstance(rest_variance, bool) or not isinstance(rest_variance, (int, float)) or \
+            not (rest_variance >= 1.0 and math.isfinite(rest_variance)):
+        raise ValueError(f"--rest-variance {rest_variance!r}: expected a number >= 1 (how many times the quiet "
+                         "stretch's variance a rest's may reach, per channel; default 4)")
     for option, value in (("--window", window), ("--min-static", min_static)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value > 0 and math.isfinite(value)):
             raise ValueError(f"{option} {value!r}: expected a positive number of seconds")
@@ -420,6 +430,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         if table_rate_si is None and n > 1:
             table_rate_si = np.gradient(table_angle_si) * timing.sample_rate
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
+                               variance_factor=float(rest_variance),
                                gap_starts=timing.gap_starts, full_scale=rail_si, table_rate=table_rate_si,
                                table_angle=table_angle_si)
     statics = segmentation.of_kind("static")
@@ -589,6 +600,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "detector": {
             "window_samples": segmentation.window,
             "min_static_samples": segmentation.min_static,
+            "rest_variance": float(rest_variance),
             "variance_threshold_accel": segmentation.variance_threshold[0],
             "variance_threshold_gyro": segmentation.variance_threshold[1],
             "rest_rate_threshold_rad_s": segmentation.rate_threshold.tolist(),
@@ -612,6 +624,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         else "--sample-rate (no time column: gaps and jitter cannot be seen)",
         "detector_window_s": segmentation.window / timing.sample_rate,
         "detector_min_static_s": segmentation.min_static / timing.sample_rate,
+        "detector_rest_variance": float(rest_variance),
         "import_warnings": ", ".join(dict.fromkeys(w.name for w in warnings)) or "none",
         "heading": "not known for any segment: a plain log has no heading reference",
         "poses": ("set by a table (--poses table): each axis-up pose and each turn about the vertical known to the "
