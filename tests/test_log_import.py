@@ -696,6 +696,28 @@ def test_rest_variance_keeps_a_pose_noisier_than_the_quiet_stretch(tmp_path, cap
     assert "--rest-variance 0.5: expected a number >= 1" in capsys.readouterr().err
 
 
+def test_rows_of_other_packets_without_the_six_channels_are_skipped(tmp_path):
+    """Found on a real MicroStrain CX5 log (github.com/NCSU-High-Powered-Rocketry-Club/AirbrakesV2): every other
+    row is the unit's estimate packet, its six raw channels empty and its time out of order with the raw rows'. The
+    import had stopped at the first ("column 'scaledGyroX' is '' at line 4; expected a number"); such rows are
+    skipped with a warning naming them, and the recording is the raw rows' alone."""
+    t, x = synthetic_log()
+    plain = tmp_path / "plain.csv"
+    write_synthetic(plain, t, x)
+    rows = ["time,gx,gy,gz,ax,ay,az,est"]
+    for k in range(t.size):
+        rows.append(f"{float(t[k])!r}," + ",".join(repr(float(v)) for v in x[k]) + ",")
+        if k % 2 == 0:
+            rows.append(f"{float(t[k]) - 0.5!r},,,,,,,0.25")  # the estimate packet, stamped earlier
+    mixed = tmp_path / "mixed.csv"
+    mixed.write_text("\n".join(rows) + "\n")
+    reference = import_log(plain, time_column="time")
+    result = import_log(mixed, time_column="time", columns=("gx", "gy", "gz", "ax", "ay", "az"))
+    message = {w.name: w.message for w in result.warnings}["rows_without_channels"]
+    assert message.startswith(f"{(t.size + 1) // 2} row(s) hold none of the six channel columns (lines 3, 6, 9")
+    np.testing.assert_allclose(result.recording.samples, reference.recording.samples, rtol=0, atol=1e-12)
+
+
 def test_rows_dropped_here_and_there_are_not_gaps(tmp_path):
     """A wireless IMU loses a row now and then: 5 % of the rows dropped at random (at most two in a row kept that
     way) made every stretch hold a gap, and the log could not be imported at all. They are a named warning now; the

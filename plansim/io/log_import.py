@@ -77,7 +77,8 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
                  "unclosed_motion", "held_pose", "unusual_sample_rate", "constant_channel", "dropped_samples",
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree", "frozen", "repeated_rows", "table_rate_disagrees", "table_rate_sense",
-                 "table_turning_at_rest", "table_turn_not_a_rotation", "not_a_table_pose", "short_rests")
+                 "table_turning_at_rest", "table_turn_not_a_rotation", "not_a_table_pose", "short_rests",
+                 "rows_without_channels")
 #: the quiet stretches within motion too short for a static span (``Segmentation.short_quiet``) are warned of
 #: (``short_rests``) where there are at least this many and at least as many as the static poses found: a hand
 #: session whose rests are shorter than ``--min-static`` (imu_tk's ROS2 session "data1" of GetOverMassif/imu_tk:
@@ -338,6 +339,13 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                  f"its full scale of {rails[c]:g} {unit_names[c]}; expected the range the sensor "
                                  "reads (in --units), e.g. 2000,16 with --units deg/s,g")
 
+    if table.channelless:
+        shown = ", ".join(str(k) for k in table.channelless[:GLITCHES_LISTED])
+        more = f" and {len(table.channelless) - GLITCHES_LISTED} more" if len(table.channelless) > GLITCHES_LISTED \
+            else ""
+        warnings.append(LogWarning("rows_without_channels", f"{len(table.channelless)} row(s) hold none of the six "
+                                                            f"channel columns (lines {shown}{more}): rows of the "
+                                                            "logger's other packets, skipped"))
     if table.units_row is not None:
         line, entries = table.units_row
         read = ("read as the channels' units" if units_source == "the log's row of units"

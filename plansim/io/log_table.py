@@ -95,6 +95,9 @@ class LogTable:
     #: the table's angle column (``--table-angle-column``) in the file's unit, and its name; or None
     table_angle: np.ndarray | None = None
     table_angle_column: str | None = None
+    #: lines whose six channel columns are all empty: rows of the logger's other packets (an estimate, a status),
+    #: skipped
+    channelless: tuple[int, ...] = ()
 
 
 def _split_list(text: str, option: str) -> list[str]:
@@ -353,6 +356,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         previous_stamp = 0.0
         units_row = None
         interleaved = False
+        channelless: list[int] = []  # rows with none of the six channels: other packets of the logger
         trailing: list[tuple[int, str, str]] = []  # (line, why, the error it is if a sample follows)
         for row in _rows(fh, delimiter):
             line_number += 1
@@ -398,6 +402,9 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
             # a row holding one sensor's three channels, the other's left empty: a log of two sensors sampled apart
             # in one file (every sample in a row of its own, as it came); read as NaN, paired by split_interleaved
             blank = tuple(j for j in range(n_channels) if not row[index[j]].strip())
+            if n_channels == 6 and len(blank) == 6:  # none of the six: a row of the logger's other packets
+                channelless.append(line_number)
+                continue
             if blank and n_channels == 6 and blank in ((0, 1, 2), (3, 4, 5)):
                 row = list(row)
                 for j in blank:
@@ -453,7 +460,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                     has_header, units_row, tuple((line, why) for line, why, _ in trailing),
                     clock[2] if clock else None, ((clock[0] or 0) * 86400.0 + clock[1]) if clock else None,
                     interleaved=interleaved, table_rate=table_rate, table_rate_column=table_rate_column,
-                    table_angle=table_angle, table_angle_column=table_angle_column)
+                    table_angle=table_angle, table_angle_column=table_angle_column, channelless=tuple(channelless))
 
 
 def _delimiter(line: str) -> str:
