@@ -706,7 +706,7 @@ def test_rows_of_other_packets_without_the_six_channels_are_skipped(tmp_path):
     write_synthetic(plain, t, x)
     rows = ["time,gx,gy,gz,ax,ay,az,est"]
     for k in range(t.size):
-        rows.append(f"{float(t[k])!r}," + ",".join(repr(float(v)) for v in x[k]) + ",")
+        rows.append(f"{t[k]:.12g}," + ",".join(f"{v:.12g}" for v in x[k]) + ",")  # as write_synthetic writes
         if k % 2 == 0:
             rows.append(f"{float(t[k]) - 0.5!r},,,,,,,0.25")  # the estimate packet, stamped earlier
     mixed = tmp_path / "mixed.csv"
