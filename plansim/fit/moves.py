@@ -98,6 +98,11 @@ _USED_FROM_JOINT = tuple(f"{p}{a}{b}" for p in ("Ka", "g") for a in "xyz" for b 
 G_NAMES = tuple(f"g{a}{b}" for a in "xyz" for b in "xyz")
 #: central-difference steps: a segment mean (gyro rad/s, accelerometer m/s²) and a joint parameter (SI)
 _STEP_GYRO, _STEP_ACCEL, _STEP_PARAMETER = 1e-7, 1e-6, 1e-7
+#: where the moves' integrated angles disagree with the poses, the sample rate is a cause as likely as the units:
+#: without a time column it is --sample-rate's, and a rate off by a factor scales every angle by it (a real tumble
+#: log read at 10 Hz for 3.36 Hz turned each 90° turn into 30°)
+SAMPLE_RATE_HINT = ("the sample rate (a log without a time column is read at --sample-rate: a rate off by a factor "
+                    "scales every integrated angle by it)")
 #: two moves or fewer cannot identify anything (each gives two numbers)
 MIN_TRANSITIONS = 2
 #: the first solve starts from Kg = diag(±1, ±1, ±1), each sign pattern, and keeps the smallest χ²
@@ -224,7 +229,8 @@ def _solve_information(information: np.ndarray, right: np.ndarray, Kg: np.ndarra
             "the moves between poses were left out: at the gyro scale factors that fit them best "
             f"({_shown_kg(Kg)}) they do not identify them — the angles the gyros integrate over the moves do not "
             "agree with the change of gravity between the poses. Check the gyros' --units (deg/s or rad/s), "
-            "--columns and the axes' signs, and that the segment table's moves are whole turns between the poses")
+            "--columns and the axes' signs, " + SAMPLE_RATE_HINT + ", and that the segment table's moves are whole "
+            "turns between the poses")
     return np.linalg.solve(information, right)
 
 
@@ -732,7 +738,7 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
             raise MovesNotFitted("the moves between poses were left out: from every start, the search for the gyro "
                                  "scale factors that fit them stepped onto a singular Kg — the angles the gyros "
                                  "integrate over the moves do not agree with the change of gravity between the poses. "
-                                 "Check the gyros' --units, --columns and signs")
+                                 "Check the gyros' --units, --columns and signs, and " + SAMPLE_RATE_HINT)
 
         def polish(result):  # a start screened only (SCREEN_EVALUATIONS, not converged): on to the full budget
             if result is None or result.status != 0 or result.nfev >= MAX_EVALUATIONS:
@@ -801,8 +807,8 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
                                  f"{math.degrees(math.sqrt(dark)):.3g} deg per component beyond their noise (more than "
                                  f"{math.degrees(MOVES_SCATTER_LIMIT):g} deg: a hand session's miss by a fraction of a "
                                  "degree) — the angles the gyros integrate over the moves do not agree with the poses. "
-                                 "Check the gyros' --units, --columns and signs, and whether the moves hold motion the "
-                                 "log does not (the unit turned over inside a time gap)")
+                                 "Check the gyros' --units, --columns and signs, " + SAMPLE_RATE_HINT + ", and whether "
+                                 "the moves hold motion the log does not (the unit turned over inside a time gap)")
         sources, jacobian, angles = build(Kg, dark)
         V = sources.covariance()
         # a combination the fitted moves, with their noise between moves, still determine only weakly (a cross-coupling
@@ -865,7 +871,8 @@ def fit_moves(recording, fit, transitions, unused, noise, progress=None) -> Move
                      + ", ".join(f"{Kg[a, a]:+.4g}" for a in scaled) + "): "
                      + ("a factor of 180/π from 1, the gyros' units mistaken (deg/s read as rad/s, or the reverse; "
                         "check --units)" if degrees else
-                        "check the gyros' --units and --scale, and that the moves are whole turns between the poses"))
+                        "check the gyros' --units and --scale, " + SAMPLE_RATE_HINT + ", and that the moves are whole "
+                        "turns between the poses"))
     if dark > 0:
         notes.append(f"the moves' residuals scatter beyond the predicted noise: {math.degrees(math.sqrt(dark)):.3g} "
                      "deg per component between moves, estimated from them, enters every u (kind 'between')")
