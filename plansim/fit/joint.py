@@ -75,9 +75,10 @@ METHOD_JOINT = "joint_wls"
 class AccelShear:
     """One pair of the accelerometers' cross-couplings (Ka_ij, Ka_ji) with poses placed by hand: their symmetric
     part (Ka_ij + Ka_ji)/2, a shear of the triad (its antisymmetric part is a rotation of the triad, which the
-    poses' tilts take up whole). ``determined``: the poses' tilts (second order) let the fit estimate it, and
-    ``estimate`` ± ``u`` is that estimate; otherwise it is held at 0 with ``u`` its Type B standard uncertainty
-    (a bound from the fitted tilts, or the data sheet's). Dimensionless."""
+    poses' tilts take up whole). ``determined``: the poses, spread over the sphere, let the fit estimate it (the
+    combination is estimable), and ``estimate`` ± ``u`` is that estimate; otherwise (poses near the body axes) it
+    is held at 0 with ``u`` its Type B standard uncertainty (a bound from the fitted tilts, or the data sheet's).
+    Dimensionless."""
 
     first: str
     second: str
