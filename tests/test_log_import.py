@@ -681,11 +681,12 @@ def test_rest_variance_keeps_a_pose_noisier_than_the_quiet_stretch(tmp_path, cap
 
     def statics(*options):
         assert main(["import", str(log), "--out", str(tmp_path / "r.nc"), "--time", "time", *options]) == 0
-        capsys.readouterr()
+        statics.out = capsys.readouterr().out
         recording = read_recording(tmp_path / "r.nc")
         return recording, [s for s in recording.schedule.segments if s.test == "static"]
 
     _, default = statics()
+    assert "a pose noisier than the quiet stretch above needs --rest-variance" in statics.out  # the summary says
     assert not any(s.up == "+x" and s.samples > 2000 for s in default)
     recording, wider = statics("--rest-variance", "150")
     assert [s.up for s in wider] == ["+z", "+x"] and all(s.samples > 2500 for s in wider)

@@ -587,7 +587,8 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
                f"besides: a shorter --window, e.g. {w / sample_rate / 2:.3g}, may find it)" if longest >= n_min else "")
         short = sum(w // 2 <= b - a < n_min for a, b in quiet_runs)
         hint = (f"; {short} quiet stretches are shorter than that: if the log's rests are, try --min-static "
-                f"{min_static / 2:.3g} --window {w / sample_rate / 2:.3g}" if short >= SHORT_QUIET_HINT else "")
+                f"{min_static / 2:.3g} --window {w / sample_rate / 2:.3g}" if short >= SHORT_QUIET_HINT else
+                "; if the log's rests are noisier than its quietest stretch, try --rest-variance (default 4)")
         raise ValueError(f"too few static samples: no span at rest of at least {min_static:g} s ({n_min} samples) "
                          f"was found; the longest quiet stretch has {longest} samples ({longest / sample_rate:.3g} "
                          f"s){why}. Quiet: summed variance ratios <= {variance_threshold[0]:.3g} (accelerometers) "

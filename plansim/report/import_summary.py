@@ -80,7 +80,9 @@ def format_summary(result: ImportResult) -> str:
     lines.append(f"  at rest: variance ratios <= {seg.variance_threshold[0]:.3g} (accelerometers), "
                  f"{seg.variance_threshold[1]:.3g} (gyros) over {seg.window} samples "
                  f"({seg.window / timing.sample_rate:.3g} s), for at least {seg.min_static / timing.sample_rate:.3g} "
-                 f"s; a quiet stretch turning faster than {rate} deg/s (x y z) is a steady turn")
+                 f"s; a quiet stretch turning faster than {rate} deg/s (x y z) is a steady turn (--window, "
+                 "--min-static and --rest-variance change these: a pose noisier than the quiet stretch above needs "
+                 "--rest-variance)")
     counts = {kind: len(seg.of_kind(kind)) for kind in ("static", "rotation", "move")}
     lines.append(f"  segments: {counts['static']} static, {counts['rotation']} rotation, {counts['move']} move")
     lines.append(f"  {'#':>3}  {'test':8s}  {'lines':>13s}  {'duration':>9s}  label")
