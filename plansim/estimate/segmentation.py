@@ -585,7 +585,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         why = (": quiet, but not taken for a rest (its gravity turns, its gyros read a steady turn, or the quietest "
                f"stretch the noise is measured over, {QUIET_WINDOWS} windows of {w / sample_rate:.3g} s, holds motion "
                f"besides: a shorter --window, e.g. {w / sample_rate / 2:.3g}, may find it)" if longest >= n_min else "")
-        short = sum(w // 2 <= b - a < n_min for a, b in quiet_runs)
+        short = len(_short_quiet(quiet_runs, w, n_min))
         hint = (f"; {short} quiet stretches are shorter than that: if the log's rests are, try --min-static "
                 f"{min_static / 2:.3g} --window {w / sample_rate / 2:.3g}" if short >= SHORT_QUIET_HINT else
                 "; if the log's rests are noisier than its quietest stretch, try --rest-variance (default 4)")
@@ -654,9 +654,15 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     for span in spans:
         if span.kind != "static":
             in_motion[span.start:span.stop] = True
-    short_quiet = tuple((a, b) for a, b in _runs(quiet_mask) if w // 2 <= b - a < n_min and in_motion[a:b].all())
+    short_quiet = tuple((a, b) for a, b in _short_quiet(_runs(quiet_mask), w, n_min) if in_motion[a:b].all())
     return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
                         tuple(steady), tuple(np.flatnonzero(glitch).tolist()), tuple(frozen), short_quiet)
+
+
+def _short_quiet(runs: list[tuple[int, int]], w: int, n_min: int) -> list[tuple[int, int]]:
+    """The quiet *runs* too short for a static span (``min_static``, *n_min* samples) but at least half a window
+    (*w* samples) long: rests a hand paused for, which a shorter ``--min-static`` and ``--window`` would take."""
+    return [(a, b) for a, b in runs if w // 2 <= b - a < n_min]
 
 
 def _cut_at_glitch(glitch: np.ndarray, w: int, before: Span | None, after: Span | None) -> bool:

@@ -48,7 +48,9 @@ def chi2_quantile(dof: int, probability: float) -> float:
     return float(chdtri(dof, 1.0 - probability))
 
 
-def chi2_verdict(chi2: float, dof: int) -> str:
+def chi2_verdict(chi2: float, dof: int, next_step: str = "") -> str:
+    """The verdict on χ² with *dof* degrees of freedom; *next_step*, where given, is said after a flag of residuals
+    larger than predicted (where to look next)."""
     from scipy.special import chdtrc
 
     if dof <= 0:
@@ -56,7 +58,8 @@ def chi2_verdict(chi2: float, dof: int) -> str:
     upper = float(chdtrc(dof, chi2))  # P(χ² ≥ observed)
     if upper < CHI2_FLAG_PROBABILITY / 2:
         return (f"the residuals are larger than the estimated noise and table errors predict (P = {upper:.2g}): "
-                "an effect the model lacks, or noise that does not average down")
+                "an effect the model lacks, or noise that does not average down" + (f" ({next_step})" if next_step
+                                                                                     else ""))
     if upper > 1 - CHI2_FLAG_PROBABILITY / 2:
         return f"the residuals are smaller than predicted (P = {1 - upper:.2g} of so small a χ²): the stated " \
                "uncertainties may be too large"

@@ -154,6 +154,13 @@ class Identifiability:
         """(39,) True where identified."""
         return np.array([name in self.identified for name in PARAMETER_NAMES])
 
+    def outside_row_space(self, scaled: np.ndarray) -> float:
+        """The part of *scaled* (39 + n, in the column-scaled coordinates) outside the determined combinations'
+        row space, relative to its length (0: wholly within it)."""
+        size = float(np.linalg.norm(scaled))
+        within = self.row_space.T @ (self.row_space @ scaled)
+        return float(np.linalg.norm(scaled - within)) / size if size > 0 else 0.0
+
     @property
     def basis(self) -> np.ndarray:
         """(39 + n, rank): (θ, nuisance) − their start = basis · z spans exactly what the segments determine."""
@@ -365,6 +372,11 @@ def describe_conflict(entry: dict) -> str:
 #: cross-couplings 1-2 %; a moves' fit that went astray — a log sampled too slowly for its moves, a wrong sample
 #: rate — lands anywhere: Kgxx = -2.03 with Kgyx = -0.86, or Kgyy = -0.33, on a real 3 Hz tumble log)
 REVERSAL_TOLERANCE = 0.2
+#: where the gyros' integrated angles disagree with the poses, the sample rate is a cause as likely as the units:
+#: without a time column it is --sample-rate's, and a rate off by a factor scales every angle by it (a real tumble
+#: log read at 10 Hz for 3.36 Hz turned each 90° turn into 30°)
+SAMPLE_RATE_HINT = ("the sample rate (a log without a time column is read at --sample-rate: a rate off by a factor "
+                    "scales every integrated angle by it)")
 
 
 def _like_signed_identity(estimate, prefix: str) -> bool:
@@ -411,15 +423,14 @@ def reversed_axis_notes(joint, moves=None) -> list[str]:
     gyro_moves = {a: value(moves, f"Kg{a}{a}") for a in "xyz"}
     negative = [a for a, v in gyro_moves.items() if v < 0.0]
     if negative and not _like_signed_identity(moves, "Kg"):
-        shown = ", ".join(f"{name} = {value(moves, name):.3g}" for name in
-                          [f"Kg{a}{b}" for a in "xyz" for b in "xyz"] if math.isfinite(value(moves, name))
-                          and (name[2] == name[3] or abs(value(moves, name)) > REVERSAL_TOLERANCE))
+        entries = {f"Kg{a}{b}": value(moves, f"Kg{a}{b}") for a in "xyz" for b in "xyz"}
+        shown = ", ".join(f"{name} = {v:.3g}" for name, v in entries.items()
+                          if math.isfinite(v) and (name[2] == name[3] or abs(v) > REVERSAL_TOLERANCE))
         notes.append(f"{shown} (moves): far from a unit's scale factors, reversed axis or not (each within "
                      f"{REVERSAL_TOLERANCE:g} of ±1, cross-couplings within {REVERSAL_TOLERANCE:g}): the moves were "
-                     "not integrated as they were made. Check the sample rate (without a time column, --sample-rate: "
-                     "a rate off by a factor scales every turn by it), the gyro units and --scale, and that the "
-                     "moves are slow for the sample rate (a hand's turn needs tens of samples); do not reverse a "
-                     "column on this evidence")
+                     f"not integrated as they were made. Check {SAMPLE_RATE_HINT}, the gyro units and --scale, and "
+                     "that the moves are slow for the sample rate (a hand's turn needs tens of samples); do not "
+                     "reverse a column on this evidence")
         negative = []
     if negative:
         shown = ", ".join(f"Kg{a}{a} = {gyro_moves[a]:.4g}" for a in negative)

@@ -69,6 +69,9 @@ from plansim.units import STANDARD_GRAVITY, to_unit
 
 METHOD_SPEC = "jjf2003"
 METHOD_JOINT = "joint_wls"
+#: where the segment means' χ² flags residuals larger than predicted, what tests them further
+DIAGNOSE_NEXT = ("plansim diagnose tests the residuals against a simulated null that holds the noise between "
+                 "segments, and names an effect where one explains them")
 
 
 @dataclass(frozen=True)
@@ -487,20 +490,9 @@ def _held_cross_couplings(ident: Identifiability, J: np.ndarray) -> list[tuple[i
         size = float(np.linalg.norm(scaled))
         if size == 0.0 or not np.any(J[:, i] + J[:, j]):
             continue
-        within = ident.row_space.T @ (ident.row_space @ scaled)
-        if float(np.linalg.norm(scaled - within)) > NULL_TOLERANCE * size:
+        if ident.outside_row_space(scaled) > NULL_TOLERANCE:
             out.append((i, j))
     return out
-
-
-def _segments_verdict(chi2: float, dof: int) -> str:
-    """The χ²/dof verdict of the segment means (:func:`plansim.fit.budget.chi2_verdict`), with where to go next
-    when it flags residuals larger than predicted."""
-    verdict = chi2_verdict(chi2, dof)
-    if verdict.startswith("the residuals are larger"):
-        verdict += (" (plansim diagnose tests the residuals against a simulated null that holds the noise "
-                    "between segments, and names an effect where one explains them)")
-    return verdict
 
 
 def _accel_shear(ident: Identifiability, mask, theta, gain, sources: Sources, held: list, bound: list, J,
@@ -520,9 +512,7 @@ def _accel_shear(ident: Identifiability, mask, theta, gain, sources: Sources, he
         c = np.zeros(ident.scale.size)
         c[[a, b]] = 0.5
         scaled = np.divide(c, ident.scale, out=np.zeros_like(c), where=ident.scale > 0)
-        within = ident.row_space.T @ (ident.row_space @ scaled)
-        estimable = bool(np.all(ident.scale[[a, b]] > 0)) and \
-            float(np.linalg.norm(scaled - within)) <= NULL_TOLERANCE * float(np.linalg.norm(scaled))
+        estimable = bool(np.all(ident.scale[[a, b]] > 0)) and ident.outside_row_space(scaled) <= NULL_TOLERANCE
         if estimable:
             others = Sources(sources.size)
             for pair, u in held_u.items():
@@ -1057,7 +1047,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                      unused=unused, labels=tuple(s.label for s in used_schedule.segments), observed=observed,
                      fitted=fitted, residual_sd=residual_sd, noise=noise, joint=joint, spec=spec,
                      spec_note=spec_note, spec_bias=spec_bias, chi2=chi2, chi2_dof=chi2_dof,
-                     chi2_verdict=_segments_verdict(chi2, chi2_dof), between=between,
+                     chi2_verdict=chi2_verdict(chi2, chi2_dof, DIAGNOSE_NEXT), between=between,
                      attrs=dict(getattr(recording, "attrs", {}) or {}), notes=tuple(notes) + noise.notes,
                      model=model, theta=np.asarray(theta, dtype=float), nuisance=np.asarray(tilts, dtype=float),
                      covariance=V, whitening=W, design=design, rows=rows,

@@ -82,7 +82,7 @@ from plansim.estimate.segmentation import SATURATION_STEP, stuck_runs
 from plansim.estimate.timebase import GAP_FACTOR
 from plansim.fit.between import BETWEEN_LR_THRESHOLD
 from plansim.fit.budget import Sources, chi2_verdict, propagate
-from plansim.fit.identify import UNINFORMATIVE_U, Identifiability, identifiability
+from plansim.fit.identify import SAMPLE_RATE_HINT, UNINFORMATIVE_U, Identifiability, identifiability
 from plansim.kernels.trajectory import integrate_rotation, rotate
 from plansim.model.environment import EARTH_RATE
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES
@@ -98,11 +98,6 @@ _USED_FROM_JOINT = tuple(f"{p}{a}{b}" for p in ("Ka", "g") for a in "xyz" for b 
 G_NAMES = tuple(f"g{a}{b}" for a in "xyz" for b in "xyz")
 #: central-difference steps: a segment mean (gyro rad/s, accelerometer m/s²) and a joint parameter (SI)
 _STEP_GYRO, _STEP_ACCEL, _STEP_PARAMETER = 1e-7, 1e-6, 1e-7
-#: where the moves' integrated angles disagree with the poses, the sample rate is a cause as likely as the units:
-#: without a time column it is --sample-rate's, and a rate off by a factor scales every angle by it (a real tumble
-#: log read at 10 Hz for 3.36 Hz turned each 90° turn into 30°)
-SAMPLE_RATE_HINT = ("the sample rate (a log without a time column is read at --sample-rate: a rate off by a factor "
-                    "scales every integrated angle by it)")
 #: two moves or fewer cannot identify anything (each gives two numbers)
 MIN_TRANSITIONS = 2
 #: the first solve starts from Kg = diag(±1, ±1, ±1), each sign pattern, and keeps the smallest χ²
