@@ -59,3 +59,25 @@ def test_elsewhere_each_report_is_a_whole_line_at_most_every_interval(monkeypatc
     assert not progress.progress_line_open()  # nothing for end_progress_line to end
     progress.end_progress_line()
     assert stream.getvalue().count("\n") == expected
+
+
+def test_validates_block_progress_and_diagnose_checks_use_the_same_lines(monkeypatch, clock, capsys):
+    """``plansim validate``'s block progress and ``plansim diagnose-check``'s progress wrote their own carriage-return
+    redraws; they now go through the one writer (progress_writer): off a terminal, whole lines, none left open."""
+    from plansim.report.validation import stderr_block_progress
+
+    stream = io.StringIO()
+    monkeypatch.setattr(progress.sys, "stderr", stream)
+    report = stderr_block_progress("plansim validate x")
+    for blocks in (1, 2, 3):
+        clock[0] += 6.0
+        report(1000 * blocks, blocks, 2.0 / blocks)
+    text = stream.getvalue()
+    assert "\r" not in text and text.count("\n") == 2  # the first report, and one 12 s later (LOG_INTERVAL 10 s)
+    assert text.startswith("plansim validate x: 1 blocks, 1000 trials, max 2s/δ = 2")
+    assert not progress.progress_line_open()
+    terminal = _Terminal()
+    monkeypatch.setattr(progress.sys, "stderr", terminal)
+    stderr_block_progress("plansim validate x")(1000, 1, 2.0)
+    assert terminal.getvalue().startswith("\rplansim validate x") and progress.progress_line_open()
+    progress.end_progress_line()

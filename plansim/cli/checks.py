@@ -12,7 +12,7 @@ from plansim.io.files import OutputSet, check_output_path
 def _cmd_diagnose_check(args) -> int:
     from plansim.checks.diagnose_check import check_json, run_diagnose_check
     from plansim.io.scenario_file import load_scenario
-    from plansim.report.progress import end_progress_line
+    from plansim.report.progress import end_progress_line, stderr_progress
 
     if args.out is not None:
         check_output_path(args.out, "--out", (".json",))
@@ -23,15 +23,9 @@ def _cmd_diagnose_check(args) -> int:
     scenario = load_scenario(args.scenario)
     effects = None if args.effects is None else tuple(e.strip() for e in args.effects.split(",") if e.strip())
 
-    def progress(done, total):
-        if not args.quiet:
-            print(f"\rplansim diagnose-check {scenario.name}: {done}/{total} recordings", end="", file=sys.stderr,
-                  flush=True)
-
+    progress = None if args.quiet else stderr_progress(f"plansim diagnose-check {scenario.name}", unit="recordings")
     report = run_diagnose_check(scenario, null=args.null, per_effect=args.per_effect, sizes=sizes, alpha=args.alpha,
                                 seed=args.seed, null_draws=args.null_draws, progress=progress, effects=effects)
-    if not args.quiet:
-        print(file=sys.stderr)
     end_progress_line()
     data = check_json(report)
     with OutputSet() as outputs:

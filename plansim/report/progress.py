@@ -44,25 +44,16 @@ def end_progress_line() -> None:
         mark_progress_line(False)
 
 
-def stderr_progress(label: str = "simulating", unit: str = "trials") -> ProgressCallback:
-    """A progress line on stderr, redrawn in place: *unit* (trials, cells) done / total, rate, time left; with a
-    total of None (a search that does not know its length) done, rate and time so far."""
-    start = time.perf_counter()
+def progress_writer() -> Callable[..., None]:
+    """``write(text, finished=False)``: one progress report on stderr. On a terminal *text* is redrawn in place
+    and the line kept open (:func:`mark_progress_line`) until *finished*; elsewhere each report is a whole line, the
+    first, then at most one per :data:`LOG_INTERVAL` seconds, and the *finished* one (module docstring)."""
     terminal = _is_terminal(sys.stderr)
     last = [-math.inf]  # when the last whole line was written (not on a terminal)
 
-    def report(done: int, total: int | None) -> None:
-        now = time.perf_counter()
-        elapsed = now - start
-        rate = done / elapsed if elapsed > 0 else float("nan")
-        shown = f"{rate:,.0f}" if rate >= 10 else f"{rate:.1f}"
-        finished = total is not None and done >= total
-        if total is None:  # a search: how much is done, not how much is left
-            text = f"{label}: {done} {unit} ({shown}/s, {elapsed:4.0f} s)"
-        else:
-            left = (total - done) / rate if rate > 0 else float("nan")
-            text = f"{label}: {done}/{total} {unit} ({shown}/s, {left:4.0f} s left)"
+    def write(text: str, finished: bool = False) -> None:
         if not terminal:
+            now = time.perf_counter()
             if finished or now - last[0] >= LOG_INTERVAL:
                 last[0] = now
                 sys.stderr.write(text + "\n")
@@ -74,6 +65,25 @@ def stderr_progress(label: str = "simulating", unit: str = "trials") -> Progress
         sys.stderr.write(f"\r{text}   " + ("\n" if finished else ""))
         sys.stderr.flush()
         mark_progress_line(not finished)
+
+    return write
+
+
+def stderr_progress(label: str = "simulating", unit: str = "trials") -> ProgressCallback:
+    """A progress line on stderr (:func:`progress_writer`): *unit* (trials, cells) done / total, rate, time left;
+    with a total of None (a search that does not know its length) done, rate and time so far."""
+    start = time.perf_counter()
+    write = progress_writer()
+
+    def report(done: int, total: int | None) -> None:
+        elapsed = time.perf_counter() - start
+        rate = done / elapsed if elapsed > 0 else float("nan")
+        shown = f"{rate:,.0f}" if rate >= 10 else f"{rate:.1f}"
+        if total is None:  # a search: how much is done, not how much is left
+            write(f"{label}: {done} {unit} ({shown}/s, {elapsed:4.0f} s)")
+            return
+        left = (total - done) / rate if rate > 0 else float("nan")
+        write(f"{label}: {done}/{total} {unit} ({shown}/s, {left:4.0f} s left)", finished=done >= total)
 
     return report
 

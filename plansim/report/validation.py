@@ -8,13 +8,12 @@ for programs (:func:`validation_json`, strict JSON).
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
 
 from plansim.model.parameters import N_PARAMETERS, PARAMETER_INDEX, PARAMETER_NAMES, parameter
-from plansim.report.progress import mark_progress_line
+from plansim.report.progress import progress_writer
 from plansim.uncertainty.budget import ParameterBudget
 from plansim.uncertainty.jjf1535_validation import Jjf1535ValidationReport
 from plansim.uncertainty.metrology.coverage import COVERAGE_Z
@@ -296,29 +295,22 @@ def format_report(report: ValidationReport, details: bool = True) -> str:
 
 
 def validate_progress(label: str, quiet: bool):
-    """``plansim validate``'s progress: None if *quiet*, else :func:`stderr_block_progress` (*label*) marking the
-    progress line open until the report starts (:func:`plansim.report.progress.mark_progress_line`)."""
-    if quiet:
-        return None
-    block_progress = stderr_block_progress(label)
-
-    def progress(*state) -> None:
-        block_progress(*state)
-        mark_progress_line(True)
-
-    return progress
+    """``plansim validate``'s progress: None if *quiet*, else :func:`stderr_block_progress` (*label*), whose line
+    on a terminal stays open until the report starts (:func:`plansim.report.progress.progress_writer`)."""
+    return None if quiet else stderr_block_progress(label)
 
 
 def stderr_block_progress(label: str):
-    """A progress line on stderr for the adaptive Monte Carlo, redrawn in place after each block.
+    """A progress line on stderr for the adaptive Monte Carlo after each block
+    (:func:`plansim.report.progress.progress_writer`: redrawn in place on a terminal, whole lines elsewhere).
 
     Returns ``report(trials_done, blocks, worst)``, ``worst`` the largest ``2s/δ`` (stop at ≤ 1).
     """
     start = time.perf_counter()
+    write = progress_writer()
 
     def report(done: int, blocks: int, worst: float) -> None:
         elapsed = time.perf_counter() - start
-        sys.stderr.write(f"\r{label}: {blocks} blocks, {done} trials, max 2s/δ = {worst:.3g} ({elapsed:.0f} s)   ")
-        sys.stderr.flush()
+        write(f"{label}: {blocks} blocks, {done} trials, max 2s/δ = {worst:.3g} ({elapsed:.0f} s)")
 
     return report
