@@ -661,8 +661,9 @@ def test_rest_variance_keeps_a_pose_noisier_than_the_quiet_stretch(tmp_path, cap
     """Found on a real BMI160 six-position tumble (a ground-station log): its -x pose, 45 s with the gyros as quiet
     as elsewhere and its means steady, has an ay noise 13 times the quietest stretch's, so the rest detector (a
     window's variance at most 4 times the quiet stretch's per channel) cut it into a 0.9 s pose and moves. Two poses
-    of 30 s, the second's ay noise 10 times the first's: by default the second is lost; with --rest-variance 150
-    both are found, each whole, and the recording's notes keep the factor."""
+    of 30 s, the second's ay noise 10 times the first's: by default the second is lost, and the warning
+    ``noisy_poses`` names it and the --rest-variance that keeps it; with that factor both are found, each whole, with
+    no warning, and the recording's notes keep the factor."""
     rng = np.random.default_rng(9)
     fs, n = 100.0, 3000
     first = rng.normal(size=(n, 6)) * np.r_[[1e-3] * 3, [1e-2] * 3]
@@ -688,10 +689,17 @@ def test_rest_variance_keeps_a_pose_noisier_than_the_quiet_stretch(tmp_path, cap
     _, default = statics()
     assert "a pose noisier than the quiet stretch above needs --rest-variance" in statics.out  # the summary says
     assert not any(s.up == "+x" and s.samples > 2000 for s in default)
-    recording, wider = statics("--rest-variance", "150")
+    # the import tells on its own (step 11 of the detector), with the factor that keeps the pose whole
+    warned = re.search(r"warning \[noisy_poses\]: 1 stretch\(es\) inside the motion, (\S+) s in all \(lines "
+                       r"\S+ \(\S+ s, \+x up\)\).*a rest may reach 4\).*import again with --rest-variance (\S+) ",
+                       statics.out)
+    assert warned and float(warned.group(1)) > 25.0, statics.out
+    factor = warned.group(2)
+    recording, wider = statics("--rest-variance", factor)
     assert [s.up for s in wider] == ["+z", "+x"] and all(s.samples > 2500 for s in wider)
-    assert recording.attrs["detector_rest_variance"] == 150.0
-    assert recording.schedule.notes["import"]["detector"]["rest_variance"] == 150.0
+    assert "noisy_poses" not in statics.out
+    assert recording.attrs["detector_rest_variance"] == float(factor)
+    assert recording.schedule.notes["import"]["detector"]["rest_variance"] == float(factor)
     assert main(["import", str(log), "--out", str(tmp_path / "bad.nc"), "--time", "time", "--rest-variance",
                  "0.5"]) == 2
     assert "--rest-variance 0.5: expected a number >= 1" in capsys.readouterr().err

@@ -553,3 +553,38 @@ def test_the_rate_of_a_quantised_jittery_clock_is_its_mean_rate():
     report = analyse_time(gapped, gapped.size)
     assert report.sample_rate == pytest.approx(99.7, abs=0.01)
     assert [k for k, _ in report.gaps] == [3000] and report.missing_samples == 200
+
+
+def test_a_pose_noisier_than_the_quiet_stretch_is_reported_and_sessions_without_one_are_not():
+    """Step 11 (found on a real BMI160 tumble whose -x pose had an ay noise 13 times its quiet stretch's, cut by the
+    rest detector into a 0.9 s pose and moves, with no word of it): a table log of two poses, the second's ay noise 5
+    times the first's, is reported once, with its up axis, the whole of the noisy pose (less a window at each end)
+    and a factor that keeps it whole when given as variance_factor. Ten simulated hand sessions of a consumer unit
+    (12-31 poses, moves of 3 s) give no report: on 40 such sessions (seeds 0-39, 2026-12-01) none gave one; a
+    report rate of 10 % per session would show here with probability 1 - 0.9^10 = 0.65."""
+    from plansim.simulate.hand_session import consumer_unit, hand_session, spread_poses
+
+    rng = np.random.default_rng(21)
+    first = static_noise("white", 30.0, rng)
+    second = static_noise("white", 30.0, rng)
+    second[:, 3:] = second[:, 3:] - np.r_[0.05, -0.02, 9.81] + np.r_[9.81, 0.0, 0.0]  # +x up
+    second[:, 4] = 0.05 * rng.standard_normal(second.shape[0])  # ay: 5 times the noise
+    phase = np.arange(200) / 200
+    turn = static_noise("white", 2.0, rng)
+    turn[:, 1] += -math.pi / 2 * FS / 200 * (1 - np.cos(2 * math.pi * phase))  # -90 deg about y: +z up to +x up
+    angle = -math.pi / 2 * (phase - np.sin(2 * math.pi * phase) / (2 * math.pi))
+    turn[:, 3] += -9.81 * np.sin(angle) - 0.05
+    turn[:, 5] += 9.81 * np.cos(angle) - 9.81
+    x = np.vstack([first, turn, second])
+    result = segment_log(x, None, FS)
+    assert [s.up for s in result.of_kind("static")] == ["+z"]
+    (noisy,) = result.noisy_poses
+    w = result.window
+    assert noisy.up == "+x" and 3200 <= noisy.start <= 3200 + 2 * w and x.shape[0] - 2 * w <= noisy.stop
+    wider = segment_log(x, None, FS, variance_factor=1.2 * noisy.factor)
+    assert [s.up for s in wider.of_kind("static")] == ["+z", "+x"] and wider.noisy_poses == ()
+    assert wider.of_kind("static")[1].samples >= 3000 - 2 * w
+    for seed in range(10):
+        theta, poses = consumer_unit(seed), spread_poses(12 + 2 * seed, seed=seed)
+        s = hand_session(theta, poses, seed=seed, gyro_noise=8.7e-4, accel_noise=9.8e-3)
+        assert segment_log(s.samples, s.time, FS).noisy_poses == (), seed

@@ -104,6 +104,15 @@ The method, step by step (*w* samples in a window, at least ``MIN_WINDOW_SAMPLES
     Where the channel's **full scale is declared** (``full_scale``), the rule is that instead: every sample at or
     beyond ``1 − FULL_SCALE_MARGIN`` of the full scale in magnitude is at the rail, one sample or many, in a pose
     or in a turn — a steady turn held at the rail included.
+11. **Poses noisier than the quiet stretch** (:func:`noisy_poses`, reported, not taken). Within the motion, a
+    stretch of at least ``max(min_static, 2 w)`` where the means of every two adjacent windows agree within
+    ``STATIONARY_FACTOR`` (or the quiet stretch's median plus ``SPREAD_FACTOR`` robust standard deviations of that
+    statistic, if larger) times their own noise, √((s²₁ + s²₂)/w), which holds one pose by the test of step 5 with
+    its own noise in place of the quiet stretch's, and whose mean gyro output is a rest's by the test of step 6 (its
+    threshold widened to its own window noise where that is larger) looks like a pose held on a vibrating bench or
+    with noise that depends on the pose. Its largest summed variance ratio over 3 is the ``variance_factor`` that
+    would keep it whole. It is reported (``Segmentation.noisy_poses``) and left as motion: the user decides, since a
+    hand holding the unit still is as steady.
 
 Every threshold is a multiple of the log's own noise; the multiples are module constants, chosen by
 simulation (tests/test_segmentation.py measures their false alarms on static noise of several kinds).
@@ -116,6 +125,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.stats
 
 from plansim.estimate.frozen import Frozen, frozen_mask, frozen_runs
 from plansim.estimate.rests import SAME_POSE, at_rest_against, first_rest, rests_by_g_sensitivity
@@ -176,6 +186,10 @@ GLITCH_RATIO = 5.0
 #: ... while that variation is at most this many times the largest in the quiet stretch (and at least 10 σ): the
 #: neighbours are quiet (a knock in a hand-made move, one sample wide, is motion, not a glitch)
 GLITCH_QUIET = 2.0
+#: step 11: two adjacent windows' means agree when they differ by at most this many times their own noise
+STATIONARY_FACTOR = 6.0
+#: ... and their variances agree, channel by channel, to within the F distribution's upper STATIONARY_P point
+STATIONARY_P = 1e-6
 #: robust standard deviation from the median absolute deviation of a normal distribution
 MAD_TO_SIGMA = 1.482602218505602
 
@@ -269,6 +283,18 @@ class Saturation:
 
 
 @dataclass(frozen=True)
+class NoisyPose:
+    """Step 11: samples ``[start, stop)`` within the motion that hold one pose (``up``) with the gyros at rest, but
+    noisier than the quiet stretch: ``factor`` is the ``variance_factor`` that would keep the stretch whole (its
+    largest summed variance ratio of a group over 3)."""
+
+    start: int
+    stop: int
+    up: str
+    factor: float
+
+
+@dataclass(frozen=True)
 class Segmentation:
     """The result of :func:`segment_log`.
 
@@ -294,6 +320,8 @@ class Segmentation:
     #: quiet runs at least half a window long but shorter than ``min_static``, within motion: rests too short for
     #: the detector (a hand that paused for a second), which a shorter ``--min-static`` and ``--window`` would take
     short_quiet: tuple[tuple[int, int], ...] = ()
+    #: stretches within motion that look like poses noisier than the quiet stretch (step 11), left as motion
+    noisy_poses: tuple[NoisyPose, ...] = ()
 
     def of_kind(self, kind: str) -> list[Span]:
         return [span for span in self.spans if span.kind == kind]
@@ -655,8 +683,65 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
         if span.kind != "static":
             in_motion[span.start:span.stop] = True
     short_quiet = tuple((a, b) for a, b in _short_quiet(_runs(quiet_mask), w, n_min) if in_motion[a:b].all())
+    # 11. poses noisier than the quiet stretch, reported for the user to decide on
+    blocked = near_gap | cut | ~in_motion
+    for s in saturation:
+        blocked[s.start:s.stop] = True
+    noisy = noisy_poses(x, mean, var, sigma, w, n_min, quiet, blocked, [t[0] for t in thresholds], variance_factor,
+                        statics, rate_threshold, bias)
     return Segmentation(tuple(spans), noise, w, n_min, variance_threshold, rate_threshold, tuple(saturation),
-                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()), tuple(frozen), short_quiet)
+                        tuple(steady), tuple(np.flatnonzero(glitch).tolist()), tuple(frozen), short_quiet,
+                        tuple(noisy))
+
+
+def noisy_poses(x: np.ndarray, mean: np.ndarray, var: np.ndarray, sigma: np.ndarray, w: int, n_min: int,
+                quiet: slice, blocked: np.ndarray, ratios: list[np.ndarray], variance_factor: float,
+                statics: list[Span], rate_threshold: np.ndarray, bias: np.ndarray) -> list[NoisyPose]:
+    """Step 11 of the module docstring: stretches outside *blocked* (the static spans, gaps, glitch and frozen
+    rows, rails) that hold one pose with the gyros at rest but are noisier than the quiet stretch.
+
+    *mean*, *var*: the moving statistics of the clipped samples over *w* samples (centred); *ratios*: the summed
+    variance ratios of the accelerometers and of the gyros at every sample (step 5); *statics*: the static spans,
+    for the gyro test of step 6 against the nearest one."""
+    n = x.shape[0]
+    half = w // 2
+    if n < 2 * w or not statics:
+        return []
+    # z[k]: the windows [k - w, k) and [k, k + w) (centred moving statistics at k - w + half and k + half)
+    k = np.arange(w, n - w + 1)
+    before, after = k - w + half, np.minimum(k + half, n - 1)
+    floor = (0.1 * sigma) ** 2  # a window far quieter than the quiet stretch (a quantised channel's run of one value)
+    noise = np.sqrt((np.maximum(var[before], floor) + np.maximum(var[after], floor)) / w)
+    z = np.max(np.abs(mean[after] - mean[before]) / noise, axis=1)
+    # ... and their variances agree (a window that holds a motion's onset has a large variance and so a small z)
+    spread_ratio = np.max(np.abs(np.log(np.maximum(var[after], floor) / np.maximum(var[before], floor))), axis=1)
+    in_quiet = (k >= quiet.start) & (k < quiet.stop)
+    steady = np.zeros(n, dtype=bool)
+    f_point = math.log(float(scipy.stats.f.isf(STATIONARY_P, w - 1, w - 1)))
+    agree = (z <= _limit(z[in_quiet], STATIONARY_FACTOR)) & (spread_ratio <= _limit(spread_ratio[in_quiet], f_point))
+    steady[k[agree]] = True
+    centres = np.array([0.5 * (span.start + span.stop) for span in statics])
+    found = []
+    for a, b in _runs(steady & ~blocked):
+        if b - a < max(n_min, 2 * w):
+            continue
+        factor = max(float(np.max(ratio[a:b])) for ratio in ratios) / 3.0
+        if factor <= variance_factor:  # as quiet as a rest: another test left it out (its pose or its gyros)
+            continue
+        first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
+        accel_window = np.sqrt(np.mean(var[a:b, 3:], axis=0) / w)
+        allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
+        if not np.all(np.abs(last - first) <= allowed):
+            continue
+        gyro_window = np.sqrt(np.mean(var[a:b, :3], axis=0) / w)
+        threshold = np.maximum(rate_threshold, RATE_FACTOR * gyro_window + 2.0 * EARTH_RATE)
+        nearest = statics[int(np.argmin(np.abs(centres - 0.5 * (a + b))))]
+        medians = [x[a:b, :3].mean(axis=0), nearest.mean[:3]]
+        forces = [x[a:b, 3:].mean(axis=0), nearest.mean[3:]]
+        if not at_rest_against(0, [1], medians, forces, bias, threshold):
+            continue
+        found.append(NoisyPose(a, b, nearest_axis(forces[0])[0], factor))
+    return found
 
 
 def _short_quiet(runs: list[tuple[int, int]], w: int, n_min: int) -> list[tuple[int, int]]:
@@ -730,6 +815,15 @@ def _held_runs(x, times, accel_test, near_gap, n_min, w, accel_window, static_ru
             medians.pop()
             forces.pop()
     return out
+
+
+def _limit(in_quiet: np.ndarray, least: float) -> float:
+    """*least*, or the median of a statistic over the quiet stretch plus ``SPREAD_FACTOR`` robust standard
+    deviations of it where that is larger (correlated or heavy-tailed noise)."""
+    if not in_quiet.size:
+        return least
+    spread = MAD_TO_SIGMA * float(np.median(np.abs(in_quiet - np.median(in_quiet))))
+    return max(least, float(np.median(in_quiet)) + SPREAD_FACTOR * spread)
 
 
 def _one_sided_reference(x: np.ndarray, w: int) -> np.ndarray:

@@ -78,7 +78,7 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
                  "delivery_times", "rest_turning_about_vertical", "glitch", "units_row", "trailing_lines",
                  "units_disagree", "frozen", "repeated_rows", "table_rate_disagrees", "table_rate_sense",
                  "table_turning_at_rest", "table_turn_not_a_rotation", "not_a_table_pose", "short_rests",
-                 "rows_without_channels")
+                 "rows_without_channels", "noisy_poses")
 #: the quiet stretches within motion too short for a static span (``Segmentation.short_quiet``) are warned of
 #: (``short_rests``) where there are at least this many and at least as many as the static poses found: a hand
 #: session whose rests are shorter than ``--min-static`` (imu_tk's ROS2 session "data1" of GetOverMassif/imu_tk:
@@ -86,6 +86,9 @@ WARNING_NAMES = ("gap", "jitter", "repeated_time", "sample_rate_mismatch", "satu
 #: SHORT_RESTS_LISTED are listed by line
 SHORT_RESTS_MIN = 3
 SHORT_RESTS_LISTED = 6
+#: the ``--rest-variance`` the ``noisy_poses`` warning proposes: this many times the largest factor its stretches
+#: need (a margin, so that a stretch's edge is not cut again)
+NOISY_POSE_MARGIN = 1.2
 #: how the log's poses were set (``--poses``): by hand (each pose's tilt a nuisance of the fit) or by a table that
 #: set each up-axis to its grade (JJF 2003's positions: one body axis up or down, turns about the vertical)
 POSES = ("hand", "table")
@@ -548,6 +551,21 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                                   f"rests shorter than --min-static {min_static_s:.3g} s? Import "
                                                   f"again with --min-static {min_static_s / 2:.3g} --window "
                                                   f"{window_s / 2:.3g} (docs/measured-data.md)"))
+    noisy = segmentation.noisy_poses
+    if noisy:
+        factor = rest_variance_for(max(pose.factor for pose in noisy))
+        rate = timing.sample_rate
+        listed = ", ".join(f"{table.lines[p.start]}-{table.lines[p.stop - 1]} ({(p.stop - p.start) / rate:.2g} s, "
+                           f"{p.up} up)" for p in noisy[:SHORT_RESTS_LISTED])
+        more = f" and {len(noisy) - SHORT_RESTS_LISTED} more" if len(noisy) > SHORT_RESTS_LISTED else ""
+        total = sum(p.stop - p.start for p in noisy) / rate
+        warnings.append(LogWarning("noisy_poses", f"{len(noisy)} stretch(es) inside the motion, {total:.3g} s in all "
+                                   f"(lines {listed}{more}), hold one pose with "
+                                   "the gyros at rest but are noisier than the quiet stretch (a window's variance up "
+                                   f"to {max(p.factor for p in noisy):.3g} times its own, where a rest may reach "
+                                   f"{float(rest_variance):g}): a bench that vibrates, noise that depends on the pose, "
+                                   "or a pause held in the hand? They are left as motion; if they are rests, import "
+                                   f"again with --rest-variance {factor:g} (docs/measured-data.md)"))
     for span in segmentation.spans:
         if span.kind == "move" and span.reason.startswith("no static span"):
             warnings.append(LogWarning("unclosed_motion", f"lines {table.lines[span.start]}-"
@@ -731,6 +749,14 @@ def table_source(table: LogTable, quantity: str = "rate") -> str:
     if table.table_rate_column is not None:
         return f"the table's rate column {table.table_rate_column!r}"
     return f"the table's angle column {table.table_angle_column!r} (its change per sample)"
+
+
+def rest_variance_for(factor: float) -> float:
+    """The ``--rest-variance`` the ``noisy_poses`` warning proposes for stretches that need *factor*: NOISY_POSE_MARGIN
+    times it, rounded up to two significant digits."""
+    wanted = NOISY_POSE_MARGIN * factor
+    unit = 10.0 ** (math.floor(math.log10(wanted)) - 1)
+    return float(f"{math.ceil(wanted / unit - 1e-9) * unit:.2g}")
 
 
 def _rates_from_table(segmentation, table: LogTable, table_rate: np.ndarray, warnings: list) -> dict[int, float]:
