@@ -780,8 +780,10 @@ def test_a_host_that_stamps_rows_in_bursts_as_a_serial_link_delivers_them(tmp_pa
 def test_a_units_row_a_footer_and_a_row_the_logger_did_not_finish(tmp_path):
     """Loggers write a row of units under the header, a footer after the data, or stop inside their last row (no
     line break). Each stopped the import; each is now skipped with a named warning, and the samples are those of
-    the clean log. A line that is not a sample with samples after it, or more than MAX_TRAILING_LINES of them at
-    the end, still stops it, naming the line."""
+    the clean log. A last row without a line break is kept where it is whole: every value with the decimals of
+    its column's other samples (a fixed-format logger); one cut inside a value has fewer and is skipped. A line
+    that is not a sample with samples after it, or more than MAX_TRAILING_LINES of them at the end, still stops
+    it, naming the line."""
     t, x = synthetic_log()
     write_synthetic(tmp_path / "clean.csv", t, x)
     text = (tmp_path / "clean.csv").read_text()
@@ -800,6 +802,19 @@ def test_a_units_row_a_footer_and_a_row_the_logger_did_not_finish(tmp_path):
         assert [w.name for w in result.warnings] == [warning], name
         assert words in result.warnings[0].message, (name, result.warnings[0].message)
         np.testing.assert_array_equal(result.recording.samples, clean.recording.samples)
+    # a logger that writes every value with the same decimals: its complete last row without a line break is kept,
+    # a row cut inside a value (fewer decimals) is not
+    fixed = [",".join(f"{v:.6f}" for v in (t[i], *x[i])) for i in range(len(t))]
+    (tmp_path / "fixed.csv").write_text("\n".join([header, *fixed]) + "\n")
+    whole = import_log(tmp_path / "fixed.csv", time_column="time")
+    assert whole.warnings == ()
+    for name, content, kept in (("complete", "\n".join([header, *fixed]), True),
+                                ("cut_in_value", "\n".join([header, *fixed[:-1], fixed[-1][:-2]]), False)):
+        (tmp_path / f"{name}.csv").write_text(content)
+        result = import_log(tmp_path / f"{name}.csv", time_column="time")
+        assert [w.name for w in result.warnings] == ([] if kept else ["trailing_lines"]), name
+        expected = whole.recording.samples if kept else whole.recording.samples[:-1]
+        np.testing.assert_array_equal(result.recording.samples, expected)
     middle = "\n".join([header, *rows[:50], "END OF LOG", *rows[50:]]) + "\n"
     (tmp_path / "middle.csv").write_text(middle)
     with pytest.raises(ValueError, match="line 52 has 1 values, fewer than the 7 columns"):

@@ -41,6 +41,9 @@ MAX_PREAMBLE_LINES = 50
 MAX_TRAILING_LINES = 10
 #: rows converted to numbers at a time while reading
 _BLOCK_ROWS = 65536
+#: a last line without a line break is kept when its values have the decimals of every sample checked in their
+#: columns: every FORMAT_SAMPLING-th sample and the one before it
+FORMAT_SAMPLING = 64
 
 
 @dataclass(frozen=True)
@@ -351,6 +354,7 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
         lines: list[int] = []
         line_number = header_line
         cut = _unterminated_last_line(target)  # a logger stopped while writing its last row
+        formats: list[int] | None = []  # each wanted column's decimals while every sample checked has the same
         clock = None  # the time column holds clock times (decided on the first sample): (days, seconds) of it
         day = 0  # whole days a time of day alone has passed midnight
         previous_stamp = 0.0
@@ -364,7 +368,10 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                 continue
             if row[0].lstrip().startswith("#"):
                 continue
-            if line_number == cut:
+            if line_number == cut and not (len(row) == width and formats is not None and all(
+                    f > 0 and _decimals(row[k]) == f for k, f in zip(index, formats))):
+                # a row the logger stopped inside may have lost digits: kept only where every value has the
+                # decimals every sample of its column has (a fixed format), which a cut value would not
                 trailing.append((line_number, "no line break", ""))
                 continue
             if has_header and not lines and units_row is None and len(row) == width and all(
@@ -438,6 +445,11 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                                  "or after it)")
             block.append(numbers)
             lines.append(line_number)
+            before_cut = cut is not None and line_number + 1 >= cut
+            if formats is not None and (len(lines) % FORMAT_SAMPLING == 1 or before_cut):
+                # every FORMAT_SAMPLING-th sample and the one before a last line without a line break
+                seen = [_decimals(row[k]) for k in index]
+                formats = seen if len(lines) == 1 else (formats if seen == formats else None)
             if len(block) == _BLOCK_ROWS:
                 blocks.append(np.array(block, dtype=np.float64))
                 block = []
@@ -540,6 +552,16 @@ def _clock_time(text: str) -> tuple[int | None, float, str] | None:
     if int(hours) > 23 or int(minutes) > 59 or float(seconds.replace(",", ".")) >= 61.0:
         return None
     return days, int(hours) * 3600.0 + int(minutes) * 60.0 + float(seconds.replace(",", ".")), text.strip()
+
+
+def _decimals(text: str) -> int:
+    """The digits after the decimal point (or comma) of a number written in fixed point, −1 for any other form
+    (no decimal point, an exponent): a value cut short shows fewer."""
+    t = text.strip()
+    if "e" in t or "E" in t:
+        return -1
+    point = max(t.rfind("."), t.rfind(","))
+    return len(t) - point - 1 if point >= 0 else -1
 
 
 def _is_number(text: str, delimiter: str = ",") -> bool:
