@@ -456,6 +456,36 @@ def test_a_scale_factor_that_changes_after_its_rate_test_is_unexplained_and_name
     assert "gyro_scale_asymmetry[y] was significant but is not named" in diagnose_report(d)
 
 
+def test_a_scale_factor_drifting_through_the_run_is_found_as_a_linear_change_and_named_beside_the_effect():
+    """The z gyro's scale factor drifts steadily through the run, by 1e-3 from the first segment to the last (a
+    temperature that rises through it; a linear_gaussian recording, no quantiser). The change family of the lack of
+    fit (scores.parameter_change_columns) holds a linear drift of every Kg, G, Ka, P besides their steps: it finds
+    Kgzz drifting, sized within 20 %. The schedule visits the z rates in order, so the drift also reads as the z
+    asymmetry, which is significant and named; the drift does not beat it by its margin, and the report names the
+    drift beside it as the other reading (attribution[].rival), instead of saying nothing of it. Before the linear
+    form, the change family's best was a step of Kgzz, and the report named only a step."""
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=9, trial=0)
+    site = resolve_site(scenario=scenario)
+    segments = recording.schedule.segments
+    starts = np.cumsum([0] + [seg.samples for seg in segments])
+    samples = np.array(recording.samples, dtype=float)
+    time = np.asarray(recording.time, dtype=float)
+    ramp = (time - time[0]) / (time[-1] - time[0]) - 0.5
+    for k, seg in enumerate(segments):
+        if seg.is_rotating and seg.rate_axis == "+z":
+            samples[starts[k]:starts[k + 1], 2] += 1e-3 * ramp[starts[k]:starts[k + 1]] * seg.rate
+    d = diagnose(type(recording)(samples, recording.schedule, dict(recording.attrs)), site, scenario.turntable,
+                 null_draws=500)
+    change = d.lack_of_fit.change
+    assert (change["parameter"], change["form"]) == ("Kgzz", "linear") and change["p_value"] < 0.0125
+    assert change["size"] == pytest.approx(1e-3, rel=0.2)
+    rival = diagnosis_json(d)["attribution"][0]["rival"]
+    assert (rival["family"], rival["parameter"], rival["form"]) == ("change", "Kgzz", "linear")
+    assert rival["family_statistic"] > rival["statistic"]  # it explains more, by less than its margin
+    assert "Kgzz drifting steadily through the run" in diagnose_report(d)
+
+
 def test_one_segment_far_off_is_unexplained_and_named_as_an_odd_segment():
     """The x gyro reads its +5 °/s rate segment 5 % low (a scale factor that does not hold at low rates; a
     linear_gaussian recording, no quantiser): one segment mean off by 4.4e-3 rad/s. The base fit takes it up as gx

@@ -309,7 +309,7 @@ def time_alternative(fit, best, signature) -> dict | None:
     name. ``None`` when no such column survives the base model."""
     from scipy.stats import norm
 
-    from plansim.diagnose.scores import ALIAS_TOLERANCE, _Geometry
+    from plansim.diagnose.scores import ALIAS_TOLERANCE, _Geometry, parameter_change_columns
 
     usable = [j for j in range(len(signature.components)) if best.usable[j]]
     statistics = np.asarray(best.component_statistic, dtype=float)
@@ -318,23 +318,12 @@ def time_alternative(fit, best, signature) -> dict | None:
     j = int(np.nanargmax(np.where(np.isfinite(statistics), statistics, -np.inf)))
     g = _Geometry(fit)
     z = g.project(g.W @ signature.columns[:, :, j].ravel())
-    design = fit.model.parameter_jacobian(tilts=fit.nuisance)  # (6S, 39)
     times = np.asarray(fit.segment_times, dtype=float)
-    order = np.argsort(times, kind="stable")
-    S = times.size
     identified = [PARAMETER_NAMES.index(n) for n in fit.identifiability.identified]
-    columns, where = [], []
-    for k in range(1, S):
-        after = np.zeros((S, 1))
-        after[order[k:]] = 1.0
-        for p in identified:
-            column = (design[:, p].reshape(S, 6) * after).ravel()
-            if np.any(column):
-                columns.append(column)
-                where.append((p, int(order[k - 1]), int(order[k])))
-    if not columns:
+    columns, where = parameter_change_columns(fit, identified)
+    if not where:
         return None
-    whitened = g.W @ np.array(columns).T
+    whitened = g.W @ columns
     Z = g.project(whitened)
     keep = np.linalg.norm(Z, axis=0) > ALIAS_TOLERANCE * np.maximum(np.linalg.norm(whitened, axis=0), 1e-300)
     if not np.any(keep):
@@ -348,8 +337,9 @@ def time_alternative(fit, best, signature) -> dict | None:
     i = int(np.argmax(np.abs(cosines)))
     rho = min(float(abs(cosines[i])), 1.0)  # rounding can carry an exact alias past 1
     delta = math.sqrt(max(float(statistics[j]), 0.0))
-    p, before_segment, after_segment = where[i]
-    return {"parameter": PARAMETER_NAMES[p], "between": [int(fit.used[before_segment]), int(fit.used[after_segment])],
+    p, before_segment, after_segment, form = where[i]
+    return {"parameter": PARAMETER_NAMES[p], "form": form,
+            "between": [int(fit.used[before_segment]), int(fit.used[after_segment])],
             "labels": [fit.labels[before_segment], fit.labels[after_segment]],
             "at_s": float(0.5 * (times[before_segment] + times[after_segment])), "component": signature.components[j],
             "cosine": rho, "probability_distinct": float(norm.cdf(delta * math.sqrt((1.0 - rho) / 2.0)))}
@@ -489,13 +479,15 @@ def diagnose(recording, site=None, turntable=None, *, alpha: float = 0.05, seed:
         best = max(open_, key=lambda c: (c.strongest_component(), -c.adjusted_p_value))
         if lof_current is None:
             lof_current = lack_of_fit(current, alpha=a_segment, null=null)
-        beaten = explained_better(best, lof_current, a_segment)
-        if beaten is not None:  # a step or a change in time explains it clearly better: leave it unexplained
-            not_named.append(beaten)
+        contender = rival(best, lof_current, a_segment)
+        if contender is not None and contender["clearly_better"]:
+            # a step or a change in time explains it clearly better: leave it unexplained
+            not_named.append({k: v for k, v in contender.items() if k != "clearly_better"})
             break
         signature = by_effect[best.effect]
         attribution.append({**_attribution(best, open_),
-                            "time_alternative": time_alternative(current, best, signature)})
+                            "time_alternative": time_alternative(current, best, signature),
+                            "rival": None if contender is None else _rival_summary(contender)})
         best_extra = dict(extra)
         for j, component in enumerate(signature.components):
             if best.usable[j] and _adds_rank(current, list(best_extra.values()), signature.columns[:, :, j]):
@@ -594,31 +586,58 @@ def scenario_diagnose_options(scenario) -> dict:
 
 def explained_better(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict | None:
     """The lack of fit's step, change of a parameter in time or odd segment that explains the residual clearly better
-    than candidate *best* does, or None.
+    than candidate *best* does, or None: the :func:`rival` that wins.
 
     The closed test names a significant candidate; but a feature outside the catalogue can make a candidate
     significant through the part of its signature they share (a y gyro's scale factor that changes after the y
-    rate test moves the ω² test's y turn, which the y asymmetry also moves). Each family is compared with the
-    candidate's strongest component like with like — a step's or an odd segment's profile likelihood ratio with the
-    component's
-    (:func:`plansim.diagnose.scores._profile_likelihood_ratios`), a change's efficient score with the component's
-    efficient score — and the family wins when it is significant at *alpha* and its statistic exceeds the
-    component's by more than the family's own 1 − *alpha* null quantile (what the best of its many columns gains
-    on noise alone). A catalogue effect the schedule cannot tell from a change in time (the x asymmetry and Kgxx
-    changing between −5 and 0 °/s in jjf2003) ties with that change and keeps its name."""
+    rate test moves the ω² test's y turn, which the y asymmetry also moves). The family wins when it is significant
+    at *alpha* and its statistic exceeds the candidate's strongest component's by more than the family's own
+    1 − *alpha* null quantile (what the best of its many columns gains on noise alone). A catalogue effect the
+    schedule cannot tell from a change in time (the x asymmetry and Kgxx changing between −5 and 0 °/s in jjf2003)
+    ties with that change and keeps its name."""
+    found = rival(best, lof, alpha)
+    return found if found is not None and found["clearly_better"] else None
+
+
+def rival(best: CandidateScore, lof: LackOfFit, alpha: float) -> dict | None:
+    """The strongest significant family of the lack of fit (step, change of a parameter in time, odd segment)
+    compared with candidate *best*, like with like — a step's or an odd segment's profile likelihood ratio with the
+    component's (:func:`plansim.diagnose.scores._profile_likelihood_ratios`), a change's efficient score with the
+    component's efficient score — or None when none is significant at *alpha*: ``{effect, component, statistic,
+    family, family_statistic, margin, where, clearly_better}``, where ``clearly_better`` says the family's statistic
+    exceeds the component's by more than the family's margin (:func:`explained_better`). Where it does not, the
+    report still names it: a feature outside the catalogue that explains the residual about as well as the named
+    effect (a scale factor drifting through the run, against a nonlinearity in a schedule that visits its rates in
+    order) is the other reading of the same recording."""
     values = np.asarray(best.component_statistic, dtype=float)
     if not np.any(np.isfinite(values)):
         return None
     j = int(np.nanargmax(values))
+    strongest = None
     for family, found in (("step", lof.step), ("change", lof.change), ("outlier", lof.outlier)):
         if found is None or not found["p_value"] < alpha or family not in lof.margins:
             continue
         mine = float(best.component_efficient[j] if family == "change" else values[j])
-        if found["statistic"] - mine > lof.margins[family]:
-            return {"effect": best.effect, "component": best.components[j], "statistic": mine, "family": family,
-                    "family_statistic": float(found["statistic"]), "margin": float(lof.margins[family]),
-                    "where": dict(found)}
-    return None
+        gain = found["statistic"] - mine
+        entry = {"effect": best.effect, "component": best.components[j], "statistic": mine, "family": family,
+                 "family_statistic": float(found["statistic"]), "margin": float(lof.margins[family]),
+                 "where": dict(found), "clearly_better": bool(gain > lof.margins[family])}
+        if entry["clearly_better"]:
+            return entry
+        if strongest is None or gain > strongest["family_statistic"] - strongest["statistic"]:
+            strongest = entry
+    return strongest
+
+
+def _rival_summary(contender: dict) -> dict:
+    """What the report and ``--json`` keep of a :func:`rival` that did not win: the family, its statistic against the
+    component's, the margin, and where (the parameter and form of a change, the channel of a step or an odd segment,
+    the segments)."""
+    where = contender["where"]
+    return {"family": contender["family"], "family_statistic": contender["family_statistic"],
+            "statistic": contender["statistic"], "component": contender["component"], "margin": contender["margin"],
+            **{key: where[key] for key in ("parameter", "form", "channel", "between", "labels", "at_s", "size")
+               if key in where}}
 
 
 def levels(alpha: float) -> dict:

@@ -714,33 +714,59 @@ def _draw_p_values(null_statistic: np.ndarray) -> np.ndarray:
 CHANGE_GROUPS = ("Kg", "G", "Ka", "P")
 
 
-def change_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
-    """The columns (6S, m) of a change of one parameter of eq. (1)/(2) part-way through the run: for each identified
-    parameter of :data:`CHANGE_GROUPS` and each boundary between segments adjacent in time, the parameter's column
-    of the design (at the fit's solution) on the segments after it; and each column's (parameter index, last
-    segment before, first segment after). A parameter read by a channel left out of the step test (its means'
-    noise an undithered quantiser's, :data:`UNDITHERED_SHARE`) is left out here too."""
+def change_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int, str]]]:
+    """The columns (6S, m) of a change of one parameter of eq. (1)/(2) in time (:func:`parameter_change_columns`) for
+    each identified parameter of :data:`CHANGE_GROUPS`. A parameter read by a channel left out of the step test (its
+    means' noise an undithered quantiser's, :data:`UNDITHERED_SHARE`) is left out here too."""
     from plansim.model.parameters import PARAMETERS
 
-    times = np.asarray(fit.segment_times, dtype=float)
-    S = times.size
-    order = np.argsort(times, kind="stable")
     rows = np.asarray(fit.fitted_rows, dtype=bool)
     excluded = undithered_channels(fit)
-    design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(S, 6, -1)
+    design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(rows.shape[0], 6, -1)
     design[~rows] = 0.0
     identified = set(fit.identifiability.identified)
     chosen = [k for k, spec in enumerate(PARAMETERS) if spec.group in CHANGE_GROUPS and spec.name in identified
               and not excluded & {c for c in range(6) if np.any(design[:, c, k])}]
+    return parameter_change_columns(fit, chosen)
+
+
+def parameter_change_columns(fit, parameters) -> tuple[np.ndarray, list[tuple[int, int, int, str]]]:
+    """The columns (6S, m) of a change in time of each parameter of eq. (1)/(2) in *parameters* (indices), in two
+    forms, and each column's (parameter index, segment, segment, form) (indices into the fit's segments):
+
+    - ``"step"``: the parameter changes between two segments adjacent in time: for each boundary, the parameter's
+      column of the design (at the fit's solution) on the segments after it (the segments: the last before it and
+      the first after it);
+    - ``"linear"``: the parameter drifts at a steady rate over the run (a temperature that rises through it): its
+      column times (t_s − t̄)/(t_last − t_first) on every segment s, t_s the segment's mid-time, so that its
+      coefficient is the change from the first segment to the last (the segments: the first and the last in time).
+      Only with three segments or more (with two it is the step).
+
+    A column equal to the parameter's own (no segment before the boundary reads it) is not a change and is left
+    out; one the base model spans otherwise is dropped where it is scored (:meth:`_Geometry.surviving`)."""
+    times = np.asarray(fit.segment_times, dtype=float)
+    S = times.size
+    order = np.argsort(times, kind="stable")
+    rows = np.asarray(fit.fitted_rows, dtype=bool)
+    design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(S, 6, -1)
+    design[~rows] = 0.0
     columns, where = [], []
     for k in range(1, S):
         later = order[k:]
-        for p in chosen:
+        for p in parameters:
             column = np.zeros((S, 6))
             column[later] = design[later, :, p]
             if np.any(column) and np.any(design[order[:k], :, p]):  # a change, not the parameter itself
                 columns.append(column.ravel())
-                where.append((p, int(order[k - 1]), int(order[k])))
+                where.append((p, int(order[k - 1]), int(order[k]), "step"))
+    span = float(times[order[-1]] - times[order[0]]) if S else 0.0
+    if S >= 3 and span > 0:
+        ramp = (times - 0.5 * (times[order[0]] + times[order[-1]])) / span
+        for p in parameters:
+            column = design[:, :, p] * ramp[:, None]
+            if np.any(column):
+                columns.append(column.ravel())
+                where.append((p, int(order[0]), int(order[-1]), "linear"))
     return (np.array(columns).T if columns else np.zeros((6 * S, 0))), where
 
 
@@ -767,11 +793,12 @@ def _largest(fit, scores, null_scores, sizes, where, B: int, what) -> tuple[dict
     ``{statistic, p_value, …what(first of where), between, labels, at_s, size}`` and each draw's own p (its rank)."""
     best = int(np.argmax(scores))
     T = float(scores[best])
-    first, before, after = where[best]
+    first, before, after, *form = where[best]
     found = {"statistic": T, "p_value": float((1 + np.count_nonzero(null_scores >= T)) / (B + 1)), **what(first),
              "between": [int(fit.used[before]), int(fit.used[after])],
              "labels": [fit.labels[before], fit.labels[after]],
-             "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])), "size": float(sizes[best])}
+             "at_s": float(0.5 * (fit.segment_times[before] + fit.segment_times[after])), "size": float(sizes[best]),
+             **({"form": form[0]} if form else {})}
     return found, _draw_p_values(null_scores)
 
 

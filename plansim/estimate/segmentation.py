@@ -541,9 +541,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     thresholds = []
     for group in (slice(3, 6), slice(0, 3)):
         ratio = np.sum(var[:, group] / sigma[group] ** 2, axis=1)
-        in_quiet = ratio[quiet]
-        spread = MAD_TO_SIGMA * np.median(np.abs(in_quiet - np.median(in_quiet)))
-        thresholds.append((ratio, max(variance_factor * 3.0, float(np.median(in_quiet) + SPREAD_FACTOR * spread))))
+        thresholds.append((ratio, _limit(ratio[quiet], variance_factor * 3.0)))
     quiet_mask = ~near_gap
     for ratio, threshold in thresholds:
         quiet_mask &= ratio <= threshold

@@ -27,6 +27,19 @@ def _p(value: float) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
 
 
+def _rival_text(r: dict) -> str:
+    """The lack of fit's step, change or odd segment that rivals a named effect (``attribution[].rival``), in words."""
+    between = r.get("between", [None, None])
+    if r["family"] == "change" and r.get("form") == "linear":
+        return f"{r['parameter']} drifting steadily through the run (segments {between[0]} to {between[1]})"
+    if r["family"] == "change":
+        return (f"{r['parameter']} changing between segments {between[0]} and {between[1]} (at "
+                f"{r['at_s'] / 60:.1f} min)")
+    if r["family"] == "step":
+        return f"a step in {r['channel']} between segments {between[0]} and {between[1]} (at {r['at_s'] / 60:.1f} min)"
+    return f"segment {between[0]} off in {r['channel']}"
+
+
 def _within_lines(d) -> list[str]:
     """The within-segment findings, each with its pattern in display units."""
     w = d.within
@@ -116,12 +129,22 @@ def diagnose_report(d) -> str:
                              f"{100 * a['probability_correct']:.0f} % of the time)")
             t = a.get("time_alternative")
             if t is not None:
-                lines.append(f"  or, outside the catalogue: {t['parameter']} changing between segments "
-                             f"{t['between'][0]} and {t['between'][1]} (at {t['at_s'] / 60:.1f} min) looks like "
+                when = (f"drifting steadily from segment {t['between'][0]} to {t['between'][1]} (over the run)"
+                        if t.get("form") == "linear" else f"changing between segments {t['between'][0]} and "
+                        f"{t['between'][1]} (at {t['at_s'] / 60:.1f} min)")
+                lines.append(f"  or, outside the catalogue: {t['parameter']} {when} looks like "
                              f"{a['effect']}"
                              f"[{t['component']}] with cosine {t['cosine']:.3f}: at this size the schedule tells "
                              f"them apart about {100 * t['probability_distinct']:.0f} % of the time"
                              + (" — this recording cannot say which" if t["cosine"] > 0.99 else ""))
+            r = a.get("rival")
+            if r is not None:
+                lines.append(f"  the lack of fit's {_FAMILY_NAMES[r['family']]} is significant too: {_rival_text(r)} "
+                             f"(statistic {r['family_statistic']:.1f} against {r['statistic']:.1f} for "
+                             f"{a['effect']}[{r['component']}]; the effect stays named unless the "
+                             f"{_FAMILY_NAMES[r['family']]} wins by more than {r['margin']:.1f}, what the best of its "
+                             "columns gains on noise alone): another reading of this recording, outside the "
+                             "catalogue")
     else:
         lines.append("Found: no catalogue effect is named.")
     for item in d.not_named:
@@ -155,10 +178,15 @@ def diagnose_report(d) -> str:
         change = d.unexplained.get("change")
         if change is not None:
             spec = next(q for q in PARAMETERS if q.name == change["parameter"])
-            lines.append(f"  a change of {change['parameter']} by {change['size'] / spec.display_factor:+.3g} "
-                         f"{spec.display_unit} between segment {change['between'][0]} {change['labels'][0]} and "
-                         f"{change['between'][1]} {change['labels'][1]} (at about {change['at_s']:.0f} s; "
-                         f"p = {_p(change['p_value'])})")
+            by = f"{change['size'] / spec.display_factor:+.3g} {spec.display_unit}"
+            if change.get("form") == "linear":
+                lines.append(f"  {change['parameter']} drifting steadily through the run, by {by} from segment "
+                             f"{change['between'][0]} {change['labels'][0]} to {change['between'][1]} "
+                             f"{change['labels'][1]} (p = {_p(change['p_value'])})")
+            else:
+                lines.append(f"  a change of {change['parameter']} by {by} between segment {change['between'][0]} "
+                             f"{change['labels'][0]} and {change['between'][1]} {change['labels'][1]} (at about "
+                             f"{change['at_s']:.0f} s; p = {_p(change['p_value'])})")
     elif excess:
         lines.append(f"No lack of fit is flagged at segment level (p = {_p(after.p_value)}), but the tests cannot "
                      "see a slow effect here:")
