@@ -422,6 +422,17 @@ def test_a_bias_step_between_segments_is_unexplained_and_placed():
         assert "a step in gx" in diagnose_report(d)
 
 
+def _linear_gaussian_to_edit():
+    """A linear_gaussian recording (seed 9) to add an effect to: the scenario, the recording, its site, its
+    segments, each segment's first sample (and the end) and a copy of its samples."""
+    scenario = load_scenario("linear_gaussian")
+    recording = simulate_and_record(scenario, seed=9, trial=0)
+    segments = recording.schedule.segments
+    starts = np.cumsum([0] + [seg.samples for seg in segments])
+    return (scenario, recording, resolve_site(scenario=scenario), segments, starts,
+            np.array(recording.samples, dtype=float))
+
+
 def test_a_scale_factor_that_changes_after_its_rate_test_is_unexplained_and_named_a_change():
     """The y gyro's scale factor grows by 3e-4 after the y rate test (a linear_gaussian recording, no quantiser): only
     the ω² test's y turn at 100 °/s sees it, 0.03 °/s off in one segment mean. No catalogue effect has that shape;
@@ -430,12 +441,7 @@ def test_a_scale_factor_that_changes_after_its_rate_test_is_unexplained_and_name
     the diagnosis reports it unexplained, named after no candidate (the y asymmetry, significant through the
     ω² turn it shares, is left unnamed: the change explains clearly more). Null level: on 40 jjf2003 and 40
     linear_gaussian null recordings the change statistic alone fell below α/4 = 0.0125 in 0 and 0 (docs)."""
-    scenario = load_scenario("linear_gaussian")
-    recording = simulate_and_record(scenario, seed=9, trial=0)
-    site = resolve_site(scenario=scenario)
-    segments = recording.schedule.segments
-    starts = np.cumsum([0] + [seg.samples for seg in segments])
-    samples = np.array(recording.samples, dtype=float)
+    scenario, recording, site, segments, starts, samples = _linear_gaussian_to_edit()
     last_y_rate = max(k for k, seg in enumerate(segments) if seg.test == "rate" and seg.rate_axis == "+y")
     for k, seg in enumerate(segments):
         if k > last_y_rate and seg.is_rotating and seg.rate_axis == "+y":
@@ -464,12 +470,7 @@ def test_a_scale_factor_drifting_through_the_run_is_found_as_a_linear_change_and
     asymmetry, which is significant and named; the drift does not beat it by its margin, and the report names the
     drift beside it as the other reading (attribution[].rival), instead of saying nothing of it. Before the linear
     form, the change family's best was a step of Kgzz, and the report named only a step."""
-    scenario = load_scenario("linear_gaussian")
-    recording = simulate_and_record(scenario, seed=9, trial=0)
-    site = resolve_site(scenario=scenario)
-    segments = recording.schedule.segments
-    starts = np.cumsum([0] + [seg.samples for seg in segments])
-    samples = np.array(recording.samples, dtype=float)
+    scenario, recording, site, segments, starts, samples = _linear_gaussian_to_edit()
     time = np.asarray(recording.time, dtype=float)
     ramp = (time - time[0]) / (time[-1] - time[0]) - 0.5
     for k, seg in enumerate(segments):

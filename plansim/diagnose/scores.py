@@ -45,8 +45,8 @@ likelihood ratio with the channel's between-segment noise re-estimated under the
 through a run moves every later segment's mean: the omnibus test barely sees it, because the slow noise between
 segments, estimated from the same residuals, takes it up (a correlation time of 300 s and a σ of about half the
 step) — and so would a step score measured against that noise — while a step is one abrupt change where that noise
-changes little from one 30 s segment to the next. The largest **change** of one parameter part-way through the
-run (:func:`change_columns`) is scored alike, and so is the **odd segment**: the one segment whose mean in one
+changes little from one 30 s segment to the next. The largest **change** of one parameter in time — a step
+part-way through the run, or a steady drift through it (:func:`change_columns`) — is scored alike, and so is the **odd segment**: the one segment whose mean in one
 channel is most off the model (:func:`outlier_columns`, a column that moves that segment's mean alone; its profile
 likelihood ratio is the leave-one-segment-out residual's, with the channel's between-segment noise re-estimated
 without that segment). One segment far off — a rate the table did not hold, a pose knocked, a scale factor that
