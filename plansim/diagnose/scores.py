@@ -37,26 +37,26 @@ estimated as (1 + #{b: min_d p*_{d,b} ≤ p_c})/(B + 1). Holm (1979) on analytic
 likelihood ratio as χ²(1), Bonferroni over the candidate's components) is the documented fallback
 (``method="holm"``).
 
-**Lack of fit** (segment level): L = ‖r_w‖² against the same simulated null, p = (1 + #{L*_b ≥ L})/(B + 1),
-overall and per channel (the channel's rows of r_w); and the largest **step** in one channel's level between two
-segments adjacent in time (:func:`step_columns`), max over channels and boundaries of each step column's profile
-likelihood ratio with the channel's between-segment noise re-estimated under the step
-(:func:`_step_likelihood_ratios`), against the max of the same over the null draws. A bias that jumps part-way
-through a run moves every later segment's mean: the omnibus test barely sees it, because the slow noise between
-segments, estimated from the same residuals, takes it up (a correlation time of 300 s and a σ of about half the
-step) — and so would a step score measured against that noise — while a step is one abrupt change where that noise
-changes little from one 30 s segment to the next. The largest **change** of one parameter in time — a step
-part-way through the run, or a steady drift through it (:func:`change_columns`) — is scored alike, and so is the **odd segment**: the one segment whose mean in one
-channel is most off the model (:func:`outlier_columns`, a column that moves that segment's mean alone; its profile
-likelihood ratio is the leave-one-segment-out residual's, with the channel's between-segment noise re-estimated
-without that segment). One segment far off — a rate the table did not hold, a pose knocked, a scale factor that
-holds only at some rates — is otherwise taken up by the between-segment noise, estimated from the residuals it
-is in, as noise "independent from segment to segment", and no other test sees it: a 5 % loss of the x gyro's
-scale factor at ±5 °/s alone (4.4e-3 rad/s, some 290 times a segment mean's u) left the omnibus at p = 0.11 and
-gx's between-segment noise at 69 times its samples' prediction. The tests are held together at α by their min-p
-over the same draws (each draw's p-values its ranks among the draws). The diagnosis takes the omnibus and the
-other three on two fits of one recording — the omnibus under the quantisation error given the level counts, the
-others under the candidates' — with null draws coupled between them (:func:`coupled_null_residuals`).
+**Lack of fit** (segment level): L = ‖r_w‖² against the same simulated null, p = (1 + #{L*_b ≥ L})/(B + 1), overall
+and per channel (the channel's rows of r_w); and the largest **step** in one channel's level between two segments
+adjacent in time (:func:`step_columns`), max over channels and boundaries of each step column's profile likelihood
+ratio with the channel's between-segment noise re-estimated under the step (:func:`_step_likelihood_ratios`),
+against the max of the same over the null draws. A bias that jumps part-way through a run moves every later
+segment's mean: the omnibus test barely sees it, because the slow noise between segments, estimated from the same
+residuals, takes it up (a correlation time of 300 s and a σ of about half the step) — and so would a step score
+measured against that noise — while a step is one abrupt change where that noise changes little from one 30 s
+segment to the next. The largest **change** of one parameter in time — a step part-way through the run, or a steady
+drift through it (:func:`change_columns`) — is scored alike, and so is the **odd segment**: the one segment whose
+mean in one channel is most off the model (:func:`outlier_columns`, a column that moves that segment's mean alone;
+its profile likelihood ratio is the leave-one-segment-out residual's, with the channel's between-segment noise
+re-estimated without that segment). One segment far off — a rate the table did not hold, a pose knocked, a scale
+factor that holds only at some rates — is otherwise taken up by the between-segment noise, estimated from the
+residuals it is in, as noise "independent from segment to segment", and no other test sees it: a 5 % loss of the x
+gyro's scale factor at ±5 °/s alone (4.4e-3 rad/s, some 290 times a segment mean's u) left the omnibus at p = 0.11
+and gx's between-segment noise at 69 times its samples' prediction. The tests are held together at α by their min-p
+over the same draws (each draw's p-values its ranks among the draws). The diagnosis takes the omnibus and the other
+three on two fits of one recording — the omnibus under the quantisation error given the level counts, the others
+under the candidates' — with null draws coupled between them (:func:`coupled_null_residuals`).
 
 **Attribution.** Two candidates can both be significant when their signatures alias in part (ω² and |ω|
 over the rate points of one axis are both even in ω). Which one the residual is attributed to is decided by each
