@@ -727,10 +727,11 @@ def change_columns(fit) -> tuple[np.ndarray, list[tuple[int, int, int, str]]]:
     identified = set(fit.identifiability.identified)
     chosen = [k for k, spec in enumerate(PARAMETERS) if spec.group in CHANGE_GROUPS and spec.name in identified
               and not excluded & {c for c in range(6) if np.any(design[:, c, k])}]
-    return parameter_change_columns(fit, chosen)
+    return parameter_change_columns(fit, chosen, design)
 
 
-def parameter_change_columns(fit, parameters) -> tuple[np.ndarray, list[tuple[int, int, int, str]]]:
+def parameter_change_columns(fit, parameters, design: np.ndarray | None = None
+                             ) -> tuple[np.ndarray, list[tuple[int, int, int, str]]]:
     """The columns (6S, m) of a change in time of each parameter of eq. (1)/(2) in *parameters* (indices), in two
     forms, and each column's (parameter index, segment, segment, form) (indices into the fit's segments):
 
@@ -743,13 +744,14 @@ def parameter_change_columns(fit, parameters) -> tuple[np.ndarray, list[tuple[in
       Only with three segments or more (with two it is the step).
 
     A column equal to the parameter's own (no segment before the boundary reads it) is not a change and is left
-    out; one the base model spans otherwise is dropped where it is scored (:meth:`_Geometry.surviving`)."""
+    out; one the base model spans otherwise is dropped where it is scored (:meth:`_Geometry.surviving`). *design*:
+    the fit's parameter Jacobian (S, 6, 39) with its rows not fitted zeroed, where the caller has it already."""
     times = np.asarray(fit.segment_times, dtype=float)
     S = times.size
     order = np.argsort(times, kind="stable")
-    rows = np.asarray(fit.fitted_rows, dtype=bool)
-    design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(S, 6, -1)
-    design[~rows] = 0.0
+    if design is None:
+        design = fit.model.parameter_jacobian(tilts=fit.nuisance).reshape(S, 6, -1)
+        design[~np.asarray(fit.fitted_rows, dtype=bool)] = 0.0
     columns, where = [], []
     for k in range(1, S):
         later = order[k:]

@@ -550,12 +550,7 @@ def segment_log(samples: np.ndarray, time: np.ndarray | None, sample_rate: float
     # one pose from end to end: the specific force of the first and the last window agree (a unit tumbling
     # smoothly can be as quiet as its own quietest stretch, but its gravity turns)
     accel_window = sigma[3:] / math.sqrt(w)
-    one_pose = []
-    for a, b in runs:
-        first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
-        allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
-        one_pose.append(bool(np.all(np.abs(last - first) <= allowed)))
-    runs = [run for run, ok in zip(runs, one_pose) if ok]
+    runs = [(a, b) for a, b in runs if _one_pose(x, a, b, w, accel_window)]
 
     # 6. rest or steady turn: each run against the nearest run at rest, outwards from the quiet stretch (a
     # slow drift of the bias over a long log is not a turn)
@@ -726,10 +721,7 @@ def noisy_poses(x: np.ndarray, mean: np.ndarray, var: np.ndarray, sigma: np.ndar
         factor = max(float(np.max(ratio[a:b])) for ratio in ratios) / 3.0
         if factor <= variance_factor:  # as quiet as a rest: another test left it out (its pose or its gyros)
             continue
-        first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
-        accel_window = np.sqrt(np.mean(var[a:b, 3:], axis=0) / w)
-        allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
-        if not np.all(np.abs(last - first) <= allowed):
+        if not _one_pose(x, a, b, w, np.sqrt(np.mean(var[a:b, 3:], axis=0) / w)):  # with its own noise
             continue
         gyro_window = np.sqrt(np.mean(var[a:b, :3], axis=0) / w)
         threshold = np.maximum(rate_threshold, RATE_FACTOR * gyro_window + 2.0 * EARTH_RATE)
@@ -792,9 +784,7 @@ def _held_runs(x, times, accel_test, near_gap, n_min, w, accel_window, static_ru
     medians, forces, where = list(rest_medians), list(rest_forces), [0.5 * (a + b) for a, b in static_runs]
     out = []
     for a, b in candidates:
-        first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
-        allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
-        if not np.all(np.abs(last - first) <= allowed):
+        if not _one_pose(x, a, b, w, accel_window):
             continue
         gyro = x[a:b, :3]
         centre = gyro.mean(axis=0)
@@ -813,6 +803,16 @@ def _held_runs(x, times, accel_test, near_gap, n_min, w, accel_window, static_ru
             medians.pop()
             forces.pop()
     return out
+
+
+def _one_pose(x: np.ndarray, a: int, b: int, w: int, accel_window: np.ndarray) -> bool:
+    """Whether samples ``[a, b)`` hold one pose (step 5): the mean specific force of the first and the last *w*
+    samples differ by at most ``RATE_FACTOR`` √2 times *accel_window* (the noise of a window mean, per
+    accelerometer) plus ``POSE_TOLERANCE`` of gravity on each axis (a unit tumbling smoothly can be as quiet as its
+    own quietest stretch, but its gravity turns)."""
+    first, last = x[a:a + w, 3:].mean(axis=0), x[b - w:b, 3:].mean(axis=0)
+    allowed = RATE_FACTOR * math.sqrt(2.0) * accel_window + np.linalg.norm(first) * math.sin(POSE_TOLERANCE)
+    return bool(np.all(np.abs(last - first) <= allowed))
 
 
 def _limit(in_quiet: np.ndarray, least: float) -> float:

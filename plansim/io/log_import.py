@@ -343,11 +343,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                                  "reads (in --units), e.g. 2000,16 with --units deg/s,g")
 
     if table.channelless:
-        shown = ", ".join(str(k) for k in table.channelless[:GLITCHES_LISTED])
-        more = f" and {len(table.channelless) - GLITCHES_LISTED} more" if len(table.channelless) > GLITCHES_LISTED \
-            else ""
+        shown = _first_few([str(k) for k in table.channelless], GLITCHES_LISTED)
         warnings.append(LogWarning("rows_without_channels", f"{len(table.channelless)} row(s) hold none of the six "
-                                                            f"channel columns (lines {shown}{more}): rows of the "
+                                                            f"channel columns (lines {shown}): rows of the "
                                                             "logger's other packets, skipped"))
     if table.units_row is not None:
         line, entries = table.units_row
@@ -542,11 +540,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         rate = timing.sample_rate
         # a quiet run of the moving variance is about a window shorter than the rest that holds it
         lengths = [(b - a + segmentation.window) / rate for a, b in short]
-        listed = ", ".join(f"{table.lines[a]}-{table.lines[b - 1]}" for a, b in short[:SHORT_RESTS_LISTED])
-        more = f" and {len(short) - SHORT_RESTS_LISTED} more" if len(short) > SHORT_RESTS_LISTED else ""
+        listed = _first_few([f"{table.lines[a]}-{table.lines[b - 1]}" for a, b in short])
         window_s, min_static_s = segmentation.window / rate, segmentation.min_static / rate
         warnings.append(LogWarning("short_rests", f"the motion holds {len(short)} quiet stretches of about "
-                                                  f"{min(lengths):.2g}-{max(lengths):.2g} s (lines {listed}{more}), "
+                                                  f"{min(lengths):.2g}-{max(lengths):.2g} s (lines {listed}), "
                                                   f"as many as the {len(statics)} static pose(s) found or more: "
                                                   f"rests shorter than --min-static {min_static_s:.3g} s? Import "
                                                   f"again with --min-static {min_static_s / 2:.3g} --window "
@@ -555,12 +552,11 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     if noisy:
         factor = rest_variance_for(max(pose.factor for pose in noisy))
         rate = timing.sample_rate
-        listed = ", ".join(f"{table.lines[p.start]}-{table.lines[p.stop - 1]} ({(p.stop - p.start) / rate:.2g} s, "
-                           f"{p.up} up)" for p in noisy[:SHORT_RESTS_LISTED])
-        more = f" and {len(noisy) - SHORT_RESTS_LISTED} more" if len(noisy) > SHORT_RESTS_LISTED else ""
+        listed = _first_few([f"{table.lines[p.start]}-{table.lines[p.stop - 1]} ({(p.stop - p.start) / rate:.2g} s, "
+                             f"{p.up} up)" for p in noisy])
         total = sum(p.stop - p.start for p in noisy) / rate
         warnings.append(LogWarning("noisy_poses", f"{len(noisy)} stretch(es) inside the motion, {total:.3g} s in all "
-                                   f"(lines {listed}{more}), hold one pose with "
+                                   f"(lines {listed}), hold one pose with "
                                    "the gyros at rest but are noisier than the quiet stretch (a window's variance up "
                                    f"to {max(p.factor for p in noisy):.3g} times its own, where a rest may reach "
                                    f"{float(rest_variance):g}): a bench that vibrates, noise that depends on the pose, "
@@ -749,6 +745,11 @@ def table_source(table: LogTable, quantity: str = "rate") -> str:
     if table.table_rate_column is not None:
         return f"the table's rate column {table.table_rate_column!r}"
     return f"the table's angle column {table.table_angle_column!r} (its change per sample)"
+
+
+def _first_few(items: list[str], limit: int = SHORT_RESTS_LISTED) -> str:
+    """The first *limit* of *items*, joined, and how many more there are (for a warning)."""
+    return ", ".join(items[:limit]) + (f" and {len(items) - limit} more" if len(items) > limit else "")
 
 
 def rest_variance_for(factor: float) -> float:

@@ -27,14 +27,19 @@ def _p(value: float) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
 
 
+def _change_text(c: dict) -> str:
+    """A change of a parameter in time (the lack of fit's ``change``, a ``time_alternative``), in words."""
+    if c.get("form") == "linear":
+        return f"{c['parameter']} drifting steadily through the run (segments {c['between'][0]} to {c['between'][1]})"
+    return (f"{c['parameter']} changing between segments {c['between'][0]} and {c['between'][1]} (at "
+            f"{c['at_s'] / 60:.1f} min)")
+
+
 def _rival_text(r: dict) -> str:
     """The lack of fit's step, change or odd segment that rivals a named effect (``attribution[].rival``), in words."""
     between = r.get("between", [None, None])
-    if r["family"] == "change" and r.get("form") == "linear":
-        return f"{r['parameter']} drifting steadily through the run (segments {between[0]} to {between[1]})"
     if r["family"] == "change":
-        return (f"{r['parameter']} changing between segments {between[0]} and {between[1]} (at "
-                f"{r['at_s'] / 60:.1f} min)")
+        return _change_text(r)
     if r["family"] == "step":
         return f"a step in {r['channel']} between segments {between[0]} and {between[1]} (at {r['at_s'] / 60:.1f} min)"
     return f"segment {between[0]} off in {r['channel']}"
@@ -129,10 +134,7 @@ def diagnose_report(d) -> str:
                              f"{100 * a['probability_correct']:.0f} % of the time)")
             t = a.get("time_alternative")
             if t is not None:
-                when = (f"drifting steadily from segment {t['between'][0]} to {t['between'][1]} (over the run)"
-                        if t.get("form") == "linear" else f"changing between segments {t['between'][0]} and "
-                        f"{t['between'][1]} (at {t['at_s'] / 60:.1f} min)")
-                lines.append(f"  or, outside the catalogue: {t['parameter']} {when} looks like "
+                lines.append(f"  or, outside the catalogue: {_change_text(t)} looks like "
                              f"{a['effect']}"
                              f"[{t['component']}] with cosine {t['cosine']:.3f}: at this size the schedule tells "
                              f"them apart about {100 * t['probability_distinct']:.0f} % of the time"
