@@ -486,11 +486,9 @@ def _held_cross_couplings(ident: Identifiability, J: np.ndarray) -> list[tuple[i
             continue
         direction = np.zeros(ident.scale.size)
         direction[[i, j]] = 1.0
-        scaled = direction * ident.scale
-        size = float(np.linalg.norm(scaled))
-        if size == 0.0 or not np.any(J[:, i] + J[:, j]):
+        if not np.any(J[:, i] + J[:, j]):
             continue
-        if ident.outside_row_space(scaled) > NULL_TOLERANCE:
+        if ident.outside_row_space(direction * ident.scale) > NULL_TOLERANCE:
             out.append((i, j))
     return out
 
