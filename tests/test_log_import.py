@@ -1391,11 +1391,50 @@ def test_a_table_angle_or_rate_column_gives_each_turn_between_rests_its_angle(tm
     assert abs(kgzz["estimate"] - 1.003) < 3.3 * kgzz["u"], kgzz
 
 
+@pytest.mark.parametrize("layout", ["gyros faster", "accelerometers faster", "interleaved"])
+def test_a_table_column_in_the_gyro_log_is_paired_with_its_outputs(tmp_path, layout):
+    """The indexing log of the test above (turns of 45, -30, 405, 90 and -567 deg, then a steady 50 deg/s), the
+    encoder's wrapping angle logged in the gyros' file and the accelerometers in a file of their own
+    (``--accel-log``), or each sensor in rows of its own in one file, the encoder on every row. Gyros at 200 Hz and
+    accelerometers at 100 Hz stamped half-way between two gyro samples: each accelerometer sample is kept with the
+    mean of the two gyro samples and of their two encoder readings, so the encoder must be unwrapped before it is
+    averaged (a mean of 359.99 and 0.01 deg is 180 deg). The other way round, and interleaved: the gyro samples are
+    kept with their own readings. Each turn between two rests takes the table's angle over it, within the
+    encoder's resolution of the turn made, and the steady turn the angle's change per sample, as in one file."""
+    turns = [45, -30, 405, 90, -567]
+    fast = 200.0 if layout == "gyros faster" else 100.0
+    t, x, rate, angle, whole = _indexed_turns_log(turns, seed=33, fs=fast)
+    encoder = np.round((angle + 123.0) % 360.0, 4)
+    gyro, accel = tmp_path / "gyro.csv", tmp_path / "accel.csv"
+    if layout == "gyros faster":  # the accelerometers at half the rate, each the mean of two samples
+        write_synthetic(gyro, t, x[:, :3], names=("gx", "gy", "gz"), extra={"enc": encoder})
+        write_synthetic(accel, t[0::2] + 0.5 / fast, 0.5 * (x[0::2, 3:] + x[1::2, 3:]), names=("ax", "ay", "az"))
+    elif layout == "accelerometers faster":  # at twice the rate, 2.5 ms either side of each gyro sample
+        write_synthetic(gyro, t, x[:, :3], names=("gx", "gy", "gz"), extra={"enc": encoder})
+        write_synthetic(accel, np.column_stack([t - 0.0025, t + 0.0025]).ravel(), np.repeat(x[:, 3:], 2, axis=0),
+                        names=("ax", "ay", "az"))
+    else:
+        blank = np.full((t.size, 3), np.nan)
+        rows = np.concatenate([np.column_stack([t, x[:, :3], blank, encoder]),
+                               np.column_stack([t + 0.0025, blank, x[:, 3:], encoder])])
+        rows = rows[np.argsort(rows[:, 0], kind="stable")]
+        text = "\n".join(",".join("" if math.isnan(v) else f"{v:.12g}" for v in row) for row in rows)
+        gyro.write_text("time,gx,gy,gz,ax,ay,az,enc\n" + text + "\n")
+    second = {} if layout == "interleaved" else {"accel_log": accel}
+    imported = import_log(gyro, time_column="time", units="deg/s,m/s^2", columns=("gx", "gy", "gz", "ax", "ay", "az"),
+                          table_angle_column="enc", **second)
+    assert not [w for w in imported.warnings if w.name.startswith("table")], imported.warnings
+    rotations = [s for s in imported.recording.schedule.segments if s.test == "rotation"]
+    assert len(rotations) == 6
+    assert [math.degrees(s.angle) for s in rotations[:5]] == pytest.approx(whole, abs=1e-3)
+    assert math.degrees(rotations[5].rate) == pytest.approx(50.0, abs=1e-3)
+
+
 def test_a_table_angle_column_in_the_wrong_unit_or_not_finite_is_named(tmp_path, capsys):
     """The encoder's column in rad read as deg (the default unit): the table turns 57 times less than the gyros
     measure, so the turns it reads beyond 1 deg are moves, named in one warning (``table_turn_not_a_rotation``);
-    read with ``--table-angle-unit rad`` they are rotations. A unit that is no angle, a NaN in the column, and the
-    column with a second file are refused, naming the option or the line."""
+    read with ``--table-angle-unit rad`` they are rotations. A unit that is no angle and a NaN in the column are
+    refused, naming the option or the line."""
     t, x, rate, angle, whole = _indexed_turns_log([90, -180], seed=32)
     log = tmp_path / "table.csv"
     write_synthetic(log, t, x, extra={"enc": np.radians(angle)})
@@ -1419,8 +1458,6 @@ def test_a_table_angle_column_in_the_wrong_unit_or_not_finite_is_named(tmp_path,
     assert "the log holds the table's column 'enc'" in report["turntable"], report["turntable"]
     with pytest.raises(ValueError, match=r"--table-angle-unit 'deg/s': allowed: rad, deg"):
         import_log(log, time_column="time", units="deg/s,m/s^2", table_angle_column="enc", table_angle_unit="deg/s")
-    with pytest.raises(ValueError, match="--table-angle-column with --accel-log"):
-        import_log(log, time_column="time", units="deg/s,m/s^2", table_angle_column="enc", accel_log=log)
     column = np.radians(angle)
     column[700] = np.nan
     write_synthetic(log, t, x, extra={"enc": column})

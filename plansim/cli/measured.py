@@ -98,13 +98,14 @@ def _add_import_command(sub) -> None:
     p.add_argument("--table-rate-column", default=None, metavar="COL",
                    help="a column holding the turntable's rate (its encoder's or controller's): each steady turn's "
                         "rate is its mean over the segment, signed as the gyros measured the turn, so the fit uses "
-                        "it without editing the segment table")
+                        "it without editing the segment table (with --accel-log: a column of LOG)")
     p.add_argument("--table-rate-unit", default="deg/s", metavar="UNIT",
                    help="unit of --table-rate-column (deg/s, rad/s or deg/h; default deg/s)")
     p.add_argument("--table-angle-column", default=None, metavar="COL",
                    help="a column holding the turntable's angle (its encoder's position, wrapping or not): each turn "
                         "between two rests takes the table's change of angle as its reference, whatever the angle, "
-                        "and without --table-rate-column its rate gives each steady turn's")
+                        "and without --table-rate-column its rate gives each steady turn's (with --accel-log: a "
+                        "column of LOG)")
     p.add_argument("--table-angle-unit", default="deg", metavar="UNIT",
                    help="unit of --table-angle-column (deg, rad, arcmin or arcsec; default deg)")
     p.add_argument("--poses", default="hand", metavar="{hand,table}",

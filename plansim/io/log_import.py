@@ -20,6 +20,7 @@ log may still be used for despite a flaw (a gap, a saturated stretch, timing jit
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from dataclasses import dataclass
@@ -193,8 +194,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
     table_rate_column : str or None
         A column holding the turntable's rate (its encoder or its controller's setpoint), in *table_rate_unit*:
         each steady turn's ``rate`` is its mean over the segment, signed as the gyros measured the turn (the
-        table's sense and the body axis's may differ), so the fit can use it without editing the table. A log of
-        one file only (not with ``accel_log``).
+        table's sense and the body axis's may differ), so the fit can use it without editing the table. With
+        ``accel_log``, a column of the gyros' log (paired as its samples are: :func:`plansim.io.log_pairing.pair_logs`).
     table_rate_unit : str
         Unit of that column: one of :data:`plansim.units.KINDS` ``angular_rate`` (``deg/s`` by default).
     table_angle_column : str or None
@@ -203,7 +204,7 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         takes the table's change of angle over it as its reference angle, whatever the angle (step 8 of
         :mod:`plansim.estimate.segmentation`), and without *table_rate_column* its rate (the angle's change per
         sample times the sample rate) decides step 6 and gives each steady turn its rate as a rate column does.
-        A log of one file only.
+        With ``accel_log``, a column of the gyros' log, unwrapped before the pairing averages it.
     table_angle_unit : str
         Unit of that column: one of :data:`plansim.units.KINDS` ``angle`` (``deg`` by default).
     poses : str
@@ -263,8 +264,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         raise ValueError("--time-unit samples: a sample counter needs --sample-rate HZ")
     if poses not in POSES:
         raise ValueError(f"--poses {poses!r}; allowed: {', '.join(POSES)} (how the log's poses were set)")
-    table_rate_factor = _table_factor("rate", table_rate_column, table_rate_unit, accel_log)
-    table_angle_factor = _table_factor("angle", table_angle_column, table_angle_unit, accel_log)
+    table_rate_factor = _table_factor("rate", table_rate_column, table_rate_unit)
+    table_angle_factor = _table_factor("angle", table_angle_column, table_angle_unit)
     if temperature_column is not None and temperature is not None:
         raise ValueError("--temperature and --temperature-column: give one (the log's column, or the lab's "
                          "temperature)")
@@ -296,12 +297,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         columns = tuple(str(name)[1:].strip() if sign < 0 else name for name, sign in zip(columns, signs))
     seconds_per_unit = TIME_UNITS[time_unit] if time_unit != "samples" else 1.0 / sample_rate
     if accel_log is None:
-        table = read_log(path, columns, time_column, temperature_column, table_rate_column=table_rate_column,
-                         table_angle_column=table_angle_column)
-        if table.interleaved and (table_rate_column is not None or table_angle_column is not None):
-            raise ValueError(f"log {str(table.path)!r}: its gyro and accelerometer samples are in rows of their own, "
-                             "paired by time; --table-rate-column and --table-angle-column are read from a log "
-                             "whose rows hold all six")
+        table = _unwrapped(read_log(path, columns, time_column, temperature_column,
+                                    table_rate_column=table_rate_column, table_angle_column=table_angle_column),
+                           table_angle_factor)
         if table.interleaved:  # the gyros' and the accelerometers' samples in rows of their own: paired by time
             table = pair_logs(*split_interleaved(table), seconds_per_unit)
     else:
@@ -310,8 +308,10 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
                              f"three ({', '.join(CHANNELS[:3])}) then the accelerometer log's "
                              f"({', '.join(CHANNELS[3:])})")
         halves = (None, None) if columns is None else (columns[:3], columns[3:])
-        table = pair_logs(read_log(path, halves[0], time_column, temperature_column, channels=CHANNELS[:3]),
-                          read_log(accel_log, halves[1], time_column, None, channels=CHANNELS[3:]),
+        gyro = _unwrapped(read_log(path, halves[0], time_column, temperature_column, channels=CHANNELS[:3],
+                                   table_rate_column=table_rate_column, table_angle_column=table_angle_column),
+                          table_angle_factor)
+        table = pair_logs(gyro, read_log(accel_log, halves[1], time_column, None, channels=CHANNELS[3:]),
                           seconds_per_unit)
     where = f"log {str(table.path)!r}"
     n = table.channels.shape[0]
@@ -434,8 +434,8 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         time_s = timing.sample_times
     table_rate_si = None if table.table_rate is None else table.table_rate * table_rate_factor
     table_angle_si = None
-    if table.table_angle is not None:  # unwrapped; its rate per sample, where no rate column was logged
-        table_angle_si = np.unwrap(table.table_angle * table_angle_factor)
+    if table.table_angle is not None:  # unwrapped as read (_unwrapped); its rate per sample, where no rate column
+        table_angle_si = table.table_angle * table_angle_factor
         if table_rate_si is None and n > 1:
             table_rate_si = np.gradient(table_angle_si) * timing.sample_rate
     segmentation = segment_log(samples, time_s, timing.sample_rate, window=window, min_static=min_static,
@@ -721,19 +721,25 @@ def _as_logged(value: float, c: int, factors, divisors, offsets, unit_names, cou
     return f"{value / factors[c] * divisors[c]:.6g} {unit_names[c]}"
 
 
-def _table_factor(quantity: str, column: str | None, unit: str, accel_log) -> float:
+def _table_factor(quantity: str, column: str | None, unit: str) -> float:
     """SI per unit of the table's *quantity* column (``"rate"``: :data:`plansim.units.KINDS` ``angular_rate``;
     ``"angle"``: ``angle``), checking its option; NaN where the column is not given."""
     if column is None:
         return math.nan
-    if accel_log is not None:
-        raise ValueError(f"--table-{quantity}-column with --accel-log: the table's {quantity} is read from a log of "
-                         "one file only")
     kind = "angular_rate" if quantity == "rate" else "angle"
     spelled = UNIT_SPELLINGS.get(unit, unit)
     if spelled not in KINDS[kind]:
         raise ValueError(f"--table-{quantity}-unit {unit!r}: allowed: {', '.join(u for u in KINDS[kind] if u)}")
     return KINDS[kind][spelled]
+
+
+def _unwrapped(table: LogTable, factor: float) -> LogTable:
+    """*table* with its table-angle column unwrapped in the file's unit (*factor* rad per unit), before anything
+    averages it (the pairing of two sensors sampled apart): an encoder that wraps at a turn must not change by half
+    a turn between two samples."""
+    if table.table_angle is None:
+        return table
+    return dataclasses.replace(table, table_angle=np.unwrap(table.table_angle, period=2.0 * math.pi / factor))
 
 
 def table_source(table: LogTable, quantity: str = "rate") -> str:

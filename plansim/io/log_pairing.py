@@ -42,6 +42,11 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
     (at most half a period of the faster log, at equal rates) does not move a static pose's means; in a turn it
     delays one sensor by less than a sample.
 
+    The gyro log's other columns (a temperature, the table's rate or its unwrapped angle) follow its outputs: as
+    logged where its samples are kept, else the mean over the gyro samples paired with each kept sample, the same
+    samples whose outputs are averaged. A turn's mean table rate, and the table's angle from rest to rest, are then
+    the reference of exactly the gyro outputs that measured them.
+
     Logs without a time column are paired row by row, and must then have as many rows (imu_tk's files, sampled
     together).
 
@@ -56,8 +61,8 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
     Returns
     -------
     LogTable
-        The six channels on the kept samples; ``path``, ``lines``, ``time`` and the header's details are the kept
-        log's, and ``pairing`` says what was done.
+        The six channels on the kept samples, with the gyro log's temperature and table columns; ``path``,
+        ``lines``, ``time`` and the header's details are the kept log's, and ``pairing`` says what was done.
 
     Raises
     ------
@@ -121,12 +126,13 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
                          "column's unit) do not overlap in time: they must be stamped by one clock")
     gyro_part, accel_part = ((kept.channels[keep], means[keep]) if kept is gyro
                              else (means[keep], kept.channels[keep]))
-    temperature = None
-    if gyro.temperature is not None:
-        if kept is gyro:
-            temperature = gyro.temperature[keep]
-        else:
-            temperature = interval_means(gyro.temperature)[keep]  # over the gyro samples paired, as their outputs
+    def gyro_column(values: np.ndarray | None) -> np.ndarray | None:
+        """A column of the gyro log (the temperature, the table's rate or unwrapped angle) on the kept samples: as
+        logged where the gyro log is kept, else its mean over the gyro samples paired with each, as their outputs."""
+        if values is None:
+            return None
+        return values[keep] if kept is gyro else interval_means(values)[keep]
+
     rates = [1.0 / (period * seconds_per_unit) for period in (period_gyro, period_accel)]
     kind = "equal-rate" if abs(period_gyro - period_accel) <= 1e-3 * period_gyro else "slower"
     apart = np.abs(offset[keep]) * seconds_per_unit
@@ -146,7 +152,9 @@ def pair_logs(gyro: LogTable, accel: LogTable, seconds_per_unit: float = 1.0) ->
                      f"{PAIRING_REACH:g} of its periods (before it started, after it stopped or in a gap): dropped")
     return dataclasses.replace(
         kept, channels=np.hstack([gyro_part, accel_part]), names=gyro.names + accel.names,
-        time=kept.time[keep], temperature=temperature, temperature_column=gyro.temperature_column,
+        time=kept.time[keep], temperature=gyro_column(gyro.temperature), temperature_column=gyro.temperature_column,
+        table_rate=gyro_column(gyro.table_rate), table_rate_column=gyro.table_rate_column,
+        table_angle=gyro_column(gyro.table_angle), table_angle_column=gyro.table_angle_column,
         ignored=gyro.ignored + accel.ignored, first_line=int(kept.lines[keep][0]), lines=kept.lines[keep],
         decimal_comma=gyro.decimal_comma or accel.decimal_comma, units_row=_paired_units_row(gyro, accel),
         pairing=(note, *extra, *_skipped_lines(other)))
@@ -172,7 +180,8 @@ def _clock(table: LogTable, what: str) -> tuple[np.ndarray, float]:
 def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
     """The gyro and the accelerometer rows of a log that writes each sensor's samples in rows of their own, the
     other sensor's three columns left empty (``table.interleaved``), as two tables for :func:`pair_logs`. A row
-    holding both is in both.
+    holding both is in both. The table's columns (logged on every row) go with the gyro rows, as the temperature
+    does with each: :func:`pair_logs` pairs them with the gyros' outputs.
 
     Raises
     ------
@@ -192,9 +201,22 @@ def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
         halves.append(dataclasses.replace(
             table, channels=table.channels[rows, part], names=table.names[part], time=table.time[rows],
             temperature=None if table.temperature is None else table.temperature[rows], lines=table.lines[rows],
+            **_table_columns(table, rows if sensor == "gyro" else None),
             first_line=int(table.lines[rows[0]]), interleaved=False))
     # one file: what was skipped in it is reported once, with the kept half
     return halves[0], dataclasses.replace(halves[1], preamble=(), trailing=())
+
+
+def _table_columns(table: LogTable, rows: np.ndarray | None) -> dict:
+    """The table's rate and angle columns of *table* on *rows* (the gyro half of an interleaved log, which pairs
+    them as its temperature), or none (*rows* None: the accelerometer half)."""
+    out = {}
+    for field in ("table_rate", "table_angle"):
+        values = getattr(table, field)
+        keep = values is not None and rows is not None
+        out[field] = values[rows] if keep else None
+        out[f"{field}_column"] = getattr(table, f"{field}_column") if keep else None
+    return out
 
 
 def _paired_units_row(gyro: LogTable, accel: LogTable) -> tuple[int, tuple[str, ...]] | None:
