@@ -229,6 +229,10 @@ class _Use:
     model_segments: list
     gyro_only: list  # per used segment: only its gyro means are fitted (a turn known by its angle, a hand turn)
     hand_axes: tuple
+    #: each turn fitted by its angle: (its index among the used segments, the rest it starts from, the rest it ends
+    #: at, its angle in rad); a rest is numbered by the motions before it, so the turns on either side of one rest
+    #: (or of none) share its number (:meth:`plansim.fit.model.MeanModel.turn_angle_sources`)
+    angle_turns: tuple = ()
 
 
 #: a turn fitted by its rate must hold it: its mean rate may differ from its median (the steady rate) by at most
@@ -267,8 +271,10 @@ def _unsteady(samples: np.ndarray) -> str | None:
 def _segment_use(schedule: Schedule, recording=None) -> _Use:
     """Which segments the fit uses, and how (:class:`_Use`); with *recording*, a turn fitted by its rate is used
     only where its samples hold one rate (:func:`_unsteady`)."""
-    used, unused, model_segments, gyro_only, hand_axes = [], {}, [], [], set()
+    used, unused, model_segments, gyro_only, hand_axes, angle_turns = [], {}, [], [], set(), []
+    motions = 0  # motions (turns, moves) before segment k: the number of the rest it starts from
     for k, s in enumerate(schedule.segments):
+        rest, motions = motions, motions + (s.test == "move" or s.is_rotating)
         if s.test == "move":
             unused[k] = "a move between poses: no reference to fit it against"
             continue
@@ -298,11 +304,13 @@ def _segment_use(schedule: Schedule, recording=None) -> _Use:
         rate = s.angle / duration if by_angle else s.rate  # the mean rate: ∫ω dt = angle, whatever the profile
         model_segments.append(dataclasses.replace(s, rate=rate, heading=s.heading if s.heading_known else 0.0,
                                                   orientation="known"))
+        if by_angle:
+            angle_turns.append((len(used), rest, rest + 1, float(s.angle)))
         used.append(k)
         gyro_only.append(by_angle or not on_table)
         if not on_table:
             hand_axes.add("xyz".index(s.rate_axis[1]))
-    return _Use(used, unused, model_segments, gyro_only, tuple(sorted(hand_axes)))
+    return _Use(used, unused, model_segments, gyro_only, tuple(sorted(hand_axes)), tuple(angle_turns))
 
 
 #: harmonics of the quantiser's covariance summed over every pair of segments; beyond them only the pairs whose
@@ -383,7 +391,11 @@ def _prior_covariance(V: np.ndarray, sources: Sources, noise: NoiseEstimate, fit
 
 
 def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, turntable, site_inputs,
-                   held: list[int], jacobian: np.ndarray, levels, tilts, priors: HeldPriors) -> Sources:
+                   held: list[int], jacobian: np.ndarray, levels, tilts, priors: HeldPriors,
+                   turn_angles: tuple = ((), 0.0)) -> Sources:
+    """The inputs that act on the segment means (docs/fitting.md, "Uncertainty"). *turn_angles* = (turns, u): the
+    turns fitted by an angle the table set or measured (:attr:`_Use.angle_turns`) and its angle's standard
+    uncertainty at each rest (0: none); those turns then carry no rate error of the point."""
     S = model.n_segments
     sources = Sources(6 * S)
     quantisation = noise.quantisation_variance
@@ -424,7 +436,10 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
                 column = np.zeros((S, 6))
                 column[:, c] = vector
                 sources.add(column.ravel(), math.sqrt(value), math.inf, "quantisation")
-    inputs = list(model.table_sources(theta, turntable, tilts))
+    turns, u_angle = turn_angles
+    inputs = list(model.table_sources(theta, turntable, tilts,
+                                      by_angle=[t[0] for t in turns] if u_angle > 0 else ()))
+    inputs += model.turn_angle_sources(theta, turns, u_angle, tilts)
     if site_inputs is not None:
         inputs += model.site_sources(theta, *site_inputs, tilts=tilts)
     covariance = model.angle_covariance(theta, tilts)  # the start angle itself, then its interaction with each input
@@ -767,28 +782,35 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
                          f"{len(unused)} segment(s) not used: " + "; ".join(f"{k}: {r}" for k, r in unused.items()))
     _refuse_constant_channels(recording)
     used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
-    if all(s.orientation != "known" for s in used_schedule.segments):
+    on_table = any(s.orientation == "known" for s in used_schedule.segments)
+    rate_column, angle_column = (schedule.import_notes.get(key) for key in TABLE_COLUMN_NOTES)
+    # a turn fitted by its angle carries the table's angle errors where the table gave it: its encoder's column,
+    # or a table that set the poses and turned between them by the angles given (poses on a table, no rate column);
+    # each rest's angle is off by the table's position accuracy and repeatability (docs/fitting.md)
+    encoder = bool(use.angle_turns) and bool(angle_column or (on_table and not rate_column))
+    turn_angles = (use.angle_turns, turntable.position_uncertainty if encoder else 0.0)
+    if not on_table:
         # no pose on a table: its position errors have nothing to act on (the hand placement is fitted instead); a
-        # turn fitted by its given rate is the table's (an imported steady turn), whose rate errors stay
+        # turn fitted by its given rate is the table's (an imported steady turn), or its angle the table's rate
+        # column's integral, whose rate errors stay
         zero = ErrorDistribution("uniform", 0.0)
-        if any(s.is_rotating and s.rate_known for s in used_schedule.segments):
+        by_rate = any(s.is_rotating and s.rate_known for s in used_schedule.segments) or \
+            bool(use.angle_turns and rate_column and not angle_column)
+        angles = (f"the turns' angles are the table's column {angle_column!r}, off by its position accuracy and "
+                  "repeatability at each rest") if encoder else ""
+        if by_rate:
             turntable = dataclasses.replace(turntable, position_accuracy=zero, position_repeatability=zero,
                                             axis_perpendicularity=zero, platform_tilt=zero,
                                             fixture_perpendicularity=zero)
-            turntable_source = (f"{turntable_source}: its rate errors only (the turns' rates are the table's; every "
-                                "pose is placed by hand)")
+            turntable_source = (f"{turntable_source}: its rate errors{' and angle errors' if encoder else ''} only "
+                                f"(the turns' rates are the table's{'; ' + angles if encoder else ''}; every pose is "
+                                "placed by hand)")
+        elif encoder:
+            turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
+            turntable_source = f"{turntable_source}: its angle errors only ({angles}; every pose is placed by hand)"
         else:
             turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
-            logged = {key: value for key, value in schedule.import_notes.items()
-                      if key in TABLE_COLUMN_NOTES and value}
-            if logged and any(s.is_rotating for s in used_schedule.segments):
-                # plansim import took the turns' angles from the table's column (docs/measured-data.md)
-                turntable_source = (f"none: the poses are placed by hand; the log holds the table's column "
-                                    f"{', '.join(map(repr, logged.values()))}, and a turn by the table's angle "
-                                    "carries no Type B for its errors (its encoder's accuracy is not an input of "
-                                    "the fit)")
-            else:
-                turntable_source = "none: every pose and turn is by hand (no table)"
+            turntable_source = "none: every pose and turn is by hand (no table)"
     model_schedule = Schedule(tuple(use.model_segments), procedure=schedule.procedure)
     rows = np.ones((len(used), 6), dtype=bool)
     rows[np.asarray(use.gyro_only, dtype=bool), 3:] = False  # a hand turn's accelerometers feel the hand
@@ -858,7 +880,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     # Type B sensitivities at the nominal point, then at the estimate; then once more with the between-segment
     # noise the residuals show beyond the prediction (slow noise the segments are too short to show)
     for iteration in range(3):
-        sources = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, levels, tilts, priors)
+        sources = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, levels, tilts, priors,
+                                 turn_angles)
         if iteration == 1:
             V_predicted = sources.covariance()
         if slow is not None:
@@ -870,7 +893,8 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         # that hold only as exactly as the levels, the dither and the offset model do (docs/fitting.md)
         working = V
         if levels is not None and np.any(noise.quantisation_variance > 0):
-            work = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, None, tilts, priors)
+            work = _build_sources(model, theta, noise, turntable, site_inputs, held_kg, J, None, tilts, priors,
+                                  turn_angles)
             if slow is not None:
                 add_between_segment_noise(work, slow, rows.reshape(observed.shape), times)
             working = work.covariance()

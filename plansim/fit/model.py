@@ -323,7 +323,7 @@ class MeanModel:
         spread = np.einsum("ksi,ksj->sij", centred, centred) / ANGLES
         return InputSource(name, kind, u, mean.ravel(), spread)
 
-    def table_sources(self, theta: np.ndarray, turntable, tilts=None) -> list[InputSource]:
+    def table_sources(self, theta: np.ndarray, turntable, tilts=None, by_angle=()) -> list[InputSource]:
         """Type B inputs of the turntable and fixture (JJF 2003 Table 1, §6.2), at the parameters *theta*.
 
         Per segment: the position error (a rotation of the pose about East, North and Up; accuracy and
@@ -332,7 +332,9 @@ class MeanModel:
         axis) and the systematic rate error. Each with the standard uncertainty of its
         :class:`~plansim.config.scenario.ErrorDistribution` and the sensitivity of the segment means by
         central differences of the kernel's physics. A pose placed by hand has no table position error: its
-        tilt is a parameter of the fit (*tilts*).
+        tilt is a parameter of the fit (*tilts*). The turns *by_angle* (segment indices) are fitted by an angle
+        whose errors are the table's at its rests (:meth:`turn_angle_sources`), not by a rate: no rate error of
+        the point.
         """
         S = self.n_segments
         sources: list[InputSource] = []
@@ -348,6 +350,8 @@ class MeanModel:
         if u_point > 0 and self.rotating.any():
             d = self.segment_sensitivity(theta, SEG_RATE_ERROR, tilts)
             for s in np.flatnonzero(self.rotating):
+                if s in by_angle:
+                    continue
                 sources.append(self._source(f"rate error of the point, segment {s}", "table", u_point, d, s))
         per_calibration = [
             ("fixture misalignment about x", FIXTURE.start, turntable.fixture_perpendicularity, ANGLE_STEP),
@@ -365,6 +369,29 @@ class MeanModel:
                 if np.any(d):
                     sources.append(self._source(name, "table", u, d))
         return sources
+
+    def turn_angle_sources(self, theta: np.ndarray, turns, u: float, tilts=None) -> list[InputSource]:
+        """Type B inputs of the angles of turns fitted by their angle, where the table gave it (its encoder's
+        column, or the angle it was set to turn between two poses).
+
+        A turn by *angle* over T seconds is fitted through its mean rate angle/T (docs/fitting.md, "Turns known by
+        their angle"). The table's angle at each rest is off by e_r (its position accuracy and repeatability, of
+        standard uncertainty *u*, rad), so a turn from rest a to rest b is off by e_b − e_a: a relative rate error
+        (e_b − e_a)/angle. One input per rest: the turns on either side of one rest share its e_r (over a run of
+        turns the errors telescope, and the angle turned in all is off by the first and last rests' alone).
+
+        *turns*: (segment index, the rest it starts from, the rest it ends at, angle in rad) per turn; none, or
+        *u* = 0: no input.
+        """
+        if u <= 0 or not turns:
+            return []
+        d = self.segment_sensitivity(theta, SEG_RATE_ERROR, tilts)  # (ANGLES, S, 6) per relative rate error
+        by_rest: dict[int, np.ndarray] = {}
+        for s, start, end, angle in turns:
+            for rest, sign in ((start, -1.0), (end, 1.0)):
+                at = by_rest.setdefault(rest, np.zeros_like(d))
+                at[:, s] += sign * d[:, s] / angle
+        return [self._source(f"the table's angle at rest {rest}", "table", u, at) for rest, at in by_rest.items()]
 
     def site_sources(self, theta: np.ndarray, u_gravity: float, u_earth_enu, tilts=None) -> list[InputSource]:
         """Type B inputs of an unknown site: gravity and the Earth rate's components."""
