@@ -64,7 +64,7 @@ from plansim.fit.site import TABLE_1_TURNTABLE, Site, unknown_site_inputs
 from plansim.fit.solve import solve, weak_directions, whitening
 from plansim.kernels.layout import CHANNELS
 from plansim.model.parameters import PARAMETER_INDEX, PARAMETER_NAMES, PARAMETERS
-from plansim.schedule.segments import TABLE_COLUMN_NOTES, Schedule
+from plansim.schedule.segments import TABLE_ANGLE_NOTE, TABLE_RATE_NOTE, Schedule
 from plansim.units import STANDARD_GRAVITY, to_unit
 
 METHOD_SPEC = "jjf2003"
@@ -783,7 +783,7 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
     _refuse_constant_channels(recording)
     used_schedule = Schedule(tuple(schedule.segments[k] for k in used), procedure=schedule.procedure)
     on_table = any(s.orientation == "known" for s in used_schedule.segments)
-    rate_column, angle_column = (schedule.import_notes.get(key) for key in TABLE_COLUMN_NOTES)
+    rate_column, angle_column = (schedule.import_notes.get(key) for key in (TABLE_RATE_NOTE, TABLE_ANGLE_NOTE))
     # a turn fitted by its angle carries the table's angle errors where the table gave it: its encoder's column,
     # or a table that set the poses and turned between them by the angles given (poses on a table, no rate column);
     # each rest's angle is off by the table's position accuracy and repeatability (docs/fitting.md)

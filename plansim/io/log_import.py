@@ -56,7 +56,7 @@ from plansim.io.log_table import (
     read_log,
 )
 from plansim.io.recording_data import CHANNELS, SITE_ATTRIBUTES, UNITS_DESCRIPTION, Recording, plansim_version
-from plansim.schedule.segments import IMPORT_NOTES, Schedule, Segment
+from plansim.schedule.segments import IMPORT_NOTES, TABLE_ANGLE_NOTE, TABLE_RATE_NOTE, Schedule, Segment
 from plansim.units import KINDS, STANDARD_GRAVITY
 
 #: a static span's mean specific force must be within this fraction of standard gravity (units check)
@@ -614,9 +614,9 @@ def import_log(path: str | os.PathLike, *, columns: tuple[str, ...] | None = Non
         "preamble": list(table.preamble),
         "header": table.has_header,
         "time_column": table.time_column,
-        "table_rate_column": table.table_rate_column,
+        TABLE_RATE_NOTE: table.table_rate_column,
         "table_rate_unit": table_rate_unit if table.table_rate_column is not None else None,
-        "table_angle_column": table.table_angle_column,
+        TABLE_ANGLE_NOTE: table.table_angle_column,
         "table_angle_unit": table_angle_unit if table.table_angle_column is not None else None,
         "time_unit": time_unit if table.time_column is not None else None,
         "detector": {

@@ -190,8 +190,10 @@ class Segment:
 #: (:func:`plansim.io.log_import.import_log` writes it; the fit and the import summary read it:
 #: :attr:`Schedule.import_notes`)
 IMPORT_NOTES = "import"
-#: … its entries naming the table's columns the log held (the column's name, or None)
-TABLE_COLUMN_NOTES = ("table_rate_column", "table_angle_column")
+#: … its entries naming the table's columns the log held (the column's name, or None): its rate, its angle
+TABLE_RATE_NOTE = "table_rate_column"
+TABLE_ANGLE_NOTE = "table_angle_column"
+TABLE_COLUMN_NOTES = (TABLE_RATE_NOTE, TABLE_ANGLE_NOTE)
 
 
 @dataclass(frozen=True)
