@@ -1431,6 +1431,10 @@ def test_a_table_column_in_the_gyro_log_is_paired_with_its_outputs(tmp_path, lay
     assert len(rotations) == 6
     assert [math.degrees(s.angle) for s in rotations[:5]] == pytest.approx(whole, abs=1e-3)
     assert math.degrees(rotations[5].rate) == pytest.approx(50.0, abs=1e-3)
+    if layout != "interleaved":  # the column looked for in the gyros' log, and the error says so
+        with pytest.raises(ValueError, match=r"column 'enc\.x' is missing.*read from the gyros' log, LOG"):
+            import_log(gyro, time_column="time", units="deg/s,m/s^2", columns=("gx", "gy", "gz", "ax", "ay", "az"),
+                       table_angle_column="enc.x", **second)
 
 
 @pytest.mark.parametrize("turns", [[90], [90, 90]])

@@ -338,6 +338,10 @@ def read_log(path: str | os.PathLike, columns: tuple[str, ...] | None = None, ti
                              "by their position, 1 for the first, e.g. --columns 2,3,4,5,6,7 --time 1")
         if missing:
             hint = "" if columns is not None else (" (name the six channel columns with --columns GX,GY,GZ,AX,AY,AZ)")
+            if tuple(channels) == CHANNELS[:3] and missing[0] in (temperature_column, table_rate_column,
+                                                                  table_angle_column):
+                hint = (" (with --accel-log the temperature and the table's columns are read from the gyros' log, "
+                        "LOG)")
             raise ValueError(f"{where}: column {missing[0]!r} is missing; the header (line {header_line}) has "
                              f"{', '.join(header_names)}{hint}")
         ignored = tuple(name for name in header_names if name not in wanted)
