@@ -231,7 +231,7 @@ class _Use:
     hand_axes: tuple
     #: each turn fitted by its angle: (its index among the used segments, the rest it starts from, the rest it ends
     #: at, its angle in rad); a rest is numbered by the motions before it, so the turns on either side of one rest
-    #: (or of none) share its number (:meth:`plansim.fit.model.MeanModel.turn_angle_sources`)
+    #: (or of none) share its number (:meth:`plansim.fit.model.MeanModel.table_sources`)
     angle_turns: tuple = ()
 
 
@@ -436,10 +436,7 @@ def _build_sources(model: MeanModel, theta: np.ndarray, noise: NoiseEstimate, tu
                 column = np.zeros((S, 6))
                 column[:, c] = vector
                 sources.add(column.ravel(), math.sqrt(value), math.inf, "quantisation")
-    turns, u_angle = turn_angles
-    inputs = list(model.table_sources(theta, turntable, tilts,
-                                      by_angle=[t[0] for t in turns] if u_angle > 0 else ()))
-    inputs += model.turn_angle_sources(theta, turns, u_angle, tilts)
+    inputs = list(model.table_sources(theta, turntable, tilts, turn_angles))
     if site_inputs is not None:
         inputs += model.site_sources(theta, *site_inputs, tilts=tilts)
     covariance = model.angle_covariance(theta, tilts)  # the start angle itself, then its interaction with each input
@@ -796,20 +793,20 @@ def fit_recording(recording, site: Site | None = None, turntable=None, turntable
         zero = ErrorDistribution("uniform", 0.0)
         by_rate = any(s.is_rotating and s.rate_known for s in used_schedule.segments) or \
             bool(use.angle_turns and rate_column and not angle_column)
-        angles = (f"the turns' angles are the table's column {angle_column!r}, off by its position accuracy and "
-                  "repeatability at each rest") if encoder else ""
         if by_rate:
             turntable = dataclasses.replace(turntable, position_accuracy=zero, position_repeatability=zero,
                                             axis_perpendicularity=zero, platform_tilt=zero,
                                             fixture_perpendicularity=zero)
-            turntable_source = (f"{turntable_source}: its rate errors{' and angle errors' if encoder else ''} only "
-                                f"(the turns' rates are the table's{'; ' + angles if encoder else ''}; every pose is "
-                                "placed by hand)")
-        elif encoder:
-            turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
-            turntable_source = f"{turntable_source}: its angle errors only ({angles}; every pose is placed by hand)"
         else:
             turntable = Turntable(*([zero] * 7), rate_smoothness=0.0)
+        kept = [(errors, why) for errors, why, on in (
+            ("rate errors", "the turns' rates are the table's", by_rate),
+            ("angle errors", f"the turns' angles are the table's column {angle_column!r}, off by its position "
+             "accuracy and repeatability at each rest", encoder)) if on]
+        if kept:
+            turntable_source = (f"{turntable_source}: its {' and '.join(errors for errors, _ in kept)} only "
+                                f"({'; '.join(why for _, why in kept)}; every pose is placed by hand)")
+        else:
             turntable_source = "none: every pose and turn is by hand (no table)"
     model_schedule = Schedule(tuple(use.model_segments), procedure=schedule.procedure)
     rows = np.ones((len(used), 6), dtype=bool)

@@ -323,7 +323,7 @@ class MeanModel:
         spread = np.einsum("ksi,ksj->sij", centred, centred) / ANGLES
         return InputSource(name, kind, u, mean.ravel(), spread)
 
-    def table_sources(self, theta: np.ndarray, turntable, tilts=None, by_angle=()) -> list[InputSource]:
+    def table_sources(self, theta: np.ndarray, turntable, tilts=None, turn_angles=((), 0.0)) -> list[InputSource]:
         """Type B inputs of the turntable and fixture (JJF 2003 Table 1, §6.2), at the parameters *theta*.
 
         Per segment: the position error (a rotation of the pose about East, North and Up; accuracy and
@@ -332,9 +332,9 @@ class MeanModel:
         axis) and the systematic rate error. Each with the standard uncertainty of its
         :class:`~plansim.config.scenario.ErrorDistribution` and the sensitivity of the segment means by
         central differences of the kernel's physics. A pose placed by hand has no table position error: its
-        tilt is a parameter of the fit (*tilts*). The turns *by_angle* (segment indices) are fitted by an angle
-        whose errors are the table's at its rests (:meth:`turn_angle_sources`), not by a rate: no rate error of
-        the point.
+        tilt is a parameter of the fit (*tilts*). *turn_angles* = (turns, u): turns fitted by an angle the table
+        gave, with its standard uncertainty at each rest (:meth:`_turn_angle_sources`); with u > 0 those turns carry
+        the table's angle errors in place of the rate error of the point.
         """
         S = self.n_segments
         sources: list[InputSource] = []
@@ -347,12 +347,15 @@ class MeanModel:
                         sources.append(self._source(f"position error about {name}, segment {s}", "table",
                                                     u_position, d, s))
         u_point = turntable.rate_error_per_point.standard_uncertainty
-        if u_point > 0 and self.rotating.any():
-            d = self.segment_sensitivity(theta, SEG_RATE_ERROR, tilts)
-            for s in np.flatnonzero(self.rotating):
-                if s in by_angle:
-                    continue
+        turns, u_angle = turn_angles
+        by_angle = {turn[0] for turn in turns} if u_angle > 0 else set()
+        by_rate = [s for s in np.flatnonzero(self.rotating) if s not in by_angle] if u_point > 0 else []
+        angle_sources = []  # appended last
+        if by_rate or by_angle:
+            d = self.segment_sensitivity(theta, SEG_RATE_ERROR, tilts)  # (ANGLES, S, 6) per relative rate error
+            for s in by_rate:
                 sources.append(self._source(f"rate error of the point, segment {s}", "table", u_point, d, s))
+            angle_sources = self._turn_angle_sources(d, turns, u_angle) if by_angle else []
         per_calibration = [
             ("fixture misalignment about x", FIXTURE.start, turntable.fixture_perpendicularity, ANGLE_STEP),
             ("fixture misalignment about y", FIXTURE.start + 1, turntable.fixture_perpendicularity, ANGLE_STEP),
@@ -368,9 +371,9 @@ class MeanModel:
                 d = self._central(theta, [column], step, tilts=tilts)
                 if np.any(d):
                     sources.append(self._source(name, "table", u, d))
-        return sources
+        return sources + angle_sources
 
-    def turn_angle_sources(self, theta: np.ndarray, turns, u: float, tilts=None) -> list[InputSource]:
+    def _turn_angle_sources(self, d: np.ndarray, turns, u: float) -> list[InputSource]:
         """Type B inputs of the angles of turns fitted by their angle, where the table gave it (its encoder's
         column, or the angle it was set to turn between two poses).
 
@@ -380,12 +383,10 @@ class MeanModel:
         (e_b − e_a)/angle. One input per rest: the turns on either side of one rest share its e_r (over a run of
         turns the errors telescope, and the angle turned in all is off by the first and last rests' alone).
 
-        *turns*: (segment index, the rest it starts from, the rest it ends at, angle in rad) per turn; none, or
-        *u* = 0: no input.
+        *d*: the segment means' sensitivity to each segment's relative rate error (:meth:`segment_sensitivity`,
+        ``SEG_RATE_ERROR``); *turns*: (segment index, the rest it starts from, the rest it ends at, angle in rad)
+        per turn.
         """
-        if u <= 0 or not turns:
-            return []
-        d = self.segment_sensitivity(theta, SEG_RATE_ERROR, tilts)  # (ANGLES, S, 6) per relative rate error
         by_rest: dict[int, np.ndarray] = {}
         for s, start, end, angle in turns:
             for rest, sign in ((start, -1.0), (end, 1.0)):
