@@ -180,8 +180,8 @@ def _clock(table: LogTable, what: str) -> tuple[np.ndarray, float]:
 def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
     """The gyro and the accelerometer rows of a log that writes each sensor's samples in rows of their own, the
     other sensor's three columns left empty (``table.interleaved``), as two tables for :func:`pair_logs`. A row
-    holding both is in both. The table's columns (logged on every row) go with the gyro rows, as the temperature
-    does with each: :func:`pair_logs` pairs them with the gyros' outputs.
+    holding both is in both. The temperature and the table's columns (logged on every row) are kept on each half's
+    rows: :func:`pair_logs` pairs the gyro half's with the gyros' outputs.
 
     Raises
     ------
@@ -200,23 +200,16 @@ def split_interleaved(table: LogTable) -> tuple[LogTable, LogTable]:
                              "sensor's (the other three columns empty), and each sensor needs its samples")
         halves.append(dataclasses.replace(
             table, channels=table.channels[rows, part], names=table.names[part], time=table.time[rows],
-            temperature=None if table.temperature is None else table.temperature[rows], lines=table.lines[rows],
-            **_table_columns(table, rows if sensor == "gyro" else None),
+            temperature=_on_rows(table.temperature, rows), table_rate=_on_rows(table.table_rate, rows),
+            table_angle=_on_rows(table.table_angle, rows), lines=table.lines[rows],
             first_line=int(table.lines[rows[0]]), interleaved=False))
     # one file: what was skipped in it is reported once, with the kept half
     return halves[0], dataclasses.replace(halves[1], preamble=(), trailing=())
 
 
-def _table_columns(table: LogTable, rows: np.ndarray | None) -> dict:
-    """The table's rate and angle columns of *table* on *rows* (the gyro half of an interleaved log, which pairs
-    them as its temperature), or none (*rows* None: the accelerometer half)."""
-    out = {}
-    for field in ("table_rate", "table_angle"):
-        values = getattr(table, field)
-        keep = values is not None and rows is not None
-        out[field] = values[rows] if keep else None
-        out[f"{field}_column"] = getattr(table, f"{field}_column") if keep else None
-    return out
+def _on_rows(values: np.ndarray | None, rows: np.ndarray) -> np.ndarray | None:
+    """A per-row column (the temperature, the table's rate or angle) on *rows*, or None where it was not logged."""
+    return None if values is None else values[rows]
 
 
 def _paired_units_row(gyro: LogTable, accel: LogTable) -> tuple[int, tuple[str, ...]] | None:
